@@ -1,0 +1,41 @@
+"""jaxbearing: a differentiable dynamic model of cylindrical roller bearings in JAX.
+
+64-bit floats are switched on at import: contact interferences are micrometres on millimetre
+geometry, and gradients through long integrations need the precision.
+"""
+
+import jax
+
+jax.config.update("jax_enable_x64", True)
+
+from ._params import (  # noqa: E402
+    Bearing,
+    Cage,
+    Flange,
+    Lubricant,
+    Material,
+    OperatingPoint,
+    Roller,
+    kinematic_cage_speed,
+    rad_s_to_rpm,
+    reference_bearing,
+    reference_operating_point,
+    rpm_to_rad_s,
+)
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "Bearing",
+    "Cage",
+    "Flange",
+    "Lubricant",
+    "Material",
+    "OperatingPoint",
+    "Roller",
+    "kinematic_cage_speed",
+    "rad_s_to_rpm",
+    "reference_bearing",
+    "reference_operating_point",
+    "rpm_to_rad_s",
+]

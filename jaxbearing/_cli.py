@@ -1,0 +1,58 @@
+"""`jaxbearing` command line.
+
+Each command lives in its own module `jaxbearing._cmd_<name>` exposing
+`register(subparsers) -> None` (adds its parser, sets `func`) so commands stay independent.
+Errors a user can fix (`jaxbearing.ConfigError` and friends) print one line and exit 2; they never
+show a traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+#: command name -> module; the order is the order of `jaxbearing --help`.
+COMMANDS = {
+    "demo": "jaxbearing._cmd_demo",
+    "config": "jaxbearing._cmd_config",
+    "zone": "jaxbearing._cmd_zone",
+    "simulate": "jaxbearing._cmd_simulate",
+}
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="jaxbearing",
+        description="Differentiable dynamic model of cylindrical roller bearings "
+        "(arc-end rollers against ring flanges).",
+    )
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    for name, module in COMMANDS.items():
+        try:
+            mod = importlib.import_module(module)
+        except ModuleNotFoundError as exc:
+            if exc.name != module:
+                raise
+            continue  # command not built yet
+        mod.register(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    from ._errors import UserInputError
+
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if not getattr(args, "func", None):
+        parser.print_help()
+        return 0
+    try:
+        return int(args.func(args) or 0)
+    except UserInputError as exc:
+        print(f"jaxbearing {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())
