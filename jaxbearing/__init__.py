@@ -23,6 +23,10 @@ from ._params import (  # noqa: E402
     rpm_to_rad_s,
 )
 
+from ._config import Config, SimulationSettings, load_config, loads_config, reference_config  # noqa: E402
+from ._errors import ConfigError, UserInputError  # noqa: E402
+from ._validation import validate_bearing  # noqa: E402
+
 __version__ = "0.1.0"
 
 __all__ = [
@@ -38,4 +42,12 @@ __all__ = [
     "reference_bearing",
     "reference_operating_point",
     "rpm_to_rad_s",
+    "Config",
+    "ConfigError",
+    "SimulationSettings",
+    "UserInputError",
+    "load_config",
+    "loads_config",
+    "reference_config",
+    "validate_bearing",
 ]

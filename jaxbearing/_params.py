@@ -135,7 +135,7 @@ class Bearing(eqx.Module):
     cage_material: Material
     lubricant: Lubricant
     num_rollers: int = eqx.field(static=True)  # Z
-    num_slices: int = eqx.field(static=True, default=30)  # N_s
+    num_slices: int = eqx.field(static=True, default=31)  # N_s (odd)
 
     # -- derived geometry ----------------------------------------------------------------
     @property
@@ -266,7 +266,7 @@ def reference_bearing() -> Bearing:
             traction_d=0.04,
         ),
         num_rollers=26,
-        num_slices=30,
+        num_slices=31,
     )
 
 

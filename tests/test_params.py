@@ -71,7 +71,7 @@ def test_masses_differentiable():
 def test_reference_bearing_summary():
     b = jb.reference_bearing()
     op = jb.reference_operating_point()
-    assert b.num_rollers == 26 and b.num_slices == 30
+    assert b.num_rollers == 26 and b.num_slices == 31
     np.testing.assert_allclose(jb.rad_s_to_rpm(jb.kinematic_cage_speed(b, op)),
                                20000 * (1 - 7.5 / 85) / 2, rtol=1e-12)
     assert 0.05 < float(b.cage_mass) < 0.15
