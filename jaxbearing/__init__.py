@@ -51,3 +51,14 @@ __all__ = [
     "reference_config",
     "validate_bearing",
 ]
+
+# roller-end/flange design zone (MODEL.md 4.1; the paper's Figure 14)
+from ._zone import DesignZone, design_zone, design_zone_grid  # noqa: E402
+
+__all__ += ["DesignZone", "design_zone", "design_zone_grid"]
+
+# roller-raceway sliced contact (MODEL.md 4.2) and the quasi-static initial solution (MODEL.md 5)
+from ._quasistatic import QuasiStatic, quasi_static  # noqa: E402
+from ._raceway import RacewayContact, raceway_contact  # noqa: E402
+
+__all__ += ["QuasiStatic", "RacewayContact", "quasi_static", "raceway_contact"]

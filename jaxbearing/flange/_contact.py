@@ -1,0 +1,285 @@
+"""Roller end against ring flange: contact geometry, kinematics, Hertz force, PV (MODEL.md 4.1).
+
+One function, `roller_flange_contact`, handles one roller against one flange for every kind of
+roller end: flat ends with corner radii (R_end = inf), arc (spherical) ends, and the switch from
+arc to corner at the limited circle. It is the support-function form of the paper's Eqs. 2-12
+(corner) and 19-26 (arc end): the contact point is the extreme point of the convex end body in
+the direction of the flange normal, the interference is the support value minus the distance of
+the flange plane from the roller centre.
+
+Frames (all vectors are 3-vectors in the inertial frame; X = bearing axis, Z = radial load):
+
+- ring r with centre c_r, raceway radius R_r, ring_sign g = +1 (inner ring, flange rises
+  radially outward) or -1 (outer ring, flange rises inward); flange side s in {-1, +1};
+- e_rad: unit radial direction from the ring axis to the roller centre (Y, Z components of
+  p - c_r, normalised);
+- the flange cone is replaced by its tangent plane at the roller's azimuth (its circumferential
+  radius of curvature, R_r / sin(theta_f), is over a metre), through
+  P0 = c_r + s (W_r/2) X + R_r e_rad, W_r = L_b1 + Delta_bf (paper Eq. 8), with
+  "up the flange" direction t = g e_rad cos(theta_f) + s X sin(theta_f) and unit normal into
+  the flange n = s X cos(theta_f) - g e_rad sin(theta_f);
+- the roller end facing the flange is the one at +s along the roller axis e; its outward axis is
+  x = s e, cos(alpha) = n . x, and r = (n - cos(alpha) x)/sin(alpha) is the radial direction of
+  the end plane towards the contact.
+
+Roller-local end-face coordinates (`end_face_position`): x = s e, z = e_rad made perpendicular to
+e (so z points away from the ring axis, towards the outer ring), y = z cross x. An aligned
+roller touches an inner-ring flange at z = -rho (the raceway side) and an outer-ring flange at
+z = +rho.
+
+Contact height (`contact_height`) is the height of the contact point above the raceway surface,
+measured radially in the flange's tangent plane: g ((C - c_r) . e_rad - R_r). For an aligned
+roller it is exactly D/2 - rho (MODEL.md 4.1 oracle); the slant distance along the flange face,
+(C - P0) . t, differs from it by the factor cos(theta_f) (4e-4 at 1.6 deg).
+
+Smoothness. The support function is C1 in the pose, so the interference and the normal force
+are C1; the Hertz curvature is blended across the limited circle
+(`jaxbearing._roller_end.LIMITED_CIRCLE_BAND`), so the stiffness is C1 as well. The contact
+point itself is the exact extreme point: continuous, but its rate of change jumps from R_end to
+R_cor per radian of the normal where it crosses the limited circle, so the moment arm (and the
+moments) are C0 with a kink there.
+"""
+
+from __future__ import annotations
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+from jaxtyping import Array, ArrayLike, Float
+
+from .._params import Bearing
+from .._roller_end import end_principal_curvatures, end_support
+from ..contact import (
+    PENETRATION_WIDTH,
+    SLIDING_EPS,
+    effective_modulus,
+    hertz_force,
+    point_contact_ellipse,
+    point_contact_peak_pressure,
+    point_contact_stiffness,
+    safe_norm,
+    smooth_direction,
+)
+
+Scalar = Float[Array, ""]
+Vec3 = Float[Array, "3"]
+
+_AXIS = jnp.array([1.0, 0.0, 0.0])
+
+
+class FlangeContact(eqx.Module):
+    """Result of one roller-end/flange contact (leading batch axes when vmapped).
+
+    Forces in N, moments in N m (about the roller centre / the ring centre), lengths in m,
+    velocities in m/s, pressures in Pa, PV in Pa m/s. `ellipse_semi_axes` are the Hertz
+    semi-axes along the end surface's meridian direction (which is the flange height direction
+    t for an aligned roller; across the corner on a corner contact) and along its parallel
+    circle (circumferential on the roller end).
+    """
+
+    interference: Float[Array, "*batch"]  # delta = h(n) - (P0 - p) . n  (negative: gap)
+    normal_force: Float[Array, "*batch"]  # Q = K delta^1.5 (softplus-smoothed)
+    peak_pressure: Float[Array, "*batch"]  # p_max = 3 Q / (2 pi a b)
+    sliding_velocity: Float[Array, "*batch 3"]  # u, tangential part (paper Eqs. 12/26)
+    sliding_speed: Float[Array, "*batch"]  # |u|
+    pv: Float[Array, "*batch"]  # p_max |u|
+    contact_point: Float[Array, "*batch 3"]  # C, extreme point of the end body
+    contact_height: Float[Array, "*batch"]  # h_c above the raceway surface
+    end_face_position: Float[Array, "*batch 2"]  # (y, z) of C in the roller-local end frame
+    contact_radius: Float[Array, "*batch"]  # rho_c, distance of C from the roller axis
+    on_arc: Float[Array, "*batch"]  # 1 on the arc end, 0 on the corner (smooth)
+    force_on_roller: Float[Array, "*batch 3"]  # F = -Q n + F_t
+    moment_on_roller: Float[Array, "*batch 3"]  # (C - p) x F
+    force_on_ring: Float[Array, "*batch 3"]  # -F
+    moment_on_ring: Float[Array, "*batch 3"]  # (C - c_r) x (-F)
+    ellipse_semi_axes: Float[Array, "*batch 2"]  # (along t / the end meridian, along the parallel)
+
+
+class _Geometry(eqx.Module):
+    """Pose-only part of the contact (no velocities, no load)."""
+
+    normal: Vec3  # n, into the flange
+    interference: Scalar
+    contact_point: Vec3
+    contact_height: Scalar
+    end_face_position: Float[Array, "2"]
+    contact_radius: Scalar
+    on_arc: Scalar
+    radius_meridian: Scalar  # principal radius of the end across the corner / along t
+    radius_parallel: Scalar  # principal radius along the parallel circle
+
+
+def _unit(x: Array) -> Array:
+    """x / |x| with a safe norm (zero vector -> zero vector, finite gradient)."""
+    n = safe_norm(x, axis=-1, keepdims=True)
+    return x / jnp.where(n > 0, n, 1.0)
+
+
+def _flange_geometry(
+    bearing: Bearing,
+    raceway_radius: ArrayLike,
+    side: ArrayLike,
+    ring_sign: ArrayLike,
+    roller_centre: Vec3,
+    roller_axis: Vec3,
+    ring_centre: Vec3,
+) -> _Geometry:
+    """Flange tangent plane, interference, contact point and principal radii (pose only);
+    shared by `roller_flange_contact` and `jaxbearing.design_zone`."""
+    roller = bearing.roller
+    theta = bearing.flange.layback_angle
+    p = jnp.asarray(roller_centre)
+    c_r = jnp.asarray(ring_centre)
+    # radial direction of the roller's azimuth (Y, Z components only)
+    e_rad = _unit((p - c_r) * jnp.array([0.0, 1.0, 1.0]))
+    # flange tangent plane
+    p0 = c_r + side * (bearing.raceway_width / 2) * _AXIS + raceway_radius * e_rad
+    n = side * jnp.cos(theta) * _AXIS - ring_sign * jnp.sin(theta) * e_rad
+    # end frame: outward axis x = s e, radial direction r of the contact
+    x_end = side * _unit(jnp.asarray(roller_axis))
+    cos_a = jnp.dot(n, x_end)
+    n_perp = n - cos_a * x_end
+    sin_a = safe_norm(n_perp)
+    r_hat = _unit(n_perp)
+    h, a, rho = end_support(roller, cos_a, sin_a)
+    delta = h - jnp.dot(p0 - p, n)
+    offset = a * x_end + rho * r_hat  # C - p
+    c = p + offset
+    # roller-local end-face frame (x = s e, z = e_rad perpendicular to e, y = z cross x)
+    z_loc = _unit(e_rad - jnp.dot(e_rad, x_end) * x_end)
+    y_loc = jnp.cross(z_loc, x_end)
+    yz = jnp.stack([jnp.dot(offset, y_loc), jnp.dot(offset, z_loc)])
+    k_m, k_p, w = end_principal_curvatures(roller, sin_a)
+    return _Geometry(
+        normal=n,
+        interference=delta,
+        contact_point=c,
+        contact_height=ring_sign * (jnp.dot(c - c_r, e_rad) - raceway_radius),
+        end_face_position=yz,
+        contact_radius=rho,
+        on_arc=w,
+        radius_meridian=1.0 / k_m,
+        radius_parallel=1.0 / k_p,
+    )
+
+
+def _e_prime(bearing: Bearing) -> Array:
+    r, g = bearing.roller_material, bearing.ring_material
+    return effective_modulus(r.elastic_modulus, r.poisson_ratio, g.elastic_modulus, g.poisson_ratio)
+
+
+def roller_flange_contact(
+    bearing: Bearing,
+    raceway_radius: ArrayLike,
+    side: ArrayLike,
+    ring_sign: ArrayLike,
+    roller_centre: Vec3,
+    roller_axis: Vec3,
+    roller_velocity: Vec3,
+    roller_angular_velocity: Vec3,
+    ring_centre: Vec3,
+    ring_velocity: Vec3,
+    ring_angular_velocity: Vec3,
+) -> FlangeContact:
+    """Contact of one roller end with one ring flange (MODEL.md 4.1; the caller vmaps).
+
+    Interference delta = h(n) - (P0 - p) . n with h the support function of the end body
+    (`jaxbearing._roller_end.end_support`); contact point C = its extreme point.
+
+    Sliding velocity (paper Eqs. 12 and 26): u = (v + w x (C - p)) - (v_r + w_r x (C - c_r)),
+    minus its component along n.
+
+    Hertz point contact of the end surface against the plane (Hamrock & Brewe 1983, via
+    `jaxbearing.contact`): principal radii R_end, R_end on the arc; R_cor across the corner and
+    rho_c / sin(alpha) along it on the corner torus, blended C1 across the limited circle
+    (`end_principal_curvatures`). Q = K delta^1.5 (softplus of width PENETRATION_WIDTH),
+    p_max = 3Q/(2 pi a b), friction F_t = -mu_f Q u / sqrt(|u|^2 + u_eps^2), PV = p_max |u|.
+
+    Forces: on the roller F = -Q n + F_t with moment (C - p) x F about its centre; on the ring
+    -F with moment (C - c_r) x (-F) about the ring centre.
+
+    Arguments: `raceway_radius` R_r of the ring; `side` s = -1 or +1 (flange at -X or +X);
+    `ring_sign` g = +1 inner ring, -1 outer ring; roller centre p, unit axis e (about +X),
+    velocity v and angular velocity w; ring centre c_r, velocity v_r, angular velocity w_r.
+    """
+    g = _flange_geometry(
+        bearing, raceway_radius, side, ring_sign, roller_centre, roller_axis, ring_centre
+    )
+    n = g.normal
+    c = g.contact_point
+    p = jnp.asarray(roller_centre)
+    c_r = jnp.asarray(ring_centre)
+    e_prime = _e_prime(bearing)
+
+    stiffness = point_contact_stiffness(g.radius_meridian, g.radius_parallel, e_prime)
+    q = hertz_force(g.interference, stiffness, PENETRATION_WIDTH)
+    # both are 0, with zero derivatives, for Q below jaxbearing.contact's load floor
+    p_max = point_contact_peak_pressure(q, g.radius_meridian, g.radius_parallel, e_prime)
+    semi = jnp.stack(point_contact_ellipse(q, g.radius_meridian, g.radius_parallel, e_prime))
+
+    v_roller = roller_velocity + jnp.cross(roller_angular_velocity, c - p)
+    v_ring = ring_velocity + jnp.cross(ring_angular_velocity, c - c_r)
+    u = v_roller - v_ring
+    u = u - jnp.dot(u, n) * n
+    speed = safe_norm(u)
+
+    f_t = -bearing.flange_traction * q * smooth_direction(u, SLIDING_EPS)
+    force = -q * n + f_t
+    return FlangeContact(
+        interference=g.interference,
+        normal_force=q,
+        peak_pressure=p_max,
+        sliding_velocity=u,
+        sliding_speed=speed,
+        pv=p_max * speed,
+        contact_point=c,
+        contact_height=g.contact_height,
+        end_face_position=g.end_face_position,
+        contact_radius=g.contact_radius,
+        on_arc=g.on_arc,
+        force_on_roller=force,
+        moment_on_roller=jnp.cross(c - p, force),
+        force_on_ring=-force,
+        moment_on_ring=jnp.cross(c - c_r, -force),
+        ellipse_semi_axes=semi,
+    )
+
+
+#: flange order of `all_flange_contacts`: (ring_sign, side)
+FLANGE_ORDER = ((1.0, -1.0), (1.0, 1.0), (-1.0, -1.0), (-1.0, 1.0))
+
+
+def all_flange_contacts(
+    bearing: Bearing,
+    roller_centre: Float[Array, "Z 3"],
+    roller_axis: Float[Array, "Z 3"],
+    roller_velocity: Float[Array, "Z 3"],
+    roller_angular_velocity: Float[Array, "Z 3"],
+    inner_ring_centre: Vec3,
+    inner_ring_velocity: Vec3,
+    inner_ring_angular_velocity: Vec3,
+    outer_ring_centre: Vec3,
+    outer_ring_velocity: Vec3,
+    outer_ring_angular_velocity: Vec3,
+) -> FlangeContact:
+    """Every roller against every flange: a FlangeContact with leading shape (Z, 4).
+
+    Flange order along axis 1 (`FLANGE_ORDER`): inner -X, inner +X, outer -X, outer +X.
+    Lifted with `jax.vmap` over flanges and rollers (no Python loop over rollers).
+    """
+    ring_sign = jnp.array([f[0] for f in FLANGE_ORDER])
+    side = jnp.array([f[1] for f in FLANGE_ORDER])
+    radius = jnp.stack([bearing.inner_raceway_radius] * 2 + [bearing.outer_raceway_radius] * 2)
+    inner = (inner_ring_centre, inner_ring_velocity, inner_ring_angular_velocity)
+    outer = (outer_ring_centre, outer_ring_velocity, outer_ring_angular_velocity)
+    inner, outer = ([jnp.asarray(x) for x in ring] for ring in (inner, outer))
+    c_r, v_r, w_r = (jnp.stack([i, i, o, o]) for i, o in zip(inner, outer))
+
+    def one(rad, sd, sg, c, vr, wr, p, e, v, w):
+        return roller_flange_contact(bearing, rad, sd, sg, p, e, v, w, c, vr, wr)
+
+    per_roller = jax.vmap(one, in_axes=(0, 0, 0, 0, 0, 0, None, None, None, None))
+    return jax.vmap(per_roller, in_axes=(None,) * 6 + (0, 0, 0, 0))(
+        radius, side, ring_sign, c_r, v_r, w_r,
+        roller_centre, roller_axis, roller_velocity, roller_angular_velocity,
+    )
