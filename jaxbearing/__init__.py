@@ -62,3 +62,26 @@ from ._quasistatic import QuasiStatic, quasi_static  # noqa: E402
 from ._raceway import RacewayContact, raceway_contact  # noqa: E402
 
 __all__ += ["QuasiStatic", "RacewayContact", "quasi_static", "raceway_contact"]
+
+from ._dynamics import Functionals  # noqa: E402
+from ._simulate import (  # noqa: E402
+    Perturbation,
+    SimulationResult,
+    Solution,
+    flange_functionals,
+    simulate,
+    solve,
+)
+from ._summary import contact_events, summarise  # noqa: E402
+
+__all__ += [
+    "Functionals",
+    "Perturbation",
+    "SimulationResult",
+    "Solution",
+    "contact_events",
+    "flange_functionals",
+    "simulate",
+    "solve",
+    "summarise",
+]

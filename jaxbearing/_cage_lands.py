@@ -1,5 +1,12 @@
 """Cage guided on the outer-ring lands: short journal bearing, rub contact, viscous torque.
 
+Film viscosity: the lands run in the oil-air mixture of the bearing cavity, so the film has the
+mixture's viscosity eta = f_oil eta_0 (`_drag.mixture_viscosity`), not that of a flooded film.
+(With eta_0 itself the Petroff torque at the reference point is about 0.9 N m, ten times the
+cage's churning torque and more than the rollers can drive: the cage decelerates without bound
+over the first tens of milliseconds. This is a modelling assumption; a flooded-land bearing
+would set oil_fraction = 1 for the lands, which the configuration does not yet separate.)
+
 The cage's outer cylinder (radius R = D_co/2) runs inside the two guiding lands of the outer
 ring (width b_l each, radial clearance c = C_g/2), like a journal in a stationary sleeve. The
 outer ring is fixed at the origin; the cage centre c_c = (0, y_c, z_c) gives the eccentricity
@@ -68,6 +75,7 @@ import jax
 import jax.numpy as jnp
 from jaxtyping import Array, ArrayLike, Float
 
+from ._drag import mixture_viscosity
 from ._params import Bearing
 from ._raceway import HUNT_CROSSLEY_ALPHA
 from .contact import (
@@ -137,7 +145,7 @@ def cage_land_forces(
     and rub friction (module docstring). Axial (X) components of position and velocity are
     ignored; the returned force has no X component.
     """
-    eta = bearing.lubricant.viscosity
+    eta = mixture_viscosity(bearing)  # the lands run in the cavity's oil-air mixture
     radius = bearing.cage.outer_diameter / 2
     clearance = bearing.cage.guiding_clearance / 2
     land = bearing.cage.land_width

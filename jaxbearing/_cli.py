@@ -18,6 +18,8 @@ COMMANDS = {
     "config": "jaxbearing._cmd_config",
     "zone": "jaxbearing._cmd_zone",
     "simulate": "jaxbearing._cmd_simulate",
+    "sweep": "jaxbearing._cmd_sweep",
+    "plot": "jaxbearing._cmd_plot",
 }
 
 

@@ -25,6 +25,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import optimistix as optx
+from jaxtyping import Array
 
 from ._dynamics import FLANGE_NAMES, Functionals, Params, contact_loads, physical_rates
 from ._params import Bearing, OperatingPoint, kinematic_cage_speed, rad_s_to_rpm
@@ -84,7 +85,7 @@ def initial_state(bearing: Bearing, op: OperatingPoint, perturbation: Perturbati
     return State(rollers=rollers, cage=cage, inner_ring=ring, accumulators=acc)
 
 
-class _Args(eqx.Module):
+class _Args(eqx.Module):  # noqa: D101
     params: Params
     scaling: Scaling
 
@@ -114,6 +115,8 @@ def _save(t, y_scaled, args: _Args):
         cage_speed=y.cage.speed,
         cage_centre=y.cage.centre,
         inner_ring_centre=y.inner_ring.centre,
+        inner_ring_contact_force=jnp.sum(loads.inner.force_on_ring[:, 1:], axis=0)
+        + jnp.sum(fl.force_on_ring[:, :2, 1:], axis=(0, 1)),
         roller_inner_load=loads.inner.normal_load,
         roller_outer_load=loads.outer.normal_load,
         roller_axial=y.rollers.axial,
@@ -156,30 +159,119 @@ class SimulationResult:
     operating: OperatingPoint
 
 
-def _integrate(y0_scaled, args, t1, ts, rtol, atol, max_steps, progress):
-    term = diffrax.ODETerm(_field)
+class Solution(eqx.Module):
+    """Raw output of `solve` (JAX arrays; vmappable). `histories` has a leading time axis."""
+
+    histories: dict
+    accumulators: Accumulators
+    result: Array  # diffrax RESULTS code (0 = successful)
+    num_steps: Array
+    num_rejected_steps: Array
+
+
+def _save_functionals(t, y_scaled, args: _Args):
+    return args.scaling.unscale(t, y_scaled).accumulators
+
+
+def solve(
+    bearing: Bearing,
+    op: OperatingPoint,
+    duration,
+    *,
+    num_saves: int = 4000,
+    rtol=1e-3,
+    atol=1e-6,
+    max_steps: int = 2_000_000,
+    progress: bool = False,
+    perturbation: Perturbation | None = Perturbation(),
+    functionals: Functionals = Functionals(),
+    adjoint: diffrax.AbstractAdjoint | None = None,
+) -> Solution:
+    """Pure, jit-able and vmappable solve of the whole bearing over [0, duration].
+
+    `num_saves` (static) samples of the flange-contact quantities, cage and rings are kept
+    (`num_saves = 0`: only the smooth functionals at t1, the cheapest form for gradients).
+    `adjoint` selects how gradients flow through the solve (default: diffrax's checkpointed
+    reverse mode; `diffrax.ForwardMode()` for `jax.jacfwd`).
+    """
+    y0 = initial_state(bearing, op, perturbation)
+    scaling = Scaling(
+        nominal=y0,
+        scale=state_scales(bearing.num_rollers, bearing.pitch_diameter / 2),
+        orbit_speed=kinematic_cage_speed(bearing, op),
+    )
+    args = _Args(params=Params(bearing=bearing, operating=op, functionals=functionals), scaling=scaling)
+    y0_scaled = scaling.scale_state(0.0, y0)
+    if num_saves:
+        saveat = diffrax.SaveAt(ts=jnp.linspace(0.0, duration, num_saves), fn=_save, t1=True)
+    else:
+        saveat = diffrax.SaveAt(t1=True, fn=_save_functionals)
     controller = diffrax.PIDController(
         rtol=rtol, atol=atol, pcoeff=0.3, icoeff=0.4, norm=optx.max_norm, dtmin=1e-13
     )
-    return diffrax.diffeqsolve(
-        term,
+    sol = diffrax.diffeqsolve(
+        diffrax.ODETerm(_field),
         diffrax.Tsit5(),
         t0=0.0,
-        t1=t1,
+        t1=duration,
         dt0=1e-7,
         y0=y0_scaled,
         args=args,
-        saveat=diffrax.SaveAt(ts=ts, fn=_save, t1=True),
+        saveat=saveat,
         stepsize_controller=controller,
         max_steps=max_steps,
         throw=False,
+        adjoint=adjoint if adjoint is not None else diffrax.RecursiveCheckpointAdjoint(),
         progress_meter=diffrax.TextProgressMeter(minimum_increase=0.05)
         if progress
         else diffrax.NoProgressMeter(),
     )
+    if num_saves:
+        ys = dict(sol.ys)
+        acc = jax.tree_util.tree_map(lambda a: a[-1], ys.pop("accumulators"))
+        hist = jax.tree_util.tree_map(lambda a: a[:-1], ys)
+    else:
+        hist, acc = {}, jax.tree_util.tree_map(lambda a: a[-1], sol.ys)
+    return Solution(
+        histories=hist,
+        accumulators=acc,
+        result=jnp.asarray(sol.result._value, dtype=jnp.int32),
+        num_steps=jnp.asarray(sol.stats["num_steps"]),
+        num_rejected_steps=jnp.asarray(sol.stats["num_rejected_steps"]),
+    )
 
 
-_integrate_jit = eqx.filter_jit(_integrate)
+def flange_functionals(bearing: Bearing, op: OperatingPoint, duration, **kwargs):
+    """(smooth peak PV [Pa m/s], smooth max contact height [m], smooth min contact height [m])
+    of a run, differentiable with respect to every float parameter of `bearing` and `op`.
+
+    Keyword arguments go to `solve` (`num_saves` is fixed to 0). Non-finite values are
+    returned where the solve failed."""
+    sol = solve(bearing, op, duration, num_saves=0, **kwargs)
+    functionals = kwargs.get("functionals", Functionals())
+    values = smooth_functionals(sol.accumulators, functionals)
+    ok = sol.result == 0
+    return tuple(jnp.where(ok, v, jnp.nan) for v in values)
+
+
+_COMPILED: dict = {}
+
+
+def _compiled_solve(bearing, op, duration, rtol, atol, static: tuple):
+    """Ahead-of-time compiled `solve`, cached on the pytree structure, shapes and static
+    arguments, so arc and corner ends, other speeds, loads and tolerances reuse one compilation."""
+    dyn = (bearing, op, duration, rtol, atol)
+    leaves, treedef = jax.tree_util.tree_flatten(dyn)
+    key = (treedef, tuple((jnp.shape(x), jnp.result_type(x)) for x in leaves), static)
+    if key not in _COMPILED:
+        num_saves, max_steps, progress, perturbation, functionals = static
+
+        def run(b, o, d, r, a):
+            return solve(b, o, d, num_saves=num_saves, rtol=r, atol=a, max_steps=max_steps,
+                         progress=progress, perturbation=perturbation, functionals=functionals)
+
+        _COMPILED[key] = jax.jit(run).lower(*dyn).compile()
+    return _COMPILED[key]
 
 
 def simulate(
@@ -195,64 +287,59 @@ def simulate(
     perturbation: Perturbation | None = Perturbation(),
     functionals: Functionals = Functionals(),
 ) -> SimulationResult:
-    """Integrate the bearing for `duration` seconds from the quasi-static state."""
-    y0 = initial_state(bearing, op, perturbation)
-    omega_c = kinematic_cage_speed(bearing, op)
-    scaling = Scaling(
-        nominal=y0, scale=state_scales(bearing.num_rollers, float(bearing.pitch_diameter) / 2), orbit_speed=omega_c
-    )
-    # nominal azimuths/cage angle advance with the orbit; their nominal value is the t=0 value
-    args = _Args(params=Params(bearing=bearing, operating=op, functionals=functionals), scaling=scaling)
-    y0_scaled = scaling.scale_state(0.0, y0)
-    ts = jnp.linspace(0.0, duration, num_saves)
+    """Integrate the bearing for `duration` seconds from the quasi-static state.
 
+    Compiles once per bearing structure (cached) and reports compile and run time separately.
+    """
+    from ._validation import validate_bearing
+
+    validate_bearing(bearing, op)
+    dyn = (bearing, op, jnp.asarray(duration, float), jnp.asarray(rtol, float), jnp.asarray(atol, float))
+    static = (int(num_saves), int(max_steps), bool(progress), perturbation, functionals)
     start = time.perf_counter()
-    lowered = _integrate_jit.lower(y0_scaled, args, duration, ts, rtol, atol, max_steps, progress)
-    compiled = lowered.compile()
+    compiled = _compiled_solve(*dyn, static)
     compile_time = time.perf_counter() - start
     start = time.perf_counter()
-    sol = compiled(y0_scaled, args, duration, ts, rtol, atol, max_steps, progress)
-    jax.block_until_ready(sol.ys)
+    sol = compiled(*dyn)
+    jax.block_until_ready(sol)
     wall = time.perf_counter() - start
-    return _result(sol, scaling, args, bearing, op, functionals, duration, wall, compile_time)
+    return _result(sol, bearing, op, functionals, duration, wall, compile_time)
 
 
-def _result_message(result) -> str:
-    for name in ("max_steps_reached", "dt_min_reached"):
-        if hasattr(diffrax.RESULTS, name) and result == getattr(diffrax.RESULTS, name):
-            return {"max_steps_reached": "the step limit max_steps was reached",
-                    "dt_min_reached": "the step size collapsed below dtmin (non-finite or unresolvable dynamics)"}[name]
-    return "the solver did not succeed"
+def _result_message(code: int) -> str:
+    for name, text in (
+        ("max_steps_reached", "the step limit max_steps was reached"),
+        ("dt_min_reached", "the step size collapsed below dtmin (non-finite or unresolvable dynamics)"),
+    ):
+        if hasattr(diffrax.RESULTS, name) and code == getattr(diffrax.RESULTS, name)._value:
+            return text
+    return f"the solver did not succeed (diffrax result code {code})"
 
 
-def _result(sol, scaling, args, bearing, op, functionals, duration, wall, compile_time) -> SimulationResult:
-    ys = jax.tree_util.tree_map(np.asarray, sol.ys)
-    # the last saved entry is t1 (SaveAt(t1=True)); histories are the ts entries
-    hist = {k: jax.tree_util.tree_map(lambda a: a[:-1], v) for k, v in ys.items()}
-    ok = bool(sol.result == diffrax.RESULTS.successful)
+def _result(sol: Solution, bearing, op, functionals, duration, wall, compile_time) -> SimulationResult:
+    hist = jax.tree_util.tree_map(np.asarray, sol.histories)
+    code = int(sol.result)
+    ok = code == 0
     t_saved = hist["t"]
     finite = np.isfinite(t_saved) & np.all(np.isfinite(hist["cage_speed"].reshape(len(t_saved), -1)), axis=1)
-    reached = float(t_saved[finite][-1]) if finite.any() else 0.0
+    # diffrax fills samples after a failure with inf; keep the samples actually reached
+    hist = {k: v[finite] for k, v in hist.items()}
+    reached = float(hist["t"][-1]) if finite.any() else 0.0
     if ok:
         status = "ok"
+        pv_peak, h_max, h_min = (float(v) for v in smooth_functionals(sol.accumulators, functionals))
     else:
         status = (
-            f"failed: {_result_message(sol.result)} (simulated time reached {reached * 1e3:.4f} ms"
+            f"failed: {_result_message(code)} (simulated time reached {reached * 1e3:.4f} ms"
             f" of {duration * 1e3:.4f} ms)"
         )
-    hist.pop("accumulators")
-    hist = {k: v[finite] for k, v in hist.items()}  # cut at the last finite sample
-    stats = sol.stats
-    final_acc = jax.tree_util.tree_map(lambda x: x[-1], sol.ys["accumulators"])
-    pv_peak, h_max, h_min = (float(v) for v in smooth_functionals(final_acc, functionals))
-    if not ok:
-        pv_peak, h_max, h_min = np.nan, np.nan, np.nan
+        pv_peak = h_max = h_min = float("nan")
     return SimulationResult(
         status=status,
         ok=ok,
         reached_time=reached,
-        num_steps=int(stats["num_steps"]),
-        num_rejected_steps=int(stats["num_rejected_steps"]),
+        num_steps=int(sol.num_steps),
+        num_rejected_steps=int(sol.num_rejected_steps),
         wall_time_s=wall,
         compile_time_s=compile_time,
         histories=hist,

@@ -22,7 +22,7 @@ from jaxbearing._cage_lands import (
 )
 
 B = reference_bearing()
-ETA = float(B.lubricant.viscosity)
+ETA = float(B.lubricant.oil_fraction * B.lubricant.viscosity)  # mixture viscosity on the lands
 R = float(B.cage.outer_diameter) / 2
 C = float(B.cage.guiding_clearance) / 2
 L = float(B.cage.land_width)
