@@ -1,0 +1,75 @@
+"""`jaxbearing simulate` end to end: outputs, both end types, bad input, forced failure."""
+
+import json
+
+import numpy as np
+import pytest
+
+from jaxbearing._cli import main
+
+SUMMARY_STATS = (
+    "flange_force_N",
+    "flange_pressure_Pa",
+    "flange_sliding_velocity_m_s",
+    "flange_pv_Pa_m_s",
+    "contact_height_m",
+    "contact_radius_m",
+)
+
+
+def _config(tmp_path, text):
+    p = tmp_path / "c.toml"
+    p.write_text(text)
+    return str(p)
+
+
+@pytest.fixture(scope="module")
+def both_run(tmp_path_factory):
+    out = tmp_path_factory.mktemp("sim")
+    cfg = out / "c.toml"
+    cfg.write_text("[simulation]\nduration_ms = 2.0\nprogress = false\n")
+    code = main(["simulate", "--config", str(cfg), "--end", "both", "--out", str(out)])
+    return code, out
+
+
+def test_both_ends_write_summary_histories_plots(both_run, capsys):
+    code, out = both_run
+    assert code == 0
+    doc = json.loads((out / "summary.json").read_text())
+    assert set(doc) == {"arc", "corner"}
+    for end in ("arc", "corner"):
+        block = doc[end]
+        assert block["status"] == "ok"
+        for key in ("cage_speed_rpm", "kinematic_cage_speed_rpm", "cage_slip", "flange_contact_events",
+                    "on_arc_fraction", "num_steps", "wall_time_s", "status"):
+            assert key in block
+        for key in SUMMARY_STATS:
+            assert set(block[key]) == {"max", "mean", "median", "min"}
+        h = np.load(out / f"histories_{end}.npz")
+        assert h["flange_force"].shape[1:] == (26, 4)
+    for png in ("flange_boxplots.png", "contact_positions.png", "cage_speed.png"):
+        assert (out / png).stat().st_size > 10_000
+    # arc ends press less on the flange than corners (the paper's headline result)
+    assert doc["arc"]["flange_pressure_Pa"]["max"] < doc["corner"]["flange_pressure_Pa"]["max"]
+
+
+def test_invalid_config_one_line_exit_2(tmp_path, capsys):
+    cfg = _config(tmp_path, "[roller]\ncorner_radius_mm = 5.0\n")
+    assert main(["simulate", "--config", cfg]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "roller.corner_radius_mm" in err[0]
+
+
+def test_invalid_override_one_line_exit_2(tmp_path, capsys):
+    assert main(["simulate", "--speed-rpm", "-5"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "operating.speed_rpm" in err[0]
+
+
+def test_forced_solver_failure_nonzero_exit(tmp_path, capsys):
+    cfg = _config(tmp_path, "[simulation]\nduration_ms = 0.6\nmax_steps = 30\nprogress = false\nend = \"arc\"\n")
+    out = tmp_path / "out"
+    assert main(["simulate", "--config", cfg, "--out", str(out)]) == 1
+    doc = json.loads((out / "summary.json").read_text())
+    assert doc["status"].startswith("failed")
+    assert "max_steps" in doc["status"]
