@@ -81,6 +81,6 @@ def test_reference_bearing_summary():
 def test_cli_demo_prints_summary(capsys):
     from jaxbearing._cli import main
 
-    assert main(["demo"]) == 0
+    assert main(["demo", "--summary-only"]) == 0
     out = capsys.readouterr().out
     assert "roller mass" in out and "kinematic cage speed" in out and "9117.6" in out
