@@ -65,8 +65,8 @@ lands; Hamrock, Schmid & Jacobson; Harris & Kotzalas, "Advanced Concepts", cage-
     M_x = -2 pi eta R^3 (2 b_l) omega_c / (c sqrt(1 - eps_f^2))
 
 (the Poiseuille contribution of the pressure field, a torque of order eps c F_t / 2, is
-neglected), plus the rub friction torque R F_friction. eta is the lubricant's eta_0: the lands
-are taken as flooded with oil.
+neglected), plus the rub friction torque R F_friction. eta is the mixture viscosity f_oil eta_0
+(see the top of this docstring).
 """
 
 from __future__ import annotations

@@ -42,12 +42,11 @@ from ._state import (
     radial_unit,
     tangential_unit,
 )
-from .flange import roller_flange_contact
+from .flange import FLANGE_ORDER, all_flange_contacts
 
 X = jnp.array([1.0, 0.0, 0.0])
 
-#: flange order along the last axis of every per-flange array: (ring_sign, side)
-FLANGES = ((1.0, -1.0), (1.0, 1.0), (-1.0, -1.0), (-1.0, 1.0))
+#: names of the four flanges along the last axis of every per-flange array (`FLANGE_ORDER`)
 FLANGE_NAMES = ("inner_left", "inner_right", "outer_left", "outer_right")
 
 
@@ -67,25 +66,6 @@ class Params(eqx.Module):
     bearing: Bearing
     operating: OperatingPoint
     functionals: Functionals = Functionals()
-
-
-def _flange_contacts(bearing: Bearing, p, e, v, w, inner_c, inner_v, inner_w):
-    """(Z, 4) FlangeContact for every roller and flange (order of FLANGES)."""
-    ring_sign = jnp.array([f[0] for f in FLANGES])
-    side = jnp.array([f[1] for f in FLANGES])
-    radius = jnp.where(ring_sign > 0, bearing.inner_raceway_radius, bearing.outer_raceway_radius)
-    zero = jnp.zeros(3)
-    ring_c = jnp.where(ring_sign[:, None] > 0, inner_c, zero)
-    ring_v = jnp.where(ring_sign[:, None] > 0, inner_v, zero)
-    ring_w = jnp.where(ring_sign[:, None] > 0, inner_w, zero)
-
-    def one_flange(rad, sd, sg, c, vr, wr, p_, e_, v_, w_):
-        return roller_flange_contact(bearing, rad, sd, sg, p_, e_, v_, w_, c, vr, wr)
-
-    per_roller = jax.vmap(one_flange, in_axes=(0, 0, 0, 0, 0, 0, None, None, None, None))
-    return jax.vmap(per_roller, in_axes=(None, None, None, None, None, None, 0, 0, 0, 0))(
-        radius, side, ring_sign, ring_c, ring_v, ring_w, p, e, v, w
-    )
 
 
 class Loads(eqx.Module):
@@ -114,7 +94,7 @@ def contact_loads(state: State, params: Params) -> Loads:
     )
     inner = raceway(b, 1.0, b.inner_raceway_radius, p, e, v, w, inner_c, inner_v, inner_w)
     outer = raceway(b, -1.0, b.outer_raceway_radius, p, e, v, w, zero, zero, zero)
-    flange = _flange_contacts(b, p, e, v, w, inner_c, inner_v, inner_w)
+    flange = all_flange_contacts(b, p, e, v, w, inner_c, inner_v, inner_w, zero, zero, zero)
 
     cage = state.cage
     cage_c = jnp.concatenate([jnp.zeros(1), cage.centre])
@@ -199,7 +179,7 @@ def physical_rates(t, state: State, params: Params) -> State:
     )
 
     # -- inner ring --------------------------------------------------------------------
-    inner_flanges = jnp.asarray([f[0] > 0 for f in FLANGES])
+    inner_flanges = jnp.asarray([ring_sign > 0 for ring_sign, _ in FLANGE_ORDER])
     ring_force = (
         jnp.sum(loads.inner.force_on_ring, axis=0)
         + jnp.sum(jnp.where(inner_flanges[None, :, None], fl.force_on_ring, 0.0), axis=(0, 1))

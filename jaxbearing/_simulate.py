@@ -132,11 +132,22 @@ def smooth_functionals(acc: Accumulators, functionals: Functionals):
     max h_c  = h_ref + log(sum int w e^{beta dh} dt / sum int w dt) / beta   (log-sum-exp)
     min h_c  = h_ref - log(sum int w e^{-beta dh} dt / sum int w dt) / beta
     Sums run over every roller and flange. Both tend to the true extremes as p, beta grow.
+
+    Without any flange contact (all accumulators zero) the peak PV is 0 and the heights are NaN
+    (there is no contact height); the double-`where` keeps every gradient finite there.
     """
-    ct = jnp.sum(acc.contact_time) + 1e-300
-    pv = functionals.pv_reference * (jnp.sum(acc.pv_power) / ct) ** (1.0 / functionals.pv_exponent)
-    h_max = functionals.height_reference + jnp.log(jnp.sum(acc.height_max_power) / ct + 1e-300) / functionals.height_sharpness
-    h_min = functionals.height_reference - jnp.log(jnp.sum(acc.height_min_power) / ct + 1e-300) / functionals.height_sharpness
+    ct = jnp.sum(acc.contact_time)
+    pv_sum = jnp.sum(acc.pv_power)
+    hi_sum, lo_sum = jnp.sum(acc.height_max_power), jnp.sum(acc.height_min_power)
+    has_pv = (pv_sum > 0) & (ct > 0)
+    has_h = (hi_sum > 0) & (lo_sum > 0) & (ct > 0)
+    safe_ct = jnp.where(ct > 0, ct, 1.0)
+    pv_ratio = jnp.where(has_pv, pv_sum / safe_ct, 1.0)
+    pv = jnp.where(has_pv, functionals.pv_reference * pv_ratio ** (1.0 / functionals.pv_exponent), 0.0)
+    hi = jnp.log(jnp.where(has_h, hi_sum / safe_ct, 1.0)) / functionals.height_sharpness
+    lo = jnp.log(jnp.where(has_h, lo_sum / safe_ct, 1.0)) / functionals.height_sharpness
+    h_max = jnp.where(has_h, functionals.height_reference + hi, jnp.nan)
+    h_min = jnp.where(has_h, functionals.height_reference - lo, jnp.nan)
     return pv, h_max, h_min
 
 
