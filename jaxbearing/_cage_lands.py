@@ -73,6 +73,7 @@ from __future__ import annotations
 
 import jax
 import jax.numpy as jnp
+import numpy as np
 from jaxtyping import Array, ArrayLike, Float
 
 from ._drag import mixture_viscosity
@@ -96,8 +97,8 @@ _LINE_EXPONENT = 10.0 / 9.0
 #: Width of the softplus keeping the Hunt-Crossley factor positive (as in `_raceway`).
 _DAMPING_FACTOR_WIDTH = 0.02
 
-_X = jnp.array([1.0, 0.0, 0.0])
-_YZ = jnp.array([0.0, 1.0, 1.0])
+_X = np.array([1.0, 0.0, 0.0])
+_YZ = np.array([0.0, 1.0, 1.0])
 
 
 def capped_eccentricity(

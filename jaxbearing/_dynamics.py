@@ -28,6 +28,7 @@ from __future__ import annotations
 import equinox as eqx
 import jax
 import jax.numpy as jnp
+import numpy as np
 from jaxtyping import Array
 
 from . import _cage_lands, _drag, _pocket, _raceway
@@ -44,7 +45,7 @@ from ._state import (
 )
 from .flange import FLANGE_ORDER, all_flange_contacts
 
-X = jnp.array([1.0, 0.0, 0.0])
+X = np.array([1.0, 0.0, 0.0])  # numpy: importing must not start the JAX backend
 
 #: names of the four flanges along the last axis of every per-flange array (`FLANGE_ORDER`)
 FLANGE_NAMES = ("inner_left", "inner_right", "outer_left", "outer_right")

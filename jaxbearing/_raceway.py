@@ -87,7 +87,7 @@ _DAMPING_FACTOR_WIDTH = 0.02
 #: load weight added to each slice in the load-weighted mean sliding speed [N] (avoids 0/0).
 _MEAN_WEIGHT_EPS = 1e-12
 
-_AXIS = jnp.array([1.0, 0.0, 0.0])
+_AXIS = np.array([1.0, 0.0, 0.0])
 
 
 def _safe_unit(v: Array, fallback: Array) -> tuple[Array, Array]:

@@ -45,6 +45,7 @@ from __future__ import annotations
 import equinox as eqx
 import jax
 import jax.numpy as jnp
+import numpy as np
 from jaxtyping import Array, ArrayLike, Float
 
 from .._params import Bearing
@@ -64,7 +65,7 @@ from ..contact import (
 Scalar = Float[Array, ""]
 Vec3 = Float[Array, "3"]
 
-_AXIS = jnp.array([1.0, 0.0, 0.0])
+_AXIS = np.array([1.0, 0.0, 0.0])
 
 
 class FlangeContact(eqx.Module):
