@@ -85,3 +85,15 @@ __all__ += [
     "solve",
     "summarise",
 ]
+
+# parameter sweeps: vmapped, sharded, resumable batches with labelled results (issue 6)
+from ._sweep import (  # noqa: E402
+    SweepSpec,
+    SweepSpecError,
+    load_sweep_spec,
+    loads_sweep_spec,
+    open_results,
+    run_sweep,
+)
+
+__all__ += ["SweepSpec", "SweepSpecError", "load_sweep_spec", "loads_sweep_spec", "open_results", "run_sweep"]

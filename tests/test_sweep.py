@@ -1,0 +1,290 @@
+"""Parameter sweeps (issue 6): spec validation, failed cases, kill -9 and resume.
+
+The sweep of tests/sweeps/small.toml (arc/corner x two speeds, 0.2 ms, 2 batches of 2) is run
+once in this process (the reference); the kill/restart test runs the same command in
+subprocesses and must reproduce it bit for bit. (The solve's program holds host callbacks, so
+JAX's persistent compilation cache does not apply: every subprocess compiles once, ~10-30 s.)
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import pathlib
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+from jaxbearing._cli import main as cli_main
+from jaxbearing._sweep import (
+    SweepSpecError,
+    computed_batches,
+    load_sweep_spec,
+    loads_sweep_spec,
+    run_sweep,
+    variable_names,
+)
+
+SWEEPS = pathlib.Path(__file__).parent / "sweeps"
+SMALL = SWEEPS / "small.toml"
+REPO = pathlib.Path(__file__).parents[1]
+
+
+def subprocess_env(**extra) -> dict:
+    """Environment of a sweep subprocess: CPU only, one device unless `extra` sets XLA_FLAGS."""
+    env = dict(os.environ)
+    env.pop("XLA_FLAGS", None)
+    env.update(
+        JAX_PLATFORMS="cpu",
+        JAX_ENABLE_X64="1",
+        PYTHONPATH=str(REPO) + os.pathsep + env.get("PYTHONPATH", ""),
+    )
+    env.update(extra)
+    return env
+
+
+def sweep_command(spec: pathlib.Path, out: pathlib.Path, *args: str) -> list[str]:
+    return [sys.executable, "-m", "jaxbearing._cli", "sweep", str(spec), "--out", str(out),
+            "--no-progress", *args]
+
+
+def assert_same_results(a, b) -> None:
+    """Bitwise-equal datasets (NaN equal to NaN), coordinates and variables alike."""
+    assert set(a.data_vars) == set(b.data_vars)
+    for name in list(a.data_vars) + list(a.coords):
+        x, y = a[name].values, b[name].values
+        if x.dtype.kind == "f":
+            assert np.array_equal(x, y, equal_nan=True), name
+        else:
+            assert np.array_equal(x, y), name
+    assert a.identical(b)
+
+
+@pytest.fixture(scope="module")
+def reference(tmp_path_factory):
+    """The small sweep run uninterrupted, single device, in this process."""
+    out = tmp_path_factory.mktemp("sweep-ref")
+    ds = run_sweep(load_sweep_spec(SMALL), out, progress=False)
+    return out, ds
+
+
+# -- spec validation (no computing) --------------------------------------------------------------
+BAD_SPECS = [
+    ('"operating.sped_rpm" = [1e4]', "operating.sped_rpm", "did you mean operating.speed_rpm"),
+    ('"roller.end_radius_m" = [0.08]', "roller.end_radius_m", "use roller.end_radius_mm"),
+    ('"operating.speed_rad_s" = [2000.0]', "operating.speed_rad_s", "use operating.speed_rpm"),
+    ('"roller.end_radius_mm" = ["80 mm"]', "roller.end_radius_mm", "units are part of the key"),
+    ('"operating.speed_rpm" = []', "operating.speed_rpm", "empty axis"),
+    ('"operating.speed_rpm" = {start = 1e4, stop = 2e4, num = 0}', "operating.speed_rpm",
+     "empty axis"),
+    ('"roller.end_radius_mm" = [80.0, 2.0]', "roller.end_radius_mm", "out of range"),
+    ('"flange.layback_angle_deg" = {start = 1, stop = 12, num = 3}',
+     "flange.layback_angle_deg", "(0, 10]"),
+    ('"roller.central_length_mm" = [4.5, 7.5]', "roller.central_length_mm",
+     "length_mm - 2 corner_radius_mm = 7.2"),
+    ('"operating.speed_rpm" = [-100.0]', "operating.speed_rpm", "out of range"),
+    ('"bearing.num_rollers" = [20, 26]', "bearing.num_rollers", "changes array shapes"),
+    ('"simulation.max_steps" = [10, 20]', "simulation.max_steps", "static"),
+    ('end = ["arc", "flat"]', "end", "not a roller end type"),
+    ('"operating.speed_rpm" = [1e4, 1e4]', "operating.speed_rpm", "appears twice"),
+]
+
+
+@pytest.mark.parametrize("axes, axis, text", BAD_SPECS, ids=[b[1] + ":" + b[2] for b in BAD_SPECS])
+def test_bad_spec_names_the_axis(axes, axis, text):
+    with pytest.raises(SweepSpecError) as info:
+        loads_sweep_spec(f"[axes]\n{axes}\n")
+    assert info.value.axis == axis
+    msg = str(info.value)
+    assert msg.startswith(axis + ":") and text in msg and "\n" not in msg
+
+
+def test_bad_spec_fields():
+    with pytest.raises(SweepSpecError, match=r"^sweep.batchsize: .*did you mean sweep.batch_size"):
+        loads_sweep_spec('[sweep]\nbatchsize = 3\n[axes]\n"operating.speed_rpm" = [1e4]\n')
+    with pytest.raises(SweepSpecError, match=r"^axes: no axes"):
+        loads_sweep_spec("[sweep]\nbatch_size = 3\n")
+    with pytest.raises(SweepSpecError, match=r"^operating.radial_load_N: zipped axes must have"):
+        loads_sweep_spec('[sweep]\nmode = "zip"\n[axes]\n"operating.speed_rpm" = [1e4, 2e4]\n'
+                         '"operating.radial_load_N" = [1e3]\n')
+    with pytest.raises(SweepSpecError, match=r'^roller.end_radius_mm: case 1: end = "arc" needs'):
+        loads_sweep_spec('[base.simulation]\nend = "arc"\n[axes]\n'
+                         '"roller.end_radius_mm" = [80.0, inf]\n')
+    with pytest.raises(SweepSpecError, match=r"^base.roller.diameter_mm: "):
+        loads_sweep_spec('[base.roller]\ndiameter_mm = -1.0\n[axes]\nend = ["arc"]\n')
+
+
+def test_bad_spec_fails_before_computing(tmp_path, capsys):
+    """The CLI prints one line naming the axis, exits 2 and creates nothing."""
+    spec = tmp_path / "bad.toml"
+    spec.write_text('[axes]\n"operating.speed_rpm" = [1e4, 2e4]\n"roller.end_radius_mm" = [1.0]\n')
+    out = tmp_path / "out"
+    start = time.perf_counter()
+    assert cli_main(["sweep", str(spec), "--out", str(out)]) == 2
+    assert time.perf_counter() - start < 5  # nothing compiled
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err[-1].startswith("jaxbearing sweep: error: roller.end_radius_mm: ")
+    assert "out of range" in err[-1]
+    assert not out.exists()
+
+
+def test_grid_and_zip_layout():
+    """Zipped axes share one dimension; cases run in C order over the dimensions."""
+    spec = load_sweep_spec(SWEEPS / "grid_zip.toml")
+    assert spec.dims == ("end", "zip0", "end_radius_mm") and spec.shape == (2, 3, 2)
+    assert spec.num_cases == 12 and spec.num_batches == 3
+    speeds = np.linspace(10000, 30000, 3)
+    loads = (500.0, 1000.0, 2000.0)
+    for case in range(12):
+        e, z, r = np.unravel_index(case, spec.shape)
+        v = spec.case_values(case)
+        assert v == {"end": ("arc", "corner")[e], "operating.speed_rpm": speeds[z],
+                     "operating.radial_load_N": loads[z], "roller.end_radius_mm": (60.0, 80.0)[r]}
+    cfg, end = spec.case_config(11)
+    assert end == "corner" and cfg["operating.radial_load_N"] == 2000.0
+    assert cfg["simulation.duration_ms"] == 0.2
+    # the reference's simulation.end = "both" adds the end axis when none is given
+    assert loads_sweep_spec('[axes]\n"operating.speed_rpm" = [1e4]\n').dims == ("speed_rpm", "end")
+    # the hash follows the content (and the batch size, which fixes the batch files)
+    assert spec.hash == load_sweep_spec(SWEEPS / "grid_zip.toml").hash
+    assert spec.hash != spec.with_batch_size(3).hash
+
+
+# -- running -------------------------------------------------------------------------------------
+def test_reference_dataset(reference):
+    """Labelled results: axes as coordinates, summary statistics, zone margins, status."""
+    out, ds = reference
+    assert (out / "results.nc").exists() and dict(ds.sizes)["end"] == 2
+    assert list(ds["end"].values) == ["arc", "corner"]
+    assert list(ds["speed_rpm"].values) == [15000.0, 20000.0]
+    assert ds["speed_rpm"].attrs["config_key"] == "operating.speed_rpm"
+    for name in variable_names():
+        assert ds[name].dims == ("end", "speed_rpm")
+    assert "flange_pv_Pa_m_s_max" in ds and "zone_relief_margin_m" in ds
+    assert (ds["status"].values == "ok").all() and (ds["result_code"].values == 0).all()
+    # independent checks: kinematic cage speed omega_i (1 - D/d_m) / 2, and the design zone
+    kin = ds["speed_rpm"].values * (1 - 7.5 / 85.0) / 2
+    np.testing.assert_allclose(ds["kinematic_cage_speed_rpm"].values, np.stack([kin, kin]),
+                               rtol=1e-12)
+    assert (np.abs(ds["cage_slip"].values) < 0.05).all()
+    # arc end: h_c = D/2 - R_end sin(theta_f) (MODEL.md 4.1), corner: D/2 - R_ce - R_cor sin
+    s = np.sin(np.radians(1.6))
+    np.testing.assert_allclose(ds["zone_contact_height_m"].sel(end="arc").values,
+                               (3.75 - 80 * s) * 1e-3, rtol=1e-9)
+    np.testing.assert_allclose(ds["zone_contact_height_m"].sel(end="corner").values,
+                               (3.75 - 3.35 - 0.4 * s) * 1e-3, rtol=1e-9)
+    assert (ds["zone_feasible"].sel(end="arc").values == 1).all()
+    # one log entry per batch, each computed once
+    assert sorted(computed_batches(out)) == [0, 1]
+    # a later run of the same sweep computes nothing
+    again = run_sweep(load_sweep_spec(SMALL), out, progress=False)
+    assert sorted(computed_batches(out)) == [0, 1]
+    assert_same_results(ds, again)
+
+
+def test_failed_case_is_recorded(tmp_path, reference):
+    """A case hitting max_steps is recorded with its status and NaNs; the sweep goes on."""
+    ds = run_sweep(load_sweep_spec(SWEEPS / "failing.toml"), tmp_path, progress=False)
+    status = list(ds["status"].values)
+    assert status[0] == "ok"
+    assert status[1].startswith("failed: the step limit max_steps was reached")
+    assert ds["result_code"].values[1] != 0
+    failed = ds.isel(duration_ms=1)
+    assert np.isnan(failed["cage_speed_rpm"].values) and np.isnan(failed["smooth_peak_pv_Pa_m_s"])
+    assert failed["num_steps"].values == 2000
+    assert np.isfinite(ds.isel(duration_ms=0)["cage_speed_rpm"].values)
+    # the successful case equals the same case of the reference sweep (arc, 20000 rpm)
+    ref = reference[1].sel(end="arc", speed_rpm=20000.0)
+    assert ds.isel(duration_ms=0)["cage_speed_rpm"].values == ref["cage_speed_rpm"].values
+
+
+def test_kill_and_resume(tmp_path, reference):
+    """SIGKILL after the first batch file appears; the same command then computes only the
+    missing batch and the dataset equals the uninterrupted run bit for bit."""
+    out = tmp_path / "sweep"
+    env = subprocess_env()
+    cmd = sweep_command(SMALL, out)
+    first = out / "batches" / "batch_00000.npz"
+    proc = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+    try:
+        deadline = time.monotonic() + 240
+        while not first.exists():
+            assert proc.poll() is None, proc.stdout.read().decode()[-3000:]
+            assert time.monotonic() < deadline, "no batch file within 240 s"
+            time.sleep(0.02)
+        os.kill(proc.pid, signal.SIGKILL)
+    finally:
+        proc.wait()
+    assert proc.returncode == -signal.SIGKILL
+    assert not (out / "results.nc").exists()
+    done_before = computed_batches(out)
+    assert 0 in done_before
+    stat = first.stat()
+    content = first.read_bytes()
+
+    rerun = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=300)
+    assert rerun.returncode == 0, rerun.stderr[-3000:]
+    log = computed_batches(out)
+    assert log[: len(done_before)] == done_before
+    assert sorted(log[len(done_before):]) == sorted({0, 1} - set(done_before))
+    assert first.stat().st_mtime_ns == stat.st_mtime_ns and first.read_bytes() == content
+    from jaxbearing._sweep import open_results
+
+    assert_same_results(open_results(out), reference[1])
+    assert json.loads((out / "spec.json").read_text())["hash"] == reference[1].attrs["spec_hash"]
+
+
+def test_resume_refuses_another_sweep(reference):
+    """A DIR holding another sweep is an error (before computing), naming --out."""
+    out, _ = reference
+    other = load_sweep_spec(SMALL).with_batch_size(4)
+    with pytest.raises(SweepSpecError, match=r"^--out: .* holds another sweep"):
+        run_sweep(other, out, progress=False)
+
+
+def test_plot_draws_every_figure_from_assembled_batches(tmp_path, capsys):
+    """Dataset assembly and `jaxbearing plot` on fabricated batch files (no solving): every
+    figure is drawn when the axes are there, and the design zone of each case is filled in."""
+    from jaxbearing._sweep import write_batch
+
+    spec = load_sweep_spec(SWEEPS / "figures.toml")
+    rng = np.random.default_rng(0)
+    cases = np.arange(spec.num_cases)
+    data = {name: rng.uniform(1.0, 2.0, spec.num_cases) for name in variable_names()}
+    angle = rng.uniform(0, 2 * np.pi, (spec.num_cases, spec.max_positions))
+    data.update(
+        case_index=cases,
+        status=np.asarray(["ok"] * spec.num_cases),
+        result_code=np.zeros(spec.num_cases, np.int32),
+        contact_position=2e-3 * np.stack([np.cos(angle), np.sin(angle)], axis=-1),
+        contact_position_count=np.full(spec.num_cases, spec.max_positions, np.int32),
+    )
+    (tmp_path / "spec.json").write_text(json.dumps({"hash": spec.hash, "spec": spec.canonical()}))
+    write_batch(tmp_path, spec, 0, data)
+    assert cli_main(["plot", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert out.count("drew Figure") == 8 and "could not" not in out
+    assert len(list((tmp_path / "figures").glob("figure*.png"))) == 8
+    from jaxbearing._sweep import open_results
+
+    ds = open_results(tmp_path)
+    assert ds["flange_pv_Pa_m_s_max"].dims == spec.dims
+    np.testing.assert_array_equal(ds["flange_pv_Pa_m_s_max"].values.ravel(),
+                                  data["flange_pv_Pa_m_s_max"])
+    # design zone per case: arc contact height D/2 - R_end sin(theta_f) (MODEL.md 4.1)
+    arc = ds.sel(end="arc", speed_rpm=10000.0, central_length_mm=4.5)
+    r, t = np.meshgrid(arc["end_radius_mm"].values, np.radians(arc["layback_angle_deg"].values),
+                       indexing="ij")
+    np.testing.assert_allclose(arc["zone_contact_height_m"].values, (3.75 - r * np.sin(t)) * 1e-3,
+                               rtol=1e-9)
+
+
+def test_plot_names_missing_axes(tmp_path, capsys):
+    assert cli_main(["plot", str(tmp_path / "nope")]) == 2
+    assert "is not a directory" in capsys.readouterr().err
+    assert cli_main(["plot", str(tmp_path)]) == 2
+    assert "not a sweep directory" in capsys.readouterr().err
