@@ -1,0 +1,95 @@
+"""Smoke test of the benchmark harness (benchmarks/): every module imports and exposes
+`main(quick)`, the cheap self-checks pass, and the runner's discovery, JSON writing and failure
+handling work. The benchmarks themselves are NOT run here (`make bench` runs them)."""
+
+from __future__ import annotations
+
+import inspect
+import json
+import math
+import sys
+from pathlib import Path
+
+import pytest
+
+BENCH_DIR = Path(__file__).resolve().parents[1] / "benchmarks"
+sys.path.insert(0, str(BENCH_DIR))
+
+import _common  # noqa: E402
+import run_all  # noqa: E402
+
+NAMES = run_all.discover()
+
+
+def test_discovery_finds_this_issues_benchmarks():
+    for name in ("bench_scipy", "bench_cost_per_eval", "bench_scaling"):
+        assert name in NAMES
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_module_imports_and_has_main(name):
+    module = run_all.load(name)
+    params = inspect.signature(module.main).parameters
+    assert "quick" in params, f"{name}.main must take `quick`"
+    if hasattr(module, "self_check"):
+        module.self_check()
+
+
+def test_write_json_is_strict_json_with_machine_info(tmp_path):
+    import numpy as np
+
+    path = _common.write_json("demo", {"x": np.float64(1.5), "a": np.arange(3), "nan": math.nan,
+                                       "inf": math.inf}, results_dir=tmp_path)
+    data = json.loads(path.read_text())
+    assert data["x"] == 1.5 and data["a"] == [0, 1, 2] and data["nan"] is None and data["inf"] == "inf"
+    assert data["benchmark"] == "demo"
+    assert data["machine"]["cpu_count"] >= 1 and data["machine"]["jax"]
+    assert not list(tmp_path.glob("*.tmp"))
+
+
+def test_format_table_and_target():
+    text = _common.format_table("T", ["a", "b"], [[1, 2.5], ["x", None]])
+    assert text.splitlines()[0] == "T" and "2.5" in text and "-" in text
+    assert _common.target("t", 3.0, 2.0, higher_is_better=True)["reached"]
+    assert not _common.target("t", 0.5, 0.3, higher_is_better=False)["reached"]
+    assert not _common.target("t", math.nan, 0.3, higher_is_better=False)["reached"]
+
+
+def test_runner_records_failure_and_continues(tmp_path, monkeypatch):
+    """A failing benchmark is recorded, the next one still runs, and the exit code is 1."""
+    (tmp_path / "bench_a_fails.py").write_text("def main(quick=False):\n    raise ValueError('boom')\n")
+    (tmp_path / "bench_b_ok.py").write_text(
+        "def main(quick=False):\n    return {'table': 'B', 'targets': {'t': {'target': 't', 'measured': 1.0,"
+        " 'threshold': 0.5, 'reached': True}}}\n")
+    results = tmp_path / "results"
+    monkeypatch.setattr(_common, "RESULTS_DIR", results)
+    monkeypatch.setattr(run_all, "discover", lambda bench_dir=tmp_path: ["bench_a_fails", "bench_b_ok"])
+
+    def run_one(name, quick, timeout):  # in-process stand-in for the subprocess
+        status_file = tmp_path / f"{name}.status"
+        monkeypatch.setattr(run_all, "load", lambda n, bench_dir=tmp_path: _load(n, tmp_path))
+        run_all._child(name, quick, str(status_file))
+        return json.loads(status_file.read_text())
+
+    monkeypatch.setattr(run_all, "run_one", run_one)
+    assert run_all.main(["--quick"]) == 1
+    summary = json.loads((results / "summary.json").read_text())
+    assert summary["failed"] == ["bench_a_fails"]
+    assert "boom" in summary["benchmarks"]["bench_a_fails"]["error"]
+    assert summary["benchmarks"]["bench_b_ok"]["ok"]
+    assert summary["targets"]["bench_b_ok.t"]["reached"]
+    assert json.loads((results / "bench_b_ok.json").read_text())["table"] == "B"  # written by the runner
+
+
+def _load(name, directory):
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location(name, directory / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_only_rejects_unknown_names(capsys):
+    assert run_all.main(["--only", "no_such_bench"]) == 2
+    assert "unknown benchmark" in capsys.readouterr().err
