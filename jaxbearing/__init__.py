@@ -97,3 +97,22 @@ from ._sweep import (  # noqa: E402
 )
 
 __all__ += ["SweepSpec", "SweepSpecError", "load_sweep_spec", "loads_sweep_spec", "open_results", "run_sweep"]
+
+# differentiable design metrics of the roller end and flange (issue 5)
+from ._design import (  # noqa: E402
+    DesignMetrics,
+    DesignVariables,
+    design_jacobian,
+    design_metrics,
+    seated_perturbation,
+    zone_margins,
+)
+
+__all__ += [
+    "DesignMetrics",
+    "DesignVariables",
+    "design_jacobian",
+    "design_metrics",
+    "seated_perturbation",
+    "zone_margins",
+]

@@ -1,4 +1,40 @@
 """optimise: gradient-based design of roller ends and flanges on top of jaxbearing.
 
-(Filled in by the gradient-design work; see the issue tracker.)
+Minimise the smooth peak flange PV of arc-end rollers over the end radius R_end, the flange
+layback angle theta_f and the axial clearance Delta_bf, inside the design zone (relief, height
+limit, limited circle, actual axial clearance), robustly over an envelope of speeds and loads.
+The search is a multi-start projected augmented Lagrangian driven by optax (`_search`); the
+objective's gradients come from forward-mode differentiation through the diffrax solve
+(`jaxbearing._design`). Command line: `optimise run --help`.
 """
+
+import jaxbearing  # noqa: F401  (enables 64-bit floats)
+
+from ._problem import (
+    MARGIN_NAMES,
+    Bounds,
+    DesignProblem,
+    any_feasible,
+    bounds_from_engineering,
+    feasibility_map,
+    load_optimise_toml,
+    make_problem,
+    operating_envelope,
+)
+from ._search import SearchResult, grid_search, search, start_points
+
+__all__ = [
+    "MARGIN_NAMES",
+    "Bounds",
+    "DesignProblem",
+    "SearchResult",
+    "any_feasible",
+    "bounds_from_engineering",
+    "feasibility_map",
+    "grid_search",
+    "load_optimise_toml",
+    "make_problem",
+    "operating_envelope",
+    "search",
+    "start_points",
+]

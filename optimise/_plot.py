@@ -1,0 +1,57 @@
+"""Search paths over the design-zone feasibility map (matplotlib, Agg backend)."""
+
+from __future__ import annotations
+
+import math
+import pathlib
+
+import numpy as np
+
+
+def plot_search(problem, result, path) -> pathlib.Path:
+    """Write a PNG of every start's path in (R_end, theta_f) over the feasibility map of the
+    design zone (`jaxbearing.design_zone_grid`, at the final Delta_bf, or the start's when no
+    feasible design was found): feasible region shaded, zero lines of each margin, starts as
+    circles, the final design as a star."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from ._problem import feasibility_map
+
+    x_ref = result.design if result.design is not None else result.start_design
+    r, t, z = feasibility_map(problem, float(x_ref[2]))
+    rr, tt = np.meshgrid(r * 1e3, np.degrees(t), indexing="ij")
+    fig, ax = plt.subplots(figsize=(7, 5))
+    feas = np.asarray(z.feasible, dtype=float)
+    ax.contourf(rr, tt, feas, levels=[-0.5, 0.5, 1.5], colors=["#f2f2f2", "#b7e1b0"])
+    styles = (("relief_margin", "tab:red", "relief"), ("height_margin", "tab:blue", "height limit"),
+              ("limited_circle_margin", "tab:purple", "limited circle"),
+              ("clearance_margin", "tab:orange", "axial clearance"))
+    for field, colour, label in styles:
+        m = np.asarray(getattr(z, field))
+        if m.min() < 0 < m.max():
+            ax.contour(rr, tt, m, levels=[0.0], colors=colour, linewidths=1.2)
+            ax.plot([], [], color=colour, label=f"{label} margin = 0")
+    h = result.history
+    if h:
+        xs = np.asarray(h["x"])  # (I, S, 3)
+        for s in range(xs.shape[1]):
+            line, = ax.plot(xs[:, s, 0] * 1e3, np.degrees(xs[:, s, 1]), "-", lw=1, marker=".", ms=3)
+            ax.plot(xs[0, s, 0] * 1e3, math.degrees(xs[0, s, 1]), "o", color=line.get_color(), mfc="none")
+    if result.design is not None:
+        ax.plot(result.design[0] * 1e3, math.degrees(result.design[1]), "*", color="k", ms=14,
+                label="final design")
+    ax.set_xlabel("end radius R_end [mm]")
+    ax.set_ylabel("layback angle theta_f [deg]")
+    free_clearance = problem.bounds.upper[2] > problem.bounds.lower[2]
+    ax.set_title(f"design zone at Delta_bf = {x_ref[2] * 1e3:.3f} mm (green: feasible) and search paths"
+                 + (" (projected: Delta_bf varies along them)" if free_clearance else ""), fontsize=9)
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(fontsize=7, loc="best")
+    fig.tight_layout()
+    path = pathlib.Path(path)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path

@@ -1,0 +1,361 @@
+"""The design problem: bounds, operating envelope, scaled objective and constraints.
+
+Variables. The design x = (R_end [m], theta_f [rad], Delta_bf [m]) is searched in the unit box:
+x = lo + u (hi - lo), u in [0, 1]^3, so every variable is O(1) and the box bounds are a
+projection (a clip). A variable whose bounds coincide (lo = hi) is held fixed.
+
+Objective. The smooth peak flange PV of the dynamic run (`jaxbearing.design_metrics`: a p-norm
+over contact time of p_max |u|, integrated inside the diffrax solve) in GPa m/s, at every
+operating point of the envelope, evaluated in one vmapped batch, and combined either as a
+weighted mean, or as the worst case through a smooth maximum (weighted log-sum-exp with
+temperature T: J = T log sum_k w_k exp(PV_k / T), w_k normalised; J -> max_k PV_k as T -> 0).
+
+Horizon (a limitation, measured). The dynamic objective is evaluated over a short horizon
+(`DEFAULT_DURATION`, 0.3 ms from the seated start), because gradients through longer runs pass
+through roller-flange impacts and stop being reliable (`jaxbearing._design`: central
+differences no longer converge). Over so short a horizon the peak PV measures how hard the
+seated rollers are driven onto their flanges in the first 0.3 ms: about 2 GPa m/s at the
+reference design (R_end 80 mm, theta_f 1.6 deg), but almost zero (1e-7 GPa m/s) for designs such
+as R_end 100-120 mm, theta_f 1.3-1.7 deg at Delta_bf 0.2 mm, whose rollers are not yet loaded
+against the flange within the horizon. The search finds those designs; whether they keep a low
+PV in steady running needs longer runs (`jaxbearing simulate`) to confirm. Pass `duration`
+(`--duration-ms`) for longer horizons.
+
+Constraints. The four margins of the design zone (`jaxbearing.design_zone`, the paper's
+Figure 14): contact ellipse above the flange relief, contact height below the upper limit,
+contact inside the limited circle, actual axial clearance Lambda_bf above `min_clearance`.
+They are static and cheap (no dynamics), scaled by `MARGIN_SCALE` (0.1 mm) to O(1), and
+tightened by `tighten` (scaled units) so that the small constraint violation an augmented
+Lagrangian leaves at its limit point still satisfies the true constraint.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import tomllib
+from typing import Sequence
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+from jaxtyping import Array, Float
+
+from jaxbearing import Bearing, OperatingPoint, Perturbation, UserInputError, rpm_to_rad_s
+from jaxbearing._design import DesignVariables, design_metrics, seated_perturbation, zone_margins
+from jaxbearing._zone import DEFAULT_FLANGE_LOAD, design_zone_grid
+
+MM = 1e-3
+DEG = math.pi / 180
+#: scale of the design-zone margins (constraints are margin / MARGIN_SCALE)
+MARGIN_SCALE = 0.1 * MM
+#: scale of the objective (PV in GPa m/s)
+PV_SCALE = 1e9
+MARGIN_NAMES = ("relief", "height", "limited_circle", "clearance")
+VARIABLE_NAMES = ("end_radius", "layback_angle", "axial_clearance")
+#: default simulated time per evaluation [s] and initial roller skew scatter [rad]. The rollers
+#: start from `seated_perturbation` (the outermost roller at zero interference with its flange,
+#: every design from an equivalent state) with a skew scatter of +/- 1 mrad (0.06 deg, the order
+#: of roller skew in high-speed bearings); skew drives them onto the flanges at once, and within
+#: 0.3 ms at 20,000 rpm the smooth peak PV reaches about 2 GPa m/s on the reference bearing, the
+#: order of the paper's arc-end PV (below 3 GPa m/s). With the default scatter (1e-4 rad) the
+#: first contacts are gentle and the PV stays four orders of magnitude lower over 0.5 ms.
+DEFAULT_DURATION = 0.3e-3
+DEFAULT_SKEW = 1e-3
+
+
+@dataclasses.dataclass(frozen=True)
+class Bounds:
+    """Box bounds of the design, SI units (R_end [m], theta_f [rad], Delta_bf [m]).
+
+    Defaults: a sensible range around the reference design (R_end 60-120 mm, theta_f 1.0-2.0
+    deg, Delta_bf 0.10-0.30 mm). lo == hi fixes a variable."""
+
+    end_radius: tuple[float, float] = (60 * MM, 120 * MM)
+    layback_angle: tuple[float, float] = (1.0 * DEG, 2.0 * DEG)
+    axial_clearance: tuple[float, float] = (0.10 * MM, 0.30 * MM)
+
+    def __post_init__(self):
+        checks = (
+            ("end_radius", "mm", 1 / MM, lambda v: v > 3.75 * MM, "> D/2"),
+            ("layback_angle", "deg", 1 / DEG, lambda v: 0 <= v < 45 * DEG, "in [0, 45) deg"),
+            ("axial_clearance", "mm", 1 / MM, lambda v: v > 0, "> 0"),
+        )
+        for name, unit, k, ok, valid in checks:
+            lo, hi = (float(v) for v in getattr(self, name))
+            for which, v in (("lower", lo), ("upper", hi)):
+                if not (math.isfinite(v) and ok(v)):
+                    raise UserInputError(
+                        f"bounds.{name}_{unit} {which} bound = {v * k:g}: must be finite and {valid}"
+                    )
+            if lo > hi:
+                raise UserInputError(
+                    f"bounds.{name}_{unit} = [{lo * k:g}, {hi * k:g}]: lower bound above upper bound"
+                )
+
+    @property
+    def lower(self) -> np.ndarray:
+        return np.array([self.end_radius[0], self.layback_angle[0], self.axial_clearance[0]])
+
+    @property
+    def upper(self) -> np.ndarray:
+        return np.array([self.end_radius[1], self.layback_angle[1], self.axial_clearance[1]])
+
+    def to_scaled(self, x) -> Array:
+        """u = (x - lo) / (hi - lo) (0 for fixed variables)."""
+        width = self.upper - self.lower
+        return jnp.where(width > 0, (jnp.asarray(x) - self.lower) / jnp.where(width > 0, width, 1.0), 0.0)
+
+    def from_scaled(self, u) -> Array:
+        """x = lo + u (hi - lo)."""
+        return self.lower + jnp.asarray(u) * (self.upper - self.lower)
+
+    def engineering(self) -> dict:
+        """Bounds in engineering units (mm, deg, mm)."""
+        return {
+            "end_radius_mm": [v / MM for v in self.end_radius],
+            "layback_angle_deg": [v / DEG for v in self.layback_angle],
+            "axial_clearance_mm": [v / MM for v in self.axial_clearance],
+        }
+
+
+def bounds_from_engineering(
+    end_radius_mm: Sequence[float] | None = None,
+    layback_angle_deg: Sequence[float] | None = None,
+    axial_clearance_mm: Sequence[float] | None = None,
+    base: Bounds | None = None,
+) -> Bounds:
+    """Bounds from engineering units (None keeps `base`, default `Bounds()`)."""
+    base = base or Bounds()
+
+    def pair(name, v, k):
+        if v is None:
+            return getattr(base, name)
+        v = list(v)
+        if len(v) != 2:
+            raise UserInputError(f"bounds.{name}: expected [lower, upper], got {v}")
+        return (float(v[0]) * k, float(v[1]) * k)
+
+    return Bounds(
+        end_radius=pair("end_radius", end_radius_mm, MM),
+        layback_angle=pair("layback_angle", layback_angle_deg, DEG),
+        axial_clearance=pair("axial_clearance", axial_clearance_mm, MM),
+    )
+
+
+#: keys of the optional optimiser TOML file (engineering units), with their meaning
+OPTIMISE_TOML_KEYS = {
+    "bounds": ("end_radius_mm", "layback_angle_deg", "axial_clearance_mm"),
+    "constraints": ("min_clearance_mm", "flange_load_N"),
+    "envelope": ("speeds_rpm", "loads_N", "weights", "aggregate", "temperature_GPa_m_s"),
+    "search": ("starts", "iterations", "learning_rate", "duration_ms", "rtol", "atol"),
+}
+
+
+def load_optimise_toml(path: str) -> dict:
+    """Read the optimiser's own small TOML file:
+
+        [bounds]       end_radius_mm = [60, 120], layback_angle_deg = [1.0, 2.0],
+                       axial_clearance_mm = [0.10, 0.30]
+        [constraints]  min_clearance_mm = 0.0, flange_load_N = 100
+        [envelope]     speeds_rpm = [...], loads_N = [...], weights = [...],
+                       aggregate = "max" | "mean", temperature_GPa_m_s = 0.1
+        [search]       starts, iterations, learning_rate, duration_ms, rtol, atol
+
+    Returns a flat dict {key: value}; unknown sections or keys raise UserInputError."""
+    try:
+        with open(path, "rb") as f:
+            data = tomllib.load(f)
+    except OSError as exc:
+        raise UserInputError(f"optimise file {path}: cannot read: {exc.strerror or exc}") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise UserInputError(f"optimise file {path}: invalid TOML: {exc}") from None
+    out = {}
+    for section, table in data.items():
+        if section not in OPTIMISE_TOML_KEYS or not isinstance(table, dict):
+            raise UserInputError(
+                f"optimise file {path}: unknown section [{section}] "
+                f"(valid: {', '.join(OPTIMISE_TOML_KEYS)})"
+            )
+        for key, value in table.items():
+            if key not in OPTIMISE_TOML_KEYS[section]:
+                raise UserInputError(
+                    f"optimise file {path}: unknown key {section}.{key} "
+                    f"(valid: {', '.join(OPTIMISE_TOML_KEYS[section])})"
+                )
+            out[key] = value
+    return out
+
+
+def operating_envelope(
+    base: OperatingPoint,
+    speeds_rpm: Sequence[float] | None = None,
+    loads_N: Sequence[float] | None = None,
+) -> OperatingPoint:
+    """Stacked operating points (leading axis) for every (speed, load) pair of the cartesian
+    product; None keeps the base value. Gravity is that of `base`."""
+    speeds = [float(base.inner_speed)] if not speeds_rpm else [rpm_to_rad_s(float(s)) for s in speeds_rpm]
+    loads = [float(base.radial_load)] if not loads_N else [float(f) for f in loads_N]
+    for s in speeds:
+        if not (math.isfinite(s) and s > 0):
+            raise UserInputError(f"speeds_rpm: {s * 60 / (2 * math.pi):g}: must be > 0 rpm")
+    for f in loads:
+        if not (math.isfinite(f) and f > 0):
+            raise UserInputError(f"loads_N: {f:g}: must be > 0 N")
+    sp, ld = np.meshgrid(speeds, loads, indexing="ij")
+    n = sp.size
+    return OperatingPoint(
+        inner_speed=sp.ravel(), radial_load=ld.ravel(), gravity=np.full(n, float(base.gravity))
+    )
+
+
+class DesignProblem(eqx.Module):
+    """Minimise the (robust) smooth peak flange PV over the box `bounds` subject to the design
+    zone. `operating` holds K stacked operating points; `weights` (K,) their weights.
+
+    `aggregate`: "max" (smooth worst case, log-sum-exp with `temperature` in GPa m/s) or
+    "mean" (weighted mean). `tighten`: constraint back-off in scaled units (x 0.1 mm)."""
+
+    bearing: Bearing
+    operating: OperatingPoint
+    weights: Float[Array, " K"]
+    bounds: Bounds = eqx.field(static=True)
+    duration: float = eqx.field(static=True, default=DEFAULT_DURATION)
+    flange_load: float = eqx.field(static=True, default=DEFAULT_FLANGE_LOAD)
+    min_clearance: float = eqx.field(static=True, default=0.0)
+    aggregate: str = eqx.field(static=True, default="max")
+    temperature: float = eqx.field(static=True, default=0.1)
+    tighten: float = eqx.field(static=True, default=0.01)
+    rtol: float = eqx.field(static=True, default=1e-3)
+    atol: float = eqx.field(static=True, default=1e-6)
+    max_steps: int = eqx.field(static=True, default=200_000)
+    #: initial roller scatter: "seated" (`jaxbearing.seated_perturbation` with skew scatter
+    #: `initial_skew`: axial scatter scaled to each design's play), or a Perturbation, or None
+    perturbation: Perturbation | str | None = eqx.field(static=True, default="seated")
+    initial_skew: float = eqx.field(static=True, default=DEFAULT_SKEW)
+
+    def __check_init__(self):
+        if self.aggregate not in ("max", "mean"):
+            raise UserInputError(f"aggregate = {self.aggregate!r}: must be 'max' or 'mean'")
+        if not (self.temperature > 0):
+            raise UserInputError(f"temperature = {self.temperature}: must be > 0 GPa m/s")
+        if not (self.duration > 0):
+            raise UserInputError(f"duration = {self.duration}: must be > 0 s")
+        if self.perturbation is not None and isinstance(self.perturbation, str) and self.perturbation != "seated":
+            raise UserInputError(f"perturbation = {self.perturbation!r}: must be 'seated', a Perturbation or None")
+        if not (self.flange_load > 0):
+            raise UserInputError(f"flange_load = {self.flange_load}: must be > 0 N")
+
+    @property
+    def num_operating_points(self) -> int:
+        return int(np.shape(self.operating.inner_speed)[0])
+
+    def design(self, u) -> DesignVariables:
+        return DesignVariables.from_array(self.bounds.from_scaled(u))
+
+    # -- objective (expensive: one dynamic solve per operating point) --------------------
+    def peak_pv(self, u: Float[Array, "3"]) -> Float[Array, " K"]:
+        """Smooth peak PV [GPa m/s] at every operating point (one vmapped batch)."""
+        import diffrax
+
+        design = self.design(u)
+        if isinstance(self.perturbation, str):
+            perturbation = seated_perturbation(design.apply(self.bearing), skew=self.initial_skew)
+        else:
+            perturbation = self.perturbation
+
+        def one(op):
+            m = design_metrics(
+                self.bearing, op, design, duration=self.duration, flange_load=self.flange_load,
+                min_clearance=self.min_clearance, rtol=self.rtol, atol=self.atol,
+                max_steps=self.max_steps, adjoint=diffrax.ForwardMode(),
+                perturbation=perturbation,
+            )
+            return m.peak_pv / PV_SCALE
+
+        return jax.vmap(one)(self.operating)
+
+    def combine(self, pv: Float[Array, " K"]) -> Float[Array, ""]:
+        """Weighted mean, or smooth max T log sum_k w_k exp(PV_k / T), of per-point PV."""
+        w = self.weights / jnp.sum(self.weights)
+        if self.aggregate == "mean":
+            return jnp.sum(w * pv)
+        t = self.temperature
+        m = jax.lax.stop_gradient(jnp.max(pv))
+        return m + t * jnp.log(jnp.sum(w * jnp.exp((pv - m) / t)))
+
+    def objective(self, u: Float[Array, "3"]) -> Float[Array, ""]:
+        """Robust smooth peak PV [GPa m/s] of the scaled design u."""
+        return self.combine(self.peak_pv(u))
+
+    # -- constraints (cheap, static) -------------------------------------------------------
+    def margins(self, u: Float[Array, "3"]) -> Float[Array, "4"]:
+        """Design-zone margins [m] (relief, height, limited circle, clearance)."""
+        return zone_margins(
+            self.bearing, self.design(u), flange_load=self.flange_load,
+            min_clearance=self.min_clearance,
+        )
+
+    def constraints(self, u: Float[Array, "3"]) -> Float[Array, "4"]:
+        """Scaled, tightened constraints c(u) = margins / MARGIN_SCALE - tighten >= 0."""
+        return self.margins(u) / MARGIN_SCALE - self.tighten
+
+
+def make_problem(
+    bearing: Bearing,
+    base_op: OperatingPoint,
+    *,
+    bounds: Bounds | None = None,
+    speeds_rpm: Sequence[float] | None = None,
+    loads_N: Sequence[float] | None = None,
+    weights: Sequence[float] | None = None,
+    **kwargs,
+) -> DesignProblem:
+    """A DesignProblem over the (speed x load) envelope around `base_op`."""
+    ops = operating_envelope(base_op, speeds_rpm, loads_N)
+    k = int(np.shape(ops.inner_speed)[0])
+    if weights is None:
+        w = np.ones(k)
+    else:
+        w = np.asarray([float(v) for v in weights])
+        if w.shape != (k,):
+            raise UserInputError(
+                f"weights: {len(w)} given, expected one per operating point ({k} = speeds x loads)"
+            )
+        if not np.all(np.isfinite(w) & (w >= 0)) or w.sum() <= 0:
+            raise UserInputError(f"weights = {w.tolist()}: must be >= 0 with a positive sum")
+    return DesignProblem(
+        bearing=bearing, operating=ops, weights=jnp.asarray(w), bounds=bounds or Bounds(), **kwargs
+    )
+
+
+def feasibility_map(problem: DesignProblem, axial_clearance: float, n: int = 81):
+    """Design-zone margins over an n x n grid of (R_end, theta_f) within the bounds at fixed
+    Delta_bf (`jaxbearing.design_zone_grid`, one vmap). Returns (R_end [m], theta_f [rad],
+    DesignZone) with fields of shape (n, n), axis 0 = R_end."""
+    lo, hi = problem.bounds.lower, problem.bounds.upper
+    r = np.linspace(lo[0], hi[0], n)
+    t = np.linspace(lo[1], hi[1], n)
+    z = design_zone_grid(
+        problem.bearing, r[:, None], t[None, :], axial_clearance, problem.flange_load,
+        problem.min_clearance,
+    )
+    return r, t, z
+
+
+@eqx.filter_jit
+def margins_batch(problem: DesignProblem, u: Float[Array, "N 3"]) -> Float[Array, "N 4"]:
+    """Design-zone margins [m] of a batch of scaled designs (one compiled vmap)."""
+    return jax.vmap(problem.margins)(u)
+
+
+def any_feasible(problem: DesignProblem, n: int = 41) -> tuple[bool, np.ndarray | None]:
+    """Whether some design on an n^3 grid over the bounds satisfies every (tightened) margin;
+    returns (found, the grid point with the largest minimum margin, scaled u)."""
+    axes = [np.linspace(0.0, 1.0, n if w > 0 else 1) for w in problem.bounds.upper - problem.bounds.lower]
+    uu = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+    c = np.asarray(margins_batch(problem, jnp.asarray(uu))) / MARGIN_SCALE - problem.tighten
+    worst = c.min(axis=1)
+    i = int(np.argmax(worst))
+    return bool(worst[i] > 0), uu[i]
