@@ -118,7 +118,7 @@ def verify_evaluation_count(bearing, op, duration) -> dict:
 
 def _compile_dopri5_rms(field: _common.FlatField, duration):
     """SciPy's algorithm inside diffrax: Dormand-Prince 5(4), RMS error norm, integral (I)
-    step-size controller with SciPy's safety 0.9 and factors [0.2, 10], automatic initial step,
+    step-size controller with SciPy's safety 0.9 and factors [0.2, 10], first step 1e-7 s,
     on the same flat compiled field. Isolates the integration loop from the choice of method."""
     import diffrax
     import jax.numpy as jnp
@@ -130,7 +130,10 @@ def _compile_dopri5_rms(field: _common.FlatField, duration):
             diffrax.Dopri5(),
             t0=0.0,
             t1=t1,
-            dt0=None,
+            # the same first step as `jaxbearing.solve`: with diffrax's automatic initial step
+            # (dt0=None) the 2 ms run never passes its first error test (every one of 20,000
+            # attempts rejected), while the 1 ms run is fine: measured in this session
+            dt0=1e-7,
             y0=y0,
             args=args_flat,
             saveat=diffrax.SaveAt(t1=True),
