@@ -54,7 +54,7 @@ import jax.numpy as jnp
 from jaxtyping import Array, ArrayLike, Float
 
 from ._params import Bearing
-from ._raceway import HUNT_CROSSLEY_ALPHA
+from ._raceway import HUNT_CROSSLEY_ALPHA, slice_positions
 from .contact import (
     PENETRATION_WIDTH,
     SLIDING_EPS,
@@ -94,9 +94,9 @@ def pocket_stiffness(bearing: Bearing) -> Float[Array, ""]:
 
 
 def pocket_slice_positions(bearing: Bearing, num_slices: int) -> Float[Array, " N_p"]:
-    """xi_k = -L_we/2 + (k + 1/2) L_we / N_p: slice centres along the roller axis [m]."""
-    l_we = bearing.roller.effective_length
-    return l_we * ((jnp.arange(num_slices) + 0.5) / num_slices - 0.5)
+    """xi_k = -L_we/2 + (k + 1/2) L_we / N_p: slice centres along the roller axis [m]
+    (the raceway slicing, `_raceway.slice_positions`, with N_p slices)."""
+    return slice_positions(bearing, num_slices)
 
 
 def pocket_contact(

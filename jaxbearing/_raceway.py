@@ -98,9 +98,10 @@ def _safe_unit(v: Array, fallback: Array) -> tuple[Array, Array]:
     return n[..., 0], u
 
 
-def slice_positions(bearing: Bearing) -> Float[Array, " N_s"]:
-    """xi_j = -L_we/2 + (j + 1/2) L_we/N_s: slice centres along the roller axis [m]."""
-    n = bearing.num_slices
+def slice_positions(bearing: Bearing, num_slices: int | None = None) -> Float[Array, " N_s"]:
+    """xi_j = -L_we/2 + (j + 1/2) L_we/N_s: slice centres along the roller axis [m]
+    (N_s = bearing.num_slices unless `num_slices` is given, as for the cage pocket)."""
+    n = bearing.num_slices if num_slices is None else num_slices
     l_we = bearing.roller.effective_length
     return l_we * ((jnp.arange(n) + 0.5) / n - 0.5)
 
