@@ -28,17 +28,9 @@ import time
 import numpy as np
 
 RESULTS = pathlib.Path(__file__).resolve().parent / "results"
+sys.path.insert(0, str(RESULTS.parent))
 
-
-def _machine() -> dict:
-    """Machine information from benchmarks/_common.py (CPU count, load, versions)."""
-    sys.path.insert(0, str(RESULTS.parent))
-    try:
-        from _common import machine_info
-
-        return machine_info()
-    except Exception as exc:  # pragma: no cover - the shared helper is optional here
-        return {"error": f"machine_info unavailable: {exc}"}
+from _common import machine_info  # noqa: E402
 
 
 def _compile_and_first(f, *args):
@@ -155,7 +147,7 @@ def main(quick: bool = True) -> dict:
         "faster_ad_mode": faster,
         "faster_by": ratio,
         "quick": quick,
-        "machine": _machine(),
+        "machine": machine_info(),
     }
     RESULTS.mkdir(parents=True, exist_ok=True)
     (RESULTS / "gradients.json").write_text(json.dumps(out, indent=2))

@@ -31,17 +31,11 @@ import time
 import numpy as np
 
 RESULTS = pathlib.Path(__file__).resolve().parent / "results"
+sys.path.insert(0, str(RESULTS.parent))
+
+from _common import machine_info  # noqa: E402
 
 
-def _machine() -> dict:
-    """Machine information from benchmarks/_common.py (CPU count, load, versions)."""
-    sys.path.insert(0, str(RESULTS.parent))
-    try:
-        from _common import machine_info
-
-        return machine_info()
-    except Exception as exc:  # pragma: no cover - the shared helper is optional here
-        return {"error": f"machine_info unavailable: {exc}"}
 CLEARANCE_MM = 0.15  # the reference design's Delta_bf
 
 
@@ -104,7 +98,7 @@ def main(quick: bool = True) -> dict:
         ),
         "no_worse_tolerance_GPa_m_s": 1e-3,
         "quick": quick,
-        "machine": _machine(),
+        "machine": machine_info(),
     }
     RESULTS.mkdir(parents=True, exist_ok=True)
     (RESULTS / "optimise_vs_grid.json").write_text(json.dumps(out, indent=2))

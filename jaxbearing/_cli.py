@@ -41,10 +41,11 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def main(argv: list[str] | None = None) -> int:
+def dispatch(parser: argparse.ArgumentParser, argv: list[str] | None) -> int:
+    """Parse `argv`, run the chosen command's `func`; help when none is given. A
+    `UserInputError` prints one line "PROG COMMAND: error: ..." and returns 2 (no traceback)."""
     from ._errors import UserInputError
 
-    parser = build_parser()
     args = parser.parse_args(argv)
     if not getattr(args, "func", None):
         parser.print_help()
@@ -52,8 +53,12 @@ def main(argv: list[str] | None = None) -> int:
     try:
         return int(args.func(args) or 0)
     except UserInputError as exc:
-        print(f"jaxbearing {args.command}: error: {exc}", file=sys.stderr)
+        print(f"{parser.prog} {args.command}: error: {exc}", file=sys.stderr)
         return 2
+
+
+def main(argv: list[str] | None = None) -> int:
+    return dispatch(build_parser(), argv)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -278,16 +278,9 @@ def _result_json(problem, options, res) -> dict:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = build_parser()
-    args = parser.parse_args(argv)
-    if not getattr(args, "func", None):
-        parser.print_help()
-        return 0
-    try:
-        return int(args.func(args) or 0)
-    except UserInputError as exc:
-        print(f"optimise {args.command}: error: {exc}", file=sys.stderr)
-        return 2
+    from jaxbearing._cli import dispatch
+
+    return dispatch(build_parser(), argv)
 
 
 if __name__ == "__main__":  # pragma: no cover
