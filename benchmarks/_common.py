@@ -56,7 +56,7 @@ def machine_info() -> dict:
     except OSError:  # pragma: no cover
         load = None
     return {
-        "date_utc": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
+        "date_utc": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"),
         "cpu_count": os.cpu_count(),
         "cpu_affinity": affinity,
         "cpu_model": _cpu_model(),
@@ -208,9 +208,9 @@ def target(description: str, measured: float, threshold: float, higher_is_better
 class FlatField:
     """The vector field diffrax integrates in `jaxbearing.solve`, as flat float64 vectors.
 
-    `jaxbearing._simulate.solve` integrates the *scaled deviation* state
-    Y = (y - nominal(t)) / scale (`jaxbearing._state.Scaling`) with the field
-    `jaxbearing._simulate._field(t, Y, args)`. This object builds exactly the same `args` and
+    `jaxbearing.run.solve` integrates the *scaled deviation* state
+    Y = (y - nominal(t)) / scale (`jaxbearing.dynamics.Scaling`) with the field
+    `jaxbearing.run._field(t, Y, args)`. This object builds exactly the same `args` and
     initial Y as `solve` does, ravels Y with `jax.flatten_util.ravel_pytree`, and ravels the
     arguments too, so that one compiled call takes three arrays (t, Y_flat, args_flat):
     the cheapest dispatch for an external integrator (`scipy.integrate.solve_ivp`).
@@ -220,10 +220,9 @@ class FlatField:
         import jax.numpy as jnp
         from jax.flatten_util import ravel_pytree
 
-        from jaxbearing._dynamics import Functionals, Params
-        from jaxbearing._params import kinematic_cage_speed
-        from jaxbearing._simulate import Perturbation, _Args, initial_state
-        from jaxbearing._state import Scaling, state_scales
+        from jaxbearing.dynamics import Functionals, Params, Scaling, state_scales
+        from jaxbearing.geometry import kinematic_cage_speed
+        from jaxbearing.run import Perturbation, _Args, initial_state
 
         if perturbation == "default":
             perturbation = Perturbation()  # the default of `solve`
@@ -247,7 +246,7 @@ class FlatField:
         """Flat scaled rate dY/dt (pure; jit this)."""
         from jax.flatten_util import ravel_pytree
 
-        from jaxbearing._simulate import _field
+        from jaxbearing.run import _field
 
         rate = _field(t, self._unravel_state(y_flat), self._unravel_args(args_flat))
         return ravel_pytree(rate)[0]
@@ -257,7 +256,7 @@ class FlatField:
         return compile_jit(self.__call__, self.t0, self.y0, self.args_flat)
 
     def physical(self, t, y_flat):
-        """The physical state (unscaled `jaxbearing._state.State`) of a flat scaled state."""
+        """The physical state (unscaled `jaxbearing.dynamics.State`) of a flat scaled state."""
         import jax.numpy as jnp
 
         return self.args.scaling.unscale(jnp.asarray(t, float), self._unravel_state(jnp.asarray(y_flat)))

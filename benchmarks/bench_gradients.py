@@ -9,7 +9,7 @@ respect to the three design variables (R_end, theta_f, Delta_bf) on the referenc
 
 each timed relative to one forward solve (compile excluded; compile times reported separately),
 and their agreement (relative to the largest entry). Same horizon and tolerances as the
-acceptance test (`jaxbearing._design.GRADIENT_HORIZON`, `GRADIENT_RTOL`, `GRADIENT_ATOL`).
+acceptance test (`jaxbearing.run.GRADIENT_HORIZON`, `GRADIENT_RTOL`, `GRADIENT_ATOL`).
 
 Writes benchmarks/results/gradients.json and prints a table. Timings: the four methods are run
 round-robin (2 repeats with quick=True, 5 otherwise) and the minimum of each is reported (the
@@ -62,10 +62,14 @@ def main(quick: bool = True) -> dict:
     import jax.numpy as jnp
 
     import jaxbearing as jb
-    from jaxbearing._design import (
-        GRADIENT_ATOL, GRADIENT_HORIZON, GRADIENT_RTOL, DesignVariables, seated_perturbation,
+    from jaxbearing.flange import DesignVariables
+    from jaxbearing.run import (
+        GRADIENT_ATOL,
+        GRADIENT_HORIZON,
+        GRADIENT_RTOL,
+        flange_functionals,
+        seated_perturbation,
     )
-    from jaxbearing._simulate import flange_functionals
 
     repeats = 2 if quick else 5
     bearing = jb.reference_bearing()

@@ -35,7 +35,6 @@ sys.path.insert(0, str(RESULTS.parent))
 
 from _common import machine_info  # noqa: E402
 
-
 CLEARANCE_MM = 0.15  # the reference design's Delta_bf
 
 

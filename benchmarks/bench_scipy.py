@@ -4,7 +4,7 @@ The source study integrates its bearing model with an explicit adaptive Runge-Ku
 rtol 1e-3, atol 1e-6 (MATLAB ode45 style). Its stand-in here is SciPy's `solve_ivp(RK45)`
 (Dormand-Prince 5(4), the ode45 pair) at those tolerances, driving *our* vector field: the very
 scaled-deviation state and field that `jaxbearing.solve` hands to diffrax
-(`jaxbearing._simulate._field`, `_Args`, `jaxbearing._state.Scaling`), raveled to one flat
+(`jaxbearing.run._field`, `_Args`, `jaxbearing.dynamics.Scaling`), raveled to one flat
 float64 vector and jit-compiled once. Both integrators therefore evaluate the same compiled
 physics from the same initial state; what differs is the integration loop (Python/NumPy in
 SciPy, one XLA while-loop in diffrax), the Runge-Kutta pair (Dormand-Prince vs Tsitouras) and
@@ -66,10 +66,10 @@ def _compile_solve(bearing, op, duration):
 
 @contextlib.contextmanager
 def _counting_field():
-    """Temporarily instrument `jaxbearing._simulate._field` to count its executions."""
+    """Temporarily instrument `jaxbearing.run._field` to count its executions."""
     import jax
 
-    import jaxbearing._simulate as sim
+    import jaxbearing.run as sim
 
     original = sim._field
     counter = {"calls": 0}
@@ -151,7 +151,7 @@ def _compile_dopri5_rms(field: _common.FlatField, duration):
 def _final_diffrax(sol, functionals):
     import numpy as np
 
-    from jaxbearing._simulate import smooth_functionals
+    from jaxbearing.run import smooth_functionals
 
     h = sol.histories
     pv = float(smooth_functionals(sol.accumulators, functionals)[0])
@@ -166,7 +166,7 @@ def _final_diffrax(sol, functionals):
 def _final_scipy(field: _common.FlatField, t1, y1):
     import numpy as np
 
-    from jaxbearing._simulate import smooth_functionals
+    from jaxbearing.run import smooth_functionals
 
     y = field.physical(t1, y1)
     pv = float(smooth_functionals(y.accumulators, field.functionals)[0])

@@ -2,7 +2,7 @@
 
 Every batch integrates the reference bearing (arc ends, speeds spread over 15,000-25,000 rpm so
 the cases are not identical) over the same simulated time, through the sweep machinery
-(`jaxbearing._sweep.batch_runner`: `jax.vmap(solve)` under `jax.shard_map` over all local
+(`jaxbearing.sweep.batch_runner`: `jax.vmap(solve)` under `jax.shard_map` over all local
 devices). Compilation is timed separately and excluded from the throughput; each batch size is
 run `repeats` times and the best run counts.
 
@@ -29,7 +29,7 @@ def _inputs(batch: int, duration: float):
     import numpy as np
 
     from jaxbearing import reference_bearing, reference_operating_point, rpm_to_rad_s
-    from jaxbearing._params import OperatingPoint
+    from jaxbearing.geometry import OperatingPoint
 
     b = reference_bearing()
     op = reference_operating_point()
@@ -45,7 +45,7 @@ def measure(batch: int, duration: float, num_saves: int = 50, max_steps: int = 1
     import jax
     import numpy as np
 
-    from jaxbearing._sweep import batch_runner, padded_size
+    from jaxbearing.sweep import batch_runner, padded_size
 
     devices = tuple(jax.local_devices())
     size = padded_size(batch, len(devices))

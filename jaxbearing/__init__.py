@@ -2,13 +2,38 @@
 
 64-bit floats are switched on at import: contact interferences are micrometres on millimetre
 geometry, and gradients through long integrations need the precision.
+
+Layers (imports point down only; `docs/architecture.md`):
+
+    cli       the `jaxbearing` command line, one module per command
+    sweep     sweep specs, batched and sharded execution, storage, dataset, plots
+    run       solve / simulate, statistics, design metrics through the dynamics
+    dynamics  state layout, rigid bodies, the vector field, the quasi-static start
+    flange    the roller-end/flange model: contact, static design zone, design variables
+    forces    the other body pairs: raceway, pocket, cage lands, drag
+    io        configuration schema (TOML, engineering units), validation, range checks
+    geometry  parameter pytrees, mass properties, the roller end body
+    contact   contact laws: Hertz point and line contact, smoothing, traction
+    _errors   the exceptions every layer raises
+
+The names below are the public API; each subpackage's `__init__` lists what it offers.
 """
 
 import jax
 
 jax.config.update("jax_enable_x64", True)
 
-from ._params import (  # noqa: E402
+from ._errors import ConfigError, UserInputError  # noqa: E402
+from .dynamics import Functionals, QuasiStatic, quasi_static  # noqa: E402
+from .flange import (  # noqa: E402
+    DesignVariables,
+    DesignZone,
+    design_zone,
+    design_zone_grid,
+    zone_margins,
+)
+from .forces import RacewayContact, raceway_contact  # noqa: E402
+from .geometry import (  # noqa: E402
     Bearing,
     Cage,
     Flange,
@@ -22,14 +47,41 @@ from ._params import (  # noqa: E402
     reference_operating_point,
     rpm_to_rad_s,
 )
-
-from ._config import Config, SimulationSettings, load_config, loads_config, reference_config  # noqa: E402
-from ._errors import ConfigError, UserInputError  # noqa: E402
-from ._validation import validate_bearing  # noqa: E402
+from .io import (  # noqa: E402
+    Config,
+    SimulationSettings,
+    load_config,
+    loads_config,
+    reference_config,
+    validate_bearing,
+)
+from .run import (  # noqa: E402
+    DesignMetrics,
+    Perturbation,
+    SimulationResult,
+    Solution,
+    contact_events,
+    design_jacobian,
+    design_metrics,
+    flange_functionals,
+    seated_perturbation,
+    simulate,
+    solve,
+    summarise,
+)
+from .sweep import (  # noqa: E402
+    SweepSpec,
+    SweepSpecError,
+    load_sweep_spec,
+    loads_sweep_spec,
+    open_results,
+    run_sweep,
+)
 
 __version__ = "0.1.0"
 
 __all__ = [
+    # parameters (MODEL.md 2)
     "Bearing",
     "Cage",
     "Flange",
@@ -42,6 +94,7 @@ __all__ = [
     "reference_bearing",
     "reference_operating_point",
     "rpm_to_rad_s",
+    # configuration and errors
     "Config",
     "ConfigError",
     "SimulationSettings",
@@ -50,31 +103,16 @@ __all__ = [
     "loads_config",
     "reference_config",
     "validate_bearing",
-]
-
-# roller-end/flange design zone (MODEL.md 4.1; the paper's Figure 14)
-from ._zone import DesignZone, design_zone, design_zone_grid  # noqa: E402
-
-__all__ += ["DesignZone", "design_zone", "design_zone_grid"]
-
-# roller-raceway sliced contact (MODEL.md 4.2) and the quasi-static initial solution (MODEL.md 5)
-from ._quasistatic import QuasiStatic, quasi_static  # noqa: E402
-from ._raceway import RacewayContact, raceway_contact  # noqa: E402
-
-__all__ += ["QuasiStatic", "RacewayContact", "quasi_static", "raceway_contact"]
-
-from ._dynamics import Functionals  # noqa: E402
-from ._simulate import (  # noqa: E402
-    Perturbation,
-    SimulationResult,
-    Solution,
-    flange_functionals,
-    simulate,
-    solve,
-)
-from ._summary import contact_events, summarise  # noqa: E402
-
-__all__ += [
+    # roller-end/flange design zone (MODEL.md 4.1; the paper's Figure 14)
+    "DesignZone",
+    "design_zone",
+    "design_zone_grid",
+    # roller-raceway contact (MODEL.md 4.2) and the quasi-static start (MODEL.md 5)
+    "QuasiStatic",
+    "RacewayContact",
+    "quasi_static",
+    "raceway_contact",
+    # dynamics and runs
     "Functionals",
     "Perturbation",
     "SimulationResult",
@@ -84,31 +122,14 @@ __all__ += [
     "simulate",
     "solve",
     "summarise",
-]
-
-# parameter sweeps: vmapped, sharded, resumable batches with labelled results (issue 6)
-from ._sweep import (  # noqa: E402
-    SweepSpec,
-    SweepSpecError,
-    load_sweep_spec,
-    loads_sweep_spec,
-    open_results,
-    run_sweep,
-)
-
-__all__ += ["SweepSpec", "SweepSpecError", "load_sweep_spec", "loads_sweep_spec", "open_results", "run_sweep"]
-
-# differentiable design metrics of the roller end and flange (issue 5)
-from ._design import (  # noqa: E402
-    DesignMetrics,
-    DesignVariables,
-    design_jacobian,
-    design_metrics,
-    seated_perturbation,
-    zone_margins,
-)
-
-__all__ += [
+    # parameter sweeps
+    "SweepSpec",
+    "SweepSpecError",
+    "load_sweep_spec",
+    "loads_sweep_spec",
+    "open_results",
+    "run_sweep",
+    # design
     "DesignMetrics",
     "DesignVariables",
     "design_jacobian",

@@ -5,13 +5,14 @@ layback angle theta_f and the axial clearance Delta_bf, inside the design zone (
 limit, limited circle, actual axial clearance), robustly over an envelope of speeds and loads.
 The search is a multi-start projected augmented Lagrangian driven by optax (`_search`); the
 objective's gradients come from forward-mode differentiation through the diffrax solve
-(`jaxbearing._design`). Command line: `optimise run --help`.
+(`jaxbearing.run.design_metrics`). Command line: `optimise run --help`.
 """
 
 import jaxbearing  # noqa: F401  (enables 64-bit floats)
+from jaxbearing.flange import MARGIN_NAMES
 
+from ._plot import plot_search
 from ._problem import (
-    MARGIN_NAMES,
     Bounds,
     DesignProblem,
     any_feasible,
@@ -35,6 +36,7 @@ __all__ = [
     "load_optimise_toml",
     "make_problem",
     "operating_envelope",
+    "plot_search",
     "search",
     "start_points",
 ]

@@ -146,7 +146,7 @@ def _design_text(x) -> str:
 
 
 def _margin_text(m) -> str:
-    from ._problem import MARGIN_NAMES
+    from jaxbearing.flange import MARGIN_NAMES
 
     return "  ".join(
         f"{n} {v * 1e3:+.4f} mm {'OK' if v > 0 else 'VIOLATED'}" for n, v in zip(MARGIN_NAMES, m)
@@ -157,9 +157,9 @@ def run(args) -> int:
     import numpy as np
 
     from jaxbearing import load_config
+    from jaxbearing.flange import MARGIN_NAMES
 
     from ._plot import plot_search
-    from ._problem import MARGIN_NAMES
     from ._search import search
 
     cfg = load_config(args.config)
@@ -225,7 +225,7 @@ def run(args) -> int:
 def _result_json(problem, options, res) -> dict:
     import numpy as np
 
-    from ._problem import MARGIN_NAMES
+    from jaxbearing.flange import MARGIN_NAMES
 
     def design(x):
         if x is None:
@@ -278,7 +278,7 @@ def _result_json(problem, options, res) -> dict:
 
 
 def main(argv: list[str] | None = None) -> int:
-    from jaxbearing._cli import dispatch
+    from jaxbearing.cli import dispatch
 
     return dispatch(build_parser(), argv)
 

@@ -13,10 +13,9 @@ def plot_search(problem, result, path) -> pathlib.Path:
     design zone (`jaxbearing.design_zone_grid`, at the final Delta_bf, or the start's when no
     feasible design was found): feasible region shaded, zero lines of each margin, starts as
     circles, the final design as a star."""
-    import matplotlib
+    from jaxbearing.io import pyplot
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     from ._problem import feasibility_map
 

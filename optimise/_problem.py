@@ -12,7 +12,7 @@ temperature T: J = T log sum_k w_k exp(PV_k / T), w_k normalised; J -> max_k PV_
 
 Horizon (a limitation, measured). The dynamic objective is evaluated over a short horizon
 (`DEFAULT_DURATION`, 0.3 ms from the seated start), because gradients through longer runs pass
-through roller-flange impacts and stop being reliable (`jaxbearing._design`: central
+through roller-flange impacts and stop being reliable (`jaxbearing.run.design_metrics`: central
 differences no longer converge). Over so short a horizon the peak PV measures how hard the
 seated rollers are driven onto their flanges in the first 0.3 ms: about 2 GPa m/s at the
 reference design (R_end 80 mm, theta_f 1.6 deg), but almost zero (1e-7 GPa m/s) for designs such
@@ -34,7 +34,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import tomllib
-from typing import Sequence
+from collections.abc import Sequence
 
 import equinox as eqx
 import jax
@@ -43,8 +43,13 @@ import numpy as np
 from jaxtyping import Array, Float
 
 from jaxbearing import Bearing, OperatingPoint, Perturbation, UserInputError, rpm_to_rad_s
-from jaxbearing._design import DesignVariables, design_metrics, seated_perturbation, zone_margins
-from jaxbearing._zone import DEFAULT_FLANGE_LOAD, design_zone_grid
+from jaxbearing.flange import (
+    DEFAULT_FLANGE_LOAD,
+    DesignVariables,
+    design_zone_grid,
+    zone_margins,
+)
+from jaxbearing.run import design_metrics, seated_perturbation
 
 MM = 1e-3
 DEG = math.pi / 180
@@ -52,8 +57,6 @@ DEG = math.pi / 180
 MARGIN_SCALE = 0.1 * MM
 #: scale of the objective (PV in GPa m/s)
 PV_SCALE = 1e9
-MARGIN_NAMES = ("relief", "height", "limited_circle", "clearance")
-VARIABLE_NAMES = ("end_radius", "layback_angle", "axial_clearance")
 #: default simulated time per evaluation [s] and initial roller skew scatter [rad]. The rollers
 #: start from `seated_perturbation` (the outermost roller at zero interference with its flange,
 #: every design from an equivalent state) with a skew scatter of +/- 1 mrad (0.06 deg, the order
@@ -255,7 +258,7 @@ class DesignProblem(eqx.Module):
         return DesignVariables.from_array(self.bounds.from_scaled(u))
 
     # -- objective (expensive: one dynamic solve per operating point) --------------------
-    def peak_pv(self, u: Float[Array, "3"]) -> Float[Array, " K"]:
+    def peak_pv(self, u: Float[Array, 3]) -> Float[Array, " K"]:
         """Smooth peak PV [GPa m/s] at every operating point (one vmapped batch)."""
         import diffrax
 
@@ -285,19 +288,19 @@ class DesignProblem(eqx.Module):
         m = jax.lax.stop_gradient(jnp.max(pv))
         return m + t * jnp.log(jnp.sum(w * jnp.exp((pv - m) / t)))
 
-    def objective(self, u: Float[Array, "3"]) -> Float[Array, ""]:
+    def objective(self, u: Float[Array, 3]) -> Float[Array, ""]:
         """Robust smooth peak PV [GPa m/s] of the scaled design u."""
         return self.combine(self.peak_pv(u))
 
     # -- constraints (cheap, static) -------------------------------------------------------
-    def margins(self, u: Float[Array, "3"]) -> Float[Array, "4"]:
+    def margins(self, u: Float[Array, 3]) -> Float[Array, 4]:
         """Design-zone margins [m] (relief, height, limited circle, clearance)."""
         return zone_margins(
             self.bearing, self.design(u), flange_load=self.flange_load,
             min_clearance=self.min_clearance,
         )
 
-    def constraints(self, u: Float[Array, "3"]) -> Float[Array, "4"]:
+    def constraints(self, u: Float[Array, 3]) -> Float[Array, 4]:
         """Scaled, tightened constraints c(u) = margins / MARGIN_SCALE - tighten >= 0."""
         return self.margins(u) / MARGIN_SCALE - self.tighten
 

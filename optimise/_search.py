@@ -22,7 +22,7 @@ Why this method:
   rho, so the limit point does not sit outside the zone by O(1/rho); the small remaining
   violation is absorbed by tightening the constraints (`DesignProblem.tighten`);
 - the constraints are cheap and static, the objective is one dynamic solve per operating point
-  with forward-mode gradients (`jaxbearing._design`: faster than checkpointed reverse mode for
+  with forward-mode gradients (`jaxbearing.run.design_metrics`: faster than checkpointed reverse mode for
   three variables), so every iteration costs one vmapped batch of starts x operating points.
 
 The result is the best *feasible* iterate (every untightened margin > 0) over all starts and
@@ -35,13 +35,16 @@ from __future__ import annotations
 
 import dataclasses
 import time
-from typing import Callable
+from collections.abc import Callable
 
 import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
 import optax
+
+from jaxbearing.flange import DesignVariables
+from jaxbearing.run import forward_jacobian
 
 from ._problem import DesignProblem, any_feasible, margins_batch
 
@@ -79,7 +82,6 @@ class SearchResult:
 def start_points(problem: DesignProblem, num_starts: int, first: np.ndarray | None = None) -> np.ndarray:
     """Scaled starts (S, 3): the bearing's own design (clipped to the bounds, or `first`),
     then a deterministic scrambled-free Halton sequence over the box (bases 2, 3, 5)."""
-    from jaxbearing._design import DesignVariables
 
     if first is None:
         first = np.asarray(DesignVariables.of(problem.bearing).as_array())
@@ -127,9 +129,7 @@ def _one_iteration(problem: DesignProblem, hyper: _Hyper, u, opt_state, lam):
         pv = problem.peak_pv(v)
         return problem.combine(pv), pv
 
-    (val, pv), (g_obj, _) = jax.vmap(
-        lambda e: jax.jvp(f, (u,), (e,)), out_axes=((None, None), 0)
-    )(jnp.eye(3))
+    (val, pv), (g_obj, _) = forward_jacobian(f, u)
     c = problem.constraints(u)
     jc = jax.jacfwd(problem.constraints)(u)  # (4, 3)
     ok = jnp.isfinite(val) & jnp.all(jnp.isfinite(g_obj))

@@ -1,4 +1,4 @@
-"""Cage on the outer-ring guiding lands (jaxbearing._cage_lands, MODEL.md 4.3).
+"""Cage on the outer-ring guiding lands (jaxbearing.forces, MODEL.md 4.3).
 
 Oracles: Petroff's concentric torque; Ocvirk's closed-form short-bearing load and attitude
 angle (Hamrock, Schmid & Jacobson, Fundamentals of Fluid Film Lubrication, short-width
@@ -14,7 +14,7 @@ import pytest
 from scipy import integrate
 
 from jaxbearing import reference_bearing
-from jaxbearing._cage_lands import (
+from jaxbearing.forces import (
     FILM_ECCENTRICITY_KNEE,
     FILM_ECCENTRICITY_MAX,
     cage_land_forces,

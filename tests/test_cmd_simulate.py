@@ -5,7 +5,7 @@ import json
 import numpy as np
 import pytest
 
-from jaxbearing._cli import main
+from jaxbearing.cli import main
 
 SUMMARY_STATS = (
     "flange_force_N",

@@ -16,8 +16,8 @@ from hypothesis import strategies as st
 
 import jaxbearing as jb
 from jaxbearing import ConfigError
-from jaxbearing._cli import main as cli_main
-from jaxbearing._validation import KEYS
+from jaxbearing.cli import main as cli_main
+from jaxbearing.io import KEYS
 
 
 def _module_fields(module) -> dict[str, object]:

@@ -1,4 +1,4 @@
-"""Differentiable design metrics (jaxbearing._design): AD through the diffrax solve against
+"""Differentiable design metrics (jaxbearing.run.design_metrics): AD through the diffrax solve against
 central finite differences (the acceptance check of issue 5), the contact-height sensitivities
 against the closed form of MODEL.md 4.1, the static margins against `design_zone`, vmapping over
 designs, and the one-line input errors.
@@ -16,17 +16,16 @@ import numpy as np
 import pytest
 
 import jaxbearing as jb
-from jaxbearing._design import (
+from jaxbearing import UserInputError
+from jaxbearing.flange import DesignVariables, zone_margins
+from jaxbearing.run import (
     GRADIENT_ATOL,
     GRADIENT_HORIZON,
     GRADIENT_RTOL,
-    DesignVariables,
     design_jacobian,
     design_metrics,
     seated_perturbation,
-    zone_margins,
 )
-from jaxbearing._errors import UserInputError
 
 REF = jb.reference_bearing()
 OP = jb.reference_operating_point()

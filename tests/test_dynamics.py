@@ -11,9 +11,8 @@ import numpy as np
 import pytest
 
 import jaxbearing as jb
-from jaxbearing._dynamics import Params, physical_rates
-from jaxbearing._simulate import Perturbation, initial_state, simulate
-from jaxbearing._summary import summarise
+from jaxbearing.dynamics import Params, physical_rates
+from jaxbearing.run import Perturbation, initial_state, simulate, summarise
 
 DURATION = 0.004  # s: 0.6 cage revolutions at the reference point
 SAVES = 800

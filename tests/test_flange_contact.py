@@ -11,15 +11,15 @@ import numpy as np
 import pytest
 
 import jaxbearing as jb
-from jaxbearing._roller_end import LIMITED_CIRCLE_BAND
-from jaxbearing._zone import with_design
 from jaxbearing.contact import effective_modulus
 from jaxbearing.flange import (
     FLANGE_ORDER,
     FlangeContact,
     all_flange_contacts,
     roller_flange_contact,
+    with_design,
 )
+from jaxbearing.geometry import LIMITED_CIRCLE_BAND
 
 X = np.array([1.0, 0.0, 0.0])
 OMEGA_I = jb.rpm_to_rad_s(20_000.0)

@@ -6,11 +6,9 @@ import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
-import pytest
 
 import jaxbearing as jb
-from jaxbearing._inertia import roller_mass_properties
-from jaxbearing._roller_end import arc_protrusion, limited_circle_radius
+from jaxbearing.geometry import arc_protrusion, limited_circle_radius, roller_mass_properties
 
 
 def _roller(**kw):
@@ -79,7 +77,7 @@ def test_reference_bearing_summary():
 
 
 def test_cli_demo_prints_summary(capsys):
-    from jaxbearing._cli import main
+    from jaxbearing.cli import main
 
     assert main(["demo", "--summary-only"]) == 0
     out = capsys.readouterr().out

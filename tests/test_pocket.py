@@ -1,4 +1,4 @@
-"""Roller against its cage pocket (jaxbearing._pocket, MODEL.md 4.3).
+"""Roller against its cage pocket (jaxbearing.forces, MODEL.md 4.3).
 
 Oracles: the ISO/TS 16281 line-contact law written out by hand (N, mm), rigid-body statics
 (action = reaction, moment arms), the direction of Coulomb friction, and the Hunt-Crossley
@@ -13,8 +13,7 @@ import numpy as np
 import pytest
 
 from jaxbearing import reference_bearing
-from jaxbearing._pocket import PocketContact, pocket_contact
-from jaxbearing._raceway import HUNT_CROSSLEY_ALPHA
+from jaxbearing.forces import HUNT_CROSSLEY_ALPHA, PocketContact, pocket_contact
 
 X = np.array([1.0, 0.0, 0.0])
 ZERO = np.zeros(3)

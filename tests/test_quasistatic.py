@@ -19,8 +19,8 @@ from scipy.special import gamma
 
 import jaxbearing as jb
 from jaxbearing import UserInputError
-from jaxbearing._quasistatic import quasi_static
-from jaxbearing._raceway import raceway_contact
+from jaxbearing.dynamics import quasi_static
+from jaxbearing.forces import raceway_contact
 
 N_LINE = 10 / 9
 X = jnp.array([1.0, 0.0, 0.0])

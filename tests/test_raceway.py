@@ -19,7 +19,8 @@ from scipy.optimize import minimize_scalar
 
 import jaxbearing as jb
 from jaxbearing import UserInputError
-from jaxbearing._raceway import (
+from jaxbearing.contact import effective_modulus, line_contact_stiffness
+from jaxbearing.forces import (
     HUNT_CROSSLEY_ALPHA,
     crown_drop,
     raceway_contact,
@@ -27,7 +28,6 @@ from jaxbearing._raceway import (
     raceway_stiffness,
     slice_positions,
 )
-from jaxbearing.contact import effective_modulus, line_contact_stiffness
 
 X = np.array([1.0, 0.0, 0.0])
 Y = np.array([0.0, 1.0, 0.0])

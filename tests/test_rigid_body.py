@@ -1,11 +1,10 @@
 """Torque-free symmetric rigid body (MODEL.md 7): precession rate, energy, angular momentum."""
 
 import diffrax
-import jax
 import jax.numpy as jnp
 import numpy as np
 
-from jaxbearing._rigid_body import angular_momentum, axisymmetric_body_rates, kinetic_energy
+from jaxbearing.dynamics import angular_momentum, axisymmetric_body_rates, kinetic_energy
 
 I_A, I_T = 1.94e-8, 2.46e-8  # the reference roller's inertias [kg m^2]
 

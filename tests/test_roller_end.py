@@ -1,5 +1,5 @@
 """Support function, extreme point and principal curvatures of the roller end body
-(jaxbearing._roller_end) against independent oracles: a numerical maximisation over the
+(jaxbearing.geometry) against independent oracles: a numerical maximisation over the
 end profile (scipy), the closed forms of MODEL.md 4.1, and the principal radii of curvature as
 eigenvalues of the Hessian of the support function (a convex-geometry identity)."""
 
@@ -12,7 +12,7 @@ import pytest
 from scipy.optimize import minimize_scalar
 
 import jaxbearing as jb
-from jaxbearing._roller_end import (
+from jaxbearing.geometry import (
     LIMITED_CIRCLE_BAND,
     arc_protrusion,
     arc_weight,

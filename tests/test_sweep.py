@@ -19,8 +19,8 @@ import time
 import numpy as np
 import pytest
 
-from jaxbearing._cli import main as cli_main
-from jaxbearing._sweep import (
+from jaxbearing.cli import main as cli_main
+from jaxbearing.sweep import (
     SweepSpecError,
     computed_batches,
     load_sweep_spec,
@@ -48,7 +48,7 @@ def subprocess_env(**extra) -> dict:
 
 
 def sweep_command(spec: pathlib.Path, out: pathlib.Path, *args: str) -> list[str]:
-    return [sys.executable, "-m", "jaxbearing._cli", "sweep", str(spec), "--out", str(out),
+    return [sys.executable, "-m", "jaxbearing.cli", "sweep", str(spec), "--out", str(out),
             "--no-progress", *args]
 
 
@@ -232,7 +232,7 @@ def test_kill_and_resume(tmp_path, reference):
     assert log[: len(done_before)] == done_before
     assert sorted(log[len(done_before):]) == sorted({0, 1} - set(done_before))
     assert first.stat().st_mtime_ns == stat.st_mtime_ns and first.read_bytes() == content
-    from jaxbearing._sweep import open_results
+    from jaxbearing.sweep import open_results
 
     assert_same_results(open_results(out), reference[1])
     assert json.loads((out / "spec.json").read_text())["hash"] == reference[1].attrs["spec_hash"]
@@ -249,7 +249,7 @@ def test_resume_refuses_another_sweep(reference):
 def test_plot_draws_every_figure_from_assembled_batches(tmp_path, capsys):
     """Dataset assembly and `jaxbearing plot` on fabricated batch files (no solving): every
     figure is drawn when the axes are there, and the design zone of each case is filled in."""
-    from jaxbearing._sweep import write_batch
+    from jaxbearing.sweep import write_batch
 
     spec = load_sweep_spec(SWEEPS / "figures.toml")
     rng = np.random.default_rng(0)
@@ -269,7 +269,7 @@ def test_plot_draws_every_figure_from_assembled_batches(tmp_path, capsys):
     out = capsys.readouterr().out
     assert out.count("drew Figure") == 8 and "could not" not in out
     assert len(list((tmp_path / "figures").glob("figure*.png"))) == 8
-    from jaxbearing._sweep import open_results
+    from jaxbearing.sweep import open_results
 
     ds = open_results(tmp_path)
     assert ds["flange_pv_Pa_m_s_max"].dims == spec.dims

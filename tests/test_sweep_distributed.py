@@ -16,9 +16,9 @@ import subprocess
 
 import numpy as np
 import pytest
-
-from jaxbearing._sweep import computed_batches, load_sweep_spec, open_results, run_sweep, variable_names
 from test_sweep import SMALL, assert_same_results, subprocess_env, sweep_command
+
+from jaxbearing.sweep import computed_batches, load_sweep_spec, open_results, run_sweep, variable_names
 
 
 @pytest.fixture(scope="module")

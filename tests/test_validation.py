@@ -24,13 +24,13 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 import tomli_w
-from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 import jaxbearing as jb
 from jaxbearing import ConfigError
-from jaxbearing._cli import main as cli_main
-from jaxbearing._validation import KEYS
+from jaxbearing.cli import main as cli_main
+from jaxbearing.io import KEYS
 
 BAD_DIR = pathlib.Path(__file__).parent / "bad_configs"
 BAD_FILES = sorted(BAD_DIR.glob("*.toml"))

@@ -10,10 +10,9 @@ import numpy as np
 import pytest
 
 import jaxbearing as jb
-from jaxbearing._cli import main
-from jaxbearing._cmd_zone import zone_maps
-from jaxbearing._errors import UserInputError
-from jaxbearing._zone import design_zone, design_zone_grid, with_design
+from jaxbearing import UserInputError
+from jaxbearing.cli import main, zone_maps
+from jaxbearing.flange import design_zone, design_zone_grid, with_design
 
 REF = jb.reference_bearing()
 D, R_COR = 7.5e-3, 0.4e-3
@@ -179,7 +178,7 @@ def test_cli_zone_prints_margins_and_writes_maps(tmp_path, capsys):
 
 
 def test_cli_zone_reports_violations():
-    lines = __import__("jaxbearing._cmd_zone", fromlist=["zone_lines"]).zone_lines
+    lines = __import__("jaxbearing.cli", fromlist=["zone_lines"]).zone_lines
     b = with_design(REF, end_radius=40e-3, layback_angle=math.radians(1.0))
     text = "\n".join(lines(b, design_zone(b), 100.0))
     assert "VIOLATED" in text and "NOT FEASIBLE" in text

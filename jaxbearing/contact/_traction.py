@@ -16,10 +16,13 @@ The force opposes the sliding velocity u with the regularised direction of
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import jax.numpy as jnp
 from jaxtyping import Array, ArrayLike, Float
 
-from .._params import Lubricant
+if TYPE_CHECKING:  # annotations only: contact laws sit below the parameter layer
+    from ..geometry import Lubricant
 from ._smooth import SLIDING_EPS
 
 

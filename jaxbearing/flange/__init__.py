@@ -1,10 +1,41 @@
-"""Roller end against ring flange (MODEL.md 4.1): contact geometry, kinematics, Hertz force, PV.
+"""The roller-end/flange model (MODEL.md 4.1; the source paper's subject), in one place.
 
-- `roller_flange_contact`: one roller against one flange (vmap it yourself);
-- `all_flange_contacts`: every roller against the four flanges, shape (Z, 4);
-- `FlangeContact`: the result pytree.
+- flange face and end pose: `flange_geometry` (tangent plane of the flange cone at the roller's
+  azimuth, extreme point of the end body, interference, contact height, principal radii);
+- the contact: `roller_flange_contact` (one roller, one flange), `all_flange_contacts` (every
+  roller against the four flanges, shape (Z, 4)), `FlangeContact`;
+- the static design zone of an aligned roller: `design_zone`, `design_zone_grid`, `DesignZone`,
+  `zone_margins`, `MARGIN_NAMES`;
+- the design variables R_end, theta_f, Delta_bf: `DesignVariables`, `with_design`, and the one
+  range check every design entry point uses, `check_design`.
+
+The shape of the roller end itself (support function, limited circle) is in
+`jaxbearing.geometry`, because the roller's mass properties need it.
+
+May import: `jaxbearing._errors`, `contact`, `geometry`, `io`.
 """
 
+from ._checks import DEFAULT_FLANGE_LOAD, check_design
 from ._contact import FLANGE_ORDER, FlangeContact, all_flange_contacts, roller_flange_contact
+from ._design import DesignVariables, with_design
+from ._geometry import FlangeGeometry, flange_effective_modulus, flange_geometry
+from ._zone import MARGIN_NAMES, DesignZone, design_zone, design_zone_grid, zone_margins
 
-__all__ = ["FLANGE_ORDER", "FlangeContact", "all_flange_contacts", "roller_flange_contact"]
+__all__ = [
+    "DEFAULT_FLANGE_LOAD",
+    "FLANGE_ORDER",
+    "MARGIN_NAMES",
+    "DesignVariables",
+    "DesignZone",
+    "FlangeContact",
+    "FlangeGeometry",
+    "all_flange_contacts",
+    "check_design",
+    "design_zone",
+    "design_zone_grid",
+    "flange_effective_modulus",
+    "flange_geometry",
+    "roller_flange_contact",
+    "with_design",
+    "zone_margins",
+]

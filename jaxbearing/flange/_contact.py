@@ -45,15 +45,11 @@ from __future__ import annotations
 import equinox as eqx
 import jax
 import jax.numpy as jnp
-import numpy as np
 from jaxtyping import Array, ArrayLike, Float
 
-from .._params import Bearing
-from .._roller_end import end_principal_curvatures, end_support
 from ..contact import (
     PENETRATION_WIDTH,
     SLIDING_EPS,
-    effective_modulus,
     hertz_force,
     point_contact_ellipse,
     point_contact_peak_pressure,
@@ -61,12 +57,11 @@ from ..contact import (
     safe_norm,
     smooth_direction,
 )
+from ..geometry import Bearing
+from ._geometry import flange_effective_modulus, flange_geometry
 
 Scalar = Float[Array, ""]
 Vec3 = Float[Array, "3"]
-
-_AXIS = np.array([1.0, 0.0, 0.0])
-
 
 class FlangeContact(eqx.Module):
     """Result of one roller-end/flange contact (leading batch axes when vmapped).
@@ -94,79 +89,6 @@ class FlangeContact(eqx.Module):
     force_on_ring: Float[Array, "*batch 3"]  # -F
     moment_on_ring: Float[Array, "*batch 3"]  # (C - c_r) x (-F)
     ellipse_semi_axes: Float[Array, "*batch 2"]  # (along t / the end meridian, along the parallel)
-
-
-class _Geometry(eqx.Module):
-    """Pose-only part of the contact (no velocities, no load)."""
-
-    normal: Vec3  # n, into the flange
-    interference: Scalar
-    contact_point: Vec3
-    contact_height: Scalar
-    end_face_position: Float[Array, "2"]
-    contact_radius: Scalar
-    on_arc: Scalar
-    radius_meridian: Scalar  # principal radius of the end across the corner / along t
-    radius_parallel: Scalar  # principal radius along the parallel circle
-
-
-def _unit(x: Array) -> Array:
-    """x / |x| with a safe norm (zero vector -> zero vector, finite gradient)."""
-    n = safe_norm(x, axis=-1, keepdims=True)
-    return x / jnp.where(n > 0, n, 1.0)
-
-
-def _flange_geometry(
-    bearing: Bearing,
-    raceway_radius: ArrayLike,
-    side: ArrayLike,
-    ring_sign: ArrayLike,
-    roller_centre: Vec3,
-    roller_axis: Vec3,
-    ring_centre: Vec3,
-) -> _Geometry:
-    """Flange tangent plane, interference, contact point and principal radii (pose only);
-    shared by `roller_flange_contact` and `jaxbearing.design_zone`."""
-    roller = bearing.roller
-    theta = bearing.flange.layback_angle
-    p = jnp.asarray(roller_centre)
-    c_r = jnp.asarray(ring_centre)
-    # radial direction of the roller's azimuth (Y, Z components only)
-    e_rad = _unit((p - c_r) * jnp.array([0.0, 1.0, 1.0]))
-    # flange tangent plane
-    p0 = c_r + side * (bearing.raceway_width / 2) * _AXIS + raceway_radius * e_rad
-    n = side * jnp.cos(theta) * _AXIS - ring_sign * jnp.sin(theta) * e_rad
-    # end frame: outward axis x = s e, radial direction r of the contact
-    x_end = side * _unit(jnp.asarray(roller_axis))
-    cos_a = jnp.dot(n, x_end)
-    n_perp = n - cos_a * x_end
-    sin_a = safe_norm(n_perp)
-    r_hat = _unit(n_perp)
-    h, a, rho = end_support(roller, cos_a, sin_a)
-    delta = h - jnp.dot(p0 - p, n)
-    offset = a * x_end + rho * r_hat  # C - p
-    c = p + offset
-    # roller-local end-face frame (x = s e, z = e_rad perpendicular to e, y = z cross x)
-    z_loc = _unit(e_rad - jnp.dot(e_rad, x_end) * x_end)
-    y_loc = jnp.cross(z_loc, x_end)
-    yz = jnp.stack([jnp.dot(offset, y_loc), jnp.dot(offset, z_loc)])
-    k_m, k_p, w = end_principal_curvatures(roller, sin_a)
-    return _Geometry(
-        normal=n,
-        interference=delta,
-        contact_point=c,
-        contact_height=ring_sign * (jnp.dot(c - c_r, e_rad) - raceway_radius),
-        end_face_position=yz,
-        contact_radius=rho,
-        on_arc=w,
-        radius_meridian=1.0 / k_m,
-        radius_parallel=1.0 / k_p,
-    )
-
-
-def _e_prime(bearing: Bearing) -> Array:
-    r, g = bearing.roller_material, bearing.ring_material
-    return effective_modulus(r.elastic_modulus, r.poisson_ratio, g.elastic_modulus, g.poisson_ratio)
 
 
 def roller_flange_contact(
@@ -203,14 +125,14 @@ def roller_flange_contact(
     `ring_sign` g = +1 inner ring, -1 outer ring; roller centre p, unit axis e (about +X),
     velocity v and angular velocity w; ring centre c_r, velocity v_r, angular velocity w_r.
     """
-    g = _flange_geometry(
+    g = flange_geometry(
         bearing, raceway_radius, side, ring_sign, roller_centre, roller_axis, ring_centre
     )
     n = g.normal
     c = g.contact_point
     p = jnp.asarray(roller_centre)
     c_r = jnp.asarray(ring_centre)
-    e_prime = _e_prime(bearing)
+    e_prime = flange_effective_modulus(bearing)
 
     stiffness = point_contact_stiffness(g.radius_meridian, g.radius_parallel, e_prime)
     q = hertz_force(g.interference, stiffness, PENETRATION_WIDTH)

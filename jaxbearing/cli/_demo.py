@@ -1,0 +1,82 @@
+"""`jaxbearing demo`: summary of the embedded reference bearing."""
+
+from __future__ import annotations
+
+
+def register(sub) -> None:
+    p = sub.add_parser(
+        "demo",
+        help="summarise the reference bearing and simulate it with arc and corner roller ends",
+        description="Print the embedded reference bearing, then simulate it at 20,000 rpm and 1000 N "
+        "with arc-end and corner-end rollers and compare the flange contacts with the source study.",
+    )
+    p.add_argument("--duration-ms", type=float, default=20.0, help="simulated time per end type [ms]")
+    p.add_argument("--out", default="out/demo", help="output directory (default: out/demo)")
+    p.add_argument("--summary-only", action="store_true", help="only print the bearing summary")
+    p.set_defaults(func=run)
+
+
+#: the source study's stated values (Machines 2025, 13(11), 993, section 3; MODEL.md 8)
+PAPER = (
+    ("peak pressure, max", "flange_pressure_Pa", "max", 1e-9, "GPa", "about 4.8", "below 0.2"),
+    ("sliding velocity, mean", "flange_sliding_velocity_m_s", "mean", 1.0, "m/s", "20", "13.5"),
+    ("PV, max", "flange_pv_Pa_m_s", "max", 1e-9, "GPa m/s", "-", "below 3"),
+    ("contact force, max", "flange_force_N", "max", 1.0, "N", "slightly below arc", "-"),
+)
+
+
+def paper_table(summaries: dict) -> str:
+    lines = [f"{'quantity':<24}{'unit':>9}{'corner':>10}{'paper':>20}{'arc':>10}{'paper':>12}"]
+    for label, key, stat, k, unit, p_corner, p_arc in PAPER:
+        vals = []
+        for end in ("corner", "arc"):
+            v = summaries.get(end, {}).get(key, {}).get(stat)
+            vals.append("-" if v is None else format(v * k, ".3g"))
+        lines.append(f"{label:<24}{unit:>9}{vals[0]:>10}{p_corner:>20}{vals[1]:>10}{p_arc:>12}")
+    return "\n".join(lines)
+
+
+def summary_lines(bearing, op) -> list[str]:
+    from ..geometry import kinematic_cage_speed, rad_s_to_rpm
+
+    r = bearing.roller
+    i_ax, i_tr = (float(v) for v in bearing.roller_inertia)
+    c_p, c_t = (float(v) for v in bearing.cage_inertia)
+    return [
+        "Reference bearing (representative aero-engine mainshaft bearing, not the paper's Table 1)",
+        f"  pitch diameter            {float(bearing.pitch_diameter) * 1e3:9.3f} mm",
+        f"  rollers                   {bearing.num_rollers} x D {float(r.diameter) * 1e3:.3f} mm"
+        f" x L {float(r.length) * 1e3:.3f} mm, R_end {float(r.end_radius) * 1e3:.1f} mm",
+        f"  roller mass               {float(bearing.roller_mass) * 1e3:9.4f} g",
+        f"  roller inertia axial      {i_ax:9.4e} kg m^2",
+        f"  roller inertia transverse {i_tr:9.4e} kg m^2",
+        f"  cage mass                 {float(bearing.cage_mass) * 1e3:9.3f} g",
+        f"  cage inertia polar        {c_p:9.4e} kg m^2",
+        f"  cage inertia transverse   {c_t:9.4e} kg m^2",
+        f"  inner ring speed          {float(rad_s_to_rpm(op.inner_speed)):9.1f} rpm",
+        f"  radial load               {float(op.radial_load):9.1f} N",
+        f"  kinematic cage speed      {float(rad_s_to_rpm(kinematic_cage_speed(bearing, op))):9.1f} rpm",
+    ]
+
+
+def run(args) -> int:
+    import pathlib
+
+    from ..io import reference_config
+    from ._simulate import format_table, run_cases, write_outputs
+
+    cfg = reference_config().replace(**{"simulation.duration_ms": args.duration_ms, "simulation.end": "both"})
+    print("\n".join(summary_lines(cfg.bearing(), cfg.operating_point())))
+    if args.summary_only:
+        return 0
+    print()
+    results = run_cases(cfg, progress=True)
+    summaries = {e: s for e, (_, s) in results.items()}
+    print()
+    print(format_table(summaries))
+    print()
+    print("Against the source study (its bearing differs; compare trends and magnitudes, see README):")
+    print(paper_table(summaries))
+    write_outputs(pathlib.Path(args.out), results)
+    print(f"\nsummary.json, histories and plots written to {args.out}/")
+    return 0 if all(s["status"] == "ok" for s in summaries.values()) else 1

@@ -1,0 +1,221 @@
+"""`jaxbearing zone`: roller-end/flange design zone (the paper's Figure 14).
+
+Prints the contact geometry of an aligned roller and each design margin with OK/VIOLATED; with
+`--map` writes
+
+- DIR/zone_height_map.png: contact height over end radius R_end (40..140 mm) x layback angle
+  theta_f (0.5..3 deg), with the upper contact-height limit, the relief (lower) limit and the
+  limited-circle line, the feasible region hatched and the current design marked;
+- DIR/zone_clearance_map.png: actual axial clearance Lambda_bf over R_end x axial clearance
+  Delta_bf (0..0.3 mm) at the current theta_f, with the Lambda_bf = 0 line.
+
+Each map is one jit-compiled vmap over its grid (`jaxbearing._zone.design_zone_grid`).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+
+from .._errors import UserInputError
+
+MM = 1e-3
+#: map grids (engineering units) and resolution
+END_RADIUS_RANGE_MM = (40.0, 140.0)
+LAYBACK_RANGE_DEG = (0.5, 3.0)
+CLEARANCE_RANGE_MM = (0.0, 0.3)
+GRID_POINTS = 121
+
+
+def register(sub) -> None:
+    p = sub.add_parser(
+        "zone",
+        help="roller-end/flange design zone: contact height, clearance, margins (Figure 14)",
+    )
+    p.add_argument("--config", help="TOML configuration (default: embedded reference bearing)")
+    p.add_argument(
+        "--flange-load-N",
+        type=float,
+        dest="flange_load_N",
+        default=None,
+        help="flange normal load for the contact-ellipse half-width [N] (default 100)",
+    )
+    p.add_argument("--map", action="store_true", help="write the two design-zone maps (PNG)")
+    p.add_argument("--out", default=".", help="output directory for --map (default: .)")
+    p.set_defaults(func=run)
+
+
+def _bearing(config):
+    """The bearing of `--config` (the embedded reference bearing without it)."""
+    from ..io import load_config
+
+    return load_config(config).bearing()
+
+
+def _mm(x) -> str:
+    return f"{float(x) / MM:10.4f} mm"
+
+
+def zone_lines(bearing, zone, flange_load: float) -> list[str]:
+    """The report printed by `jaxbearing zone` (lengths in mm)."""
+    r, f = bearing.roller, bearing.flange
+
+    def margin(name, value):
+        ok = "OK" if float(value) > 0 else "VIOLATED"
+        return f"    {name:<42}{_mm(value)}  {ok}"
+
+    theta = float(f.layback_angle)
+    end = f"{'flat (corner only)':>13}" if math.isinf(float(r.end_radius)) else _mm(r.end_radius)
+    return [
+        "Roller-end/flange design zone (aligned roller, pure rolling)",
+        f"  end radius R_end                          {end}",
+        f"  layback angle theta_f                     {math.degrees(theta):10.4f} deg",
+        f"  axial clearance Delta_bf                  {_mm(f.axial_clearance)}",
+        f"  flange load (contact ellipse)             {flange_load:10.1f} N",
+        f"  contact radius rho_c                      {_mm(zone.contact_radius)}"
+        + ("  (on the arc)" if float(zone.on_arc) > 0.5 else "  (on the corner)"),
+        f"  corner contact radius (flat ends)         {_mm(zone.corner_contact_radius)}",
+        f"  limited circle radius rho_lim             {_mm(zone.limited_circle_radius)}",
+        f"  contact height h_c                        {_mm(zone.contact_height)}",
+        f"  contact ellipse half-width (height)       {_mm(zone.ellipse_half_width)}",
+        f"  arc protrusion e                          {_mm(zone.arc_protrusion)}",
+        f"  actual axial clearance Lambda_bf          {_mm(zone.actual_axial_clearance)}",
+        f"  seated gap (aligned roller, both ends)    {_mm(zone.seated_gap)}",
+        "  margins (positive = feasible):",
+        margin("relief: h_c - half-width - h_rel", zone.relief_margin),
+        margin("height: h_up - h_c", zone.height_margin),
+        margin("limited circle: rho_lim - rho_c", zone.limited_circle_margin),
+        margin("clearance: Lambda_bf - minimum", zone.clearance_margin),
+        f"  design: {'FEASIBLE' if bool(zone.feasible) else 'NOT FEASIBLE'}",
+    ]
+
+
+def zone_maps(bearing, flange_load: float, points: int = GRID_POINTS):
+    """The two map grids: (r_mm, theta_deg, height_zone), (r_mm, clearance_mm, clearance_zone)."""
+    import numpy as np
+
+    from ..flange import design_zone_grid
+
+    r_mm = np.linspace(*END_RADIUS_RANGE_MM, points)
+    t_deg = np.linspace(*LAYBACK_RANGE_DEG, points)
+    c_mm = np.linspace(*CLEARANCE_RANGE_MM, points)
+    rr, tt = np.meshgrid(r_mm, t_deg)
+    height = design_zone_grid(
+        bearing, rr * MM, np.radians(tt), bearing.flange.axial_clearance, flange_load
+    )
+    rr2, cc = np.meshgrid(r_mm, c_mm)
+    clear = design_zone_grid(
+        bearing, rr2 * MM, bearing.flange.layback_angle, cc * MM, flange_load
+    )
+    return (r_mm, t_deg, height), (r_mm, c_mm, clear)
+
+
+def _height_feasible(z):
+    import numpy as np
+
+    return (
+        (np.asarray(z.relief_margin) > 0)
+        & (np.asarray(z.height_margin) > 0)
+        & (np.asarray(z.limited_circle_margin) > 0)
+    )
+
+
+def write_maps(bearing, flange_load: float, out_dir: str) -> list[str]:
+    import numpy as np
+
+    from ..io import pyplot
+
+    plt = pyplot()
+    from matplotlib.colors import TwoSlopeNorm
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+
+    os.makedirs(out_dir, exist_ok=True)
+    (r_mm, t_deg, hz), (_, c_mm, cz) = zone_maps(bearing, flange_load)
+    r_now = float(bearing.roller.end_radius) / MM
+    t_now = math.degrees(float(bearing.flange.layback_angle))
+    c_now = float(bearing.flange.axial_clearance) / MM
+    paths = []
+
+    # -- contact height over R_end x theta_f -----------------------------------------------
+    fig, ax = plt.subplots(figsize=(7.5, 5.5), dpi=110)
+    cf = ax.contourf(r_mm, t_deg, np.asarray(hz.contact_height) / MM, levels=24, cmap="viridis")
+    fig.colorbar(cf, ax=ax, label="contact height h_c [mm]")
+    # the limited-circle line is drawn from the arc contact radius R_end sin(theta_f), which
+    # is smooth across it (the actual contact radius has a kink there); the relief line is
+    # drawn only where the contact is on the arc (on the corner the ellipse is much narrower)
+    rr, tt = np.meshgrid(r_mm * MM, np.radians(t_deg))
+    arc_radius_margin = np.asarray(hz.limited_circle_radius) - rr * np.sin(tt)
+    on_arc = np.asarray(hz.on_arc) > 0.5
+    lines = [
+        (hz.height_margin, "tab:red", "upper limit h_c = h_up"),
+        (np.where(on_arc, hz.relief_margin, np.nan), "tab:orange",
+         "relief (lower) limit h_c - a = h_rel"),
+        (arc_radius_margin, "white", "limited circle rho_c = rho_lim"),
+    ]
+    handles = []
+    for field, colour, label in lines:
+        ax.contour(r_mm, t_deg, np.asarray(field), levels=[0.0], colors=colour, linewidths=2)
+        handles.append(Line2D([], [], color=colour, lw=2, label=label))
+    feas = _height_feasible(hz).astype(float)
+    if feas.any():
+        ax.contourf(r_mm, t_deg, feas, levels=[0.5, 1.5], colors="none", hatches=["//"])
+    handles.append(Patch(facecolor="none", edgecolor="k", hatch="//", label="feasible"))
+    if END_RADIUS_RANGE_MM[0] <= r_now <= END_RADIUS_RANGE_MM[1]:
+        ax.plot([r_now], [t_now], marker="*", ms=16, color="magenta", mec="k", ls="none")
+    handles.append(Line2D([], [], marker="*", ms=12, color="magenta", mec="k", ls="none",
+                          label="current design"))
+    ax.set_xlabel("end radius R_end [mm]")
+    ax.set_ylabel("flange layback angle theta_f [deg]")
+    ax.set_title(
+        f"Contact height (Delta_bf = {c_now:.3f} mm, flange load {flange_load:.0f} N)"
+    )
+    ax.legend(handles=handles, loc="upper right", fontsize=8, framealpha=0.85)
+    path = os.path.join(out_dir, "zone_height_map.png")
+    fig.savefig(path)
+    plt.close(fig)
+    paths.append(path)
+
+    # -- actual axial clearance over R_end x Delta_bf ---------------------------------------
+    fig, ax = plt.subplots(figsize=(7.5, 5.5), dpi=110)
+    lam = np.asarray(cz.actual_axial_clearance) / MM
+    span = max(float(np.max(np.abs(lam))), 1e-6)
+    cf = ax.contourf(
+        r_mm, c_mm, lam, levels=np.linspace(-span, span, 25), cmap="coolwarm_r",
+        norm=TwoSlopeNorm(0.0, -span, span),
+    )
+    fig.colorbar(cf, ax=ax, label="actual axial clearance Lambda_bf [mm]")
+    ax.contour(r_mm, c_mm, lam, levels=[0.0], colors="k", linewidths=2)
+    handles = [Line2D([], [], color="k", lw=2, label="Lambda_bf = 0 (contact line)")]
+    ok = (np.asarray(cz.clearance_margin) > 0).astype(float)
+    if ok.any():
+        ax.contourf(r_mm, c_mm, ok, levels=[0.5, 1.5], colors="none", hatches=["//"])
+    handles.append(Patch(facecolor="none", edgecolor="k", hatch="//", label="feasible"))
+    if END_RADIUS_RANGE_MM[0] <= r_now <= END_RADIUS_RANGE_MM[1]:
+        ax.plot([r_now], [c_now], marker="*", ms=16, color="magenta", mec="k", ls="none")
+    handles.append(Line2D([], [], marker="*", ms=12, color="magenta", mec="k", ls="none",
+                          label="current design"))
+    ax.set_xlabel("end radius R_end [mm]")
+    ax.set_ylabel("axial clearance Delta_bf [mm]")
+    ax.set_title(f"Actual axial clearance (theta_f = {t_now:.2f} deg)")
+    ax.legend(handles=handles, loc="lower right", fontsize=8, framealpha=0.85)
+    path = os.path.join(out_dir, "zone_clearance_map.png")
+    fig.savefig(path)
+    plt.close(fig)
+    paths.append(path)
+    return paths
+
+
+def run(args) -> int:
+    from ..flange import DEFAULT_FLANGE_LOAD, design_zone
+
+    load = DEFAULT_FLANGE_LOAD if args.flange_load_N is None else args.flange_load_N
+    if not (load > 0 and math.isfinite(load)):
+        raise UserInputError(f"--flange-load-N = {load}: must be a finite load > 0 N")
+    bearing = _bearing(args.config)
+    zone = design_zone(bearing, load)
+    print("\n".join(zone_lines(bearing, zone, load)))
+    if args.map:
+        for path in write_maps(bearing, load, args.out):
+            print(f"wrote {path}")
+    return 0

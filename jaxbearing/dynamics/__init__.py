@@ -1,0 +1,50 @@
+"""Whole-bearing dynamics: state layout, rigid-body rates, the vector field, the quasi-static start.
+
+- state (MODEL.md 3): `State` of `RollerState` (Z rollers), `CageState`, `RingState` and the
+  integrated `Accumulators`; `state_scales` / `Scaling` for the scaled integration state;
+- rigid bodies: `axisymmetric_body_rates` (Euler's equations with gyroscopic terms, no small
+  angles), `angular_momentum`, `kinetic_energy`;
+- the vector field: `physical_rates(t, state, params)` over every roller, the cage and the inner
+  ring, with `contact_loads` (every contact of one state) and the smooth `Functionals`;
+- the start (MODEL.md 5): `quasi_static` (load distribution with centrifugal force).
+
+May import: `jaxbearing._errors`, `contact`, `geometry`, `io`, `flange`, `forces`.
+"""
+
+from ._field import FLANGE_NAMES, Functionals, Loads, Params, contact_loads, physical_rates
+from ._quasistatic import QuasiStatic, quasi_static
+from ._rigid_body import angular_momentum, axisymmetric_body_rates, kinetic_energy
+from ._state import (
+    Accumulators,
+    CageState,
+    RingState,
+    RollerState,
+    Scaling,
+    State,
+    radial_unit,
+    state_scales,
+    tangential_unit,
+)
+
+__all__ = [
+    "FLANGE_NAMES",
+    "Accumulators",
+    "CageState",
+    "Functionals",
+    "Loads",
+    "Params",
+    "QuasiStatic",
+    "RingState",
+    "RollerState",
+    "Scaling",
+    "State",
+    "angular_momentum",
+    "axisymmetric_body_rates",
+    "contact_loads",
+    "kinetic_energy",
+    "physical_rates",
+    "quasi_static",
+    "radial_unit",
+    "state_scales",
+    "tangential_unit",
+]

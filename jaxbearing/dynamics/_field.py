@@ -1,0 +1,212 @@
+"""The vector field of the whole bearing: `vector_field(t, state, params) -> d(state)/dt`.
+
+Bodies (MODEL.md 3): every roller (3-D translation, axis direction, angular velocity), the cage
+(radial translation, rotation) and the inner ring (radial translation; spin prescribed at
+omega_i, motor driven). The outer ring is fixed.
+
+Forces on each roller (vectorised over rollers with `jax.vmap`, no Python loop):
+  inner and outer raceway slices (`_raceway`), four roller-end/flange contacts (`flange`),
+  the cage pocket (`_pocket`), oil-air drag (`_drag`) and gravity.
+On the cage: all pockets, the outer-ring guiding lands (`_cage_lands`), churning, gravity.
+On the inner ring: all inner raceway and flange reactions, the radial load F_r (+Z), gravity.
+
+Equations of motion
+-------------------
+Roller centre in cylindrical coordinates (paper Eq. 33, exact, no small angles):
+
+    m x''     = F.X
+    m r''     = F.e_rad + m r theta'^2
+    m r theta'' = F.e_tan - 2 m r' theta'
+
+Roller attitude: axis e' = omega x e and Euler's equations with their gyroscopic terms (which
+the paper's Eq. 33 omits), in `_rigid_body.axisymmetric_body_rates`.
+Cage: m_c c'' = F_c (radial), I_p omega_c' = M_c.X. Inner ring: m_i c_i'' = F_i (radial).
+"""
+
+from __future__ import annotations
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from ..flange import FLANGE_ORDER, all_flange_contacts
+from ..forces import (
+    PocketContact,
+    RacewayContact,
+    cage_drag_torque,
+    cage_land_forces,
+    pocket_contact,
+    raceway_contact,
+    roller_drag,
+)
+from ..geometry import Bearing, OperatingPoint
+from ._rigid_body import axisymmetric_body_rates
+from ._state import (
+    Accumulators,
+    CageState,
+    RingState,
+    RollerState,
+    State,
+    radial_unit,
+    tangential_unit,
+)
+
+X = np.array([1.0, 0.0, 0.0])  # numpy: importing must not start the JAX backend
+
+#: names of the four flanges along the last axis of every per-flange array (`FLANGE_ORDER`)
+FLANGE_NAMES = ("inner_left", "inner_right", "outer_left", "outer_right")
+
+
+class Functionals(eqx.Module):
+    """Parameters of the smooth peak functionals integrated inside the solve (MODEL.md 6)."""
+
+    pv_reference: float = 1e9  # PV_ref [Pa m/s]
+    pv_exponent: float = 8.0  # p of the p-norm over time
+    height_reference: float = 2.0e-3  # h_ref [m]
+    height_sharpness: float = 1.0 / 20e-6  # beta [1/m]
+    contact_load: float = 0.1  # Q_0 of the contact indicator w(Q) = Q / (Q + Q_0) [N]
+
+
+class Params(eqx.Module):
+    """Everything the vector field needs besides the state (all differentiable floats)."""
+
+    bearing: Bearing
+    operating: OperatingPoint
+    functionals: Functionals = Functionals()
+
+
+class Loads(eqx.Module):
+    """Every contact of one evaluation (for outputs as well as for the vector field)."""
+
+    inner: RacewayContact
+    outer: RacewayContact
+    flange: object  # flange.FlangeContact with leading shape (Z, 4)
+    pocket: PocketContact
+
+
+def contact_loads(state: State, params: Params) -> Loads:
+    """All contacts at a physical (unscaled) state."""
+    b, op = params.bearing, params.operating
+    r = state.rollers
+    e = r.axis / jnp.linalg.norm(r.axis, axis=-1, keepdims=True)
+    p, v, w = r.centre, r.velocity, r.angular_velocity
+
+    inner_c = jnp.concatenate([jnp.zeros(1), state.inner_ring.centre])
+    inner_v = jnp.concatenate([jnp.zeros(1), state.inner_ring.velocity])
+    inner_w = op.inner_speed * X
+    zero = jnp.zeros(3)
+
+    raceway = jax.vmap(
+        raceway_contact, in_axes=(None, None, None, 0, 0, 0, 0, None, None, None)
+    )
+    inner = raceway(b, 1.0, b.inner_raceway_radius, p, e, v, w, inner_c, inner_v, inner_w)
+    outer = raceway(b, -1.0, b.outer_raceway_radius, p, e, v, w, zero, zero, zero)
+    flange = all_flange_contacts(b, p, e, v, w, inner_c, inner_v, inner_w, zero, zero, zero)
+
+    cage = state.cage
+    cage_c = jnp.concatenate([jnp.zeros(1), cage.centre])
+    cage_v = jnp.concatenate([jnp.zeros(1), cage.velocity])
+    pocket_angle = cage.angle + 2 * jnp.pi * jnp.arange(b.num_rollers) / b.num_rollers
+    pocket_c = cage_c + (b.pitch_diameter / 2) * radial_unit(pocket_angle)
+    pocket_t = tangential_unit(pocket_angle)
+    pocket = jax.vmap(
+        pocket_contact, in_axes=(None, 0, 0, 0, 0, 0, 0, None, None, None)
+    )(b, p, e, v, w, pocket_c, pocket_t, cage_v, cage.speed * X, cage_c)
+    return Loads(inner=inner, outer=outer, flange=flange, pocket=pocket)
+
+
+def physical_rates(t, state: State, params: Params) -> State:
+    """d(state)/dt in physical units."""
+    del t
+    b, op, fn = params.bearing, params.operating, params.functionals
+    r = state.rollers
+    loads = contact_loads(state, params)
+    fl = loads.flange
+
+    m_b = b.roller_mass
+    i_a, i_t = b.roller_inertia[0], b.roller_inertia[1]
+    g = op.gravity * jnp.array([0.0, 0.0, 1.0])
+    e = r.axis / jnp.linalg.norm(r.axis, axis=-1, keepdims=True)
+    w = r.angular_velocity
+
+    # -- rollers -----------------------------------------------------------------------
+    orbital_v = r.velocity
+    spin = jnp.sum(w * e, axis=-1)
+    drag_f, drag_m = jax.vmap(roller_drag, in_axes=(None, 0, 0))(b, orbital_v, spin)
+    force = (
+        loads.inner.force_on_roller
+        + loads.outer.force_on_roller
+        + jnp.sum(fl.force_on_roller, axis=1)
+        + loads.pocket.force_on_roller
+        + drag_f
+        + m_b * g
+    )
+    moment = (
+        loads.inner.moment_on_roller
+        + loads.outer.moment_on_roller
+        + jnp.sum(fl.moment_on_roller, axis=1)
+        + loads.pocket.moment_on_roller
+        + drag_m[:, None] * e
+    )
+    e_rad, e_tan = radial_unit(r.azimuth), tangential_unit(r.azimuth)
+    f_x = force[:, 0]
+    f_r = jnp.sum(force * e_rad, axis=-1)
+    f_t = jnp.sum(force * e_tan, axis=-1)
+    axial_acc = f_x / m_b
+    radial_acc = f_r / m_b + r.radial * r.azimuth_rate**2
+    azimuth_acc = (f_t / m_b - 2 * r.radial_velocity * r.azimuth_rate) / r.radial
+
+    axis_rate, omega_dot = axisymmetric_body_rates(r.axis, w, moment, i_a, i_t)
+
+    rollers = RollerState(
+        axial=r.axial_velocity,
+        radial=r.radial_velocity,
+        azimuth=r.azimuth_rate,
+        axis=axis_rate,
+        axial_velocity=axial_acc,
+        radial_velocity=radial_acc,
+        azimuth_rate=azimuth_acc,
+        angular_velocity=omega_dot,
+    )
+
+    # -- cage --------------------------------------------------------------------------
+    cage = state.cage
+    cage_c = jnp.concatenate([jnp.zeros(1), cage.centre])
+    cage_v = jnp.concatenate([jnp.zeros(1), cage.velocity])
+    land_f, land_m = cage_land_forces(b, cage_c, cage_v, cage.speed)
+    cage_force = jnp.sum(loads.pocket.force_on_cage, axis=0) + land_f + b.cage_mass * g
+    cage_torque = (
+        jnp.sum(loads.pocket.moment_on_cage[:, 0]) + land_m + cage_drag_torque(b, cage.speed)
+    )
+    cage_rates = CageState(
+        centre=cage.velocity,
+        angle=cage.speed,
+        velocity=cage_force[1:] / b.cage_mass,
+        speed=cage_torque / b.cage_inertia[0],
+    )
+
+    # -- inner ring --------------------------------------------------------------------
+    inner_flanges = jnp.asarray([ring_sign > 0 for ring_sign, _ in FLANGE_ORDER])
+    ring_force = (
+        jnp.sum(loads.inner.force_on_ring, axis=0)
+        + jnp.sum(jnp.where(inner_flanges[None, :, None], fl.force_on_ring, 0.0), axis=(0, 1))
+        + op.radial_load * jnp.array([0.0, 0.0, 1.0])
+        + b.inner_ring_mass * g
+    )
+    ring_rates = RingState(
+        centre=state.inner_ring.velocity, velocity=ring_force[1:] / b.inner_ring_mass
+    )
+
+    # -- smooth peak functionals -------------------------------------------------------
+    q = fl.normal_force
+    w_c = q / (q + fn.contact_load)
+    # clipped so that states diffrax may visit during step rejection stay finite
+    dh = jnp.clip(fl.contact_height - fn.height_reference, -5e-3, 5e-3)
+    acc = Accumulators(
+        pv_power=w_c * (fl.pv / fn.pv_reference) ** fn.pv_exponent,
+        height_max_power=w_c * jnp.exp(fn.height_sharpness * dh),
+        height_min_power=w_c * jnp.exp(-fn.height_sharpness * dh),
+        contact_time=w_c,
+    )
+    return State(rollers=rollers, cage=cage_rates, inner_ring=ring_rates, accumulators=acc)

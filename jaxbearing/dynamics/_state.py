@@ -1,0 +1,167 @@
+"""State of the whole bearing and the frames it is expressed in.
+
+Frames (MODEL.md 3): inertial X along the bearing axis, Z along the radial load and gravity.
+A roller at azimuth theta sits at
+
+    p = x X + r e_rad(theta),  e_rad(theta) = (0, -sin theta, cos theta),
+    e_tan(theta) = d e_rad / d theta = X x e_rad = (0, -cos theta, -sin theta),
+
+so theta = 0 is the load direction (+Z) and a positive rotation about +X increases theta.
+
+Roller attitude: the unit axis `e` (inertial components) and the inertial angular velocity
+`omega`. The axis follows e' = omega x e; the spin angle about the axis is never integrated
+(the roller is axisymmetric), so there is no attitude singularity and no small-angle
+assumption for skew or tilt.
+
+The integrator sees a *scaled deviation* of this state (`ScaledState`): every component is
+measured from a nominal value (azimuths from the kinematic orbit theta_0 + omega_c t) in units of
+a physically meaningful scale (1 um, 1 urad of arc at the pitch radius, 1 mm/s ...), so that
+diffrax's rtol and atol mean the same thing for every component (MODEL.md 6).
+"""
+
+from __future__ import annotations
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+from jaxtyping import Array, Float
+
+
+def radial_unit(theta: Array) -> Array:
+    """e_rad(theta) = (0, -sin theta, cos theta), stacked on the last axis."""
+    z = jnp.zeros_like(theta)
+    return jnp.stack([z, -jnp.sin(theta), jnp.cos(theta)], axis=-1)
+
+
+def tangential_unit(theta: Array) -> Array:
+    """e_tan(theta) = X x e_rad(theta) = (0, -cos theta, -sin theta)."""
+    z = jnp.zeros_like(theta)
+    return jnp.stack([z, -jnp.cos(theta), -jnp.sin(theta)], axis=-1)
+
+
+class RollerState(eqx.Module):
+    """All rollers (leading dimension Z)."""
+
+    axial: Float[Array, " Z"]  # x_b [m]
+    radial: Float[Array, " Z"]  # r_b, distance of the centre from the bearing axis [m]
+    azimuth: Float[Array, " Z"]  # theta_b [rad]
+    axis: Float[Array, "Z 3"]  # unit roller axis e
+    axial_velocity: Float[Array, " Z"]
+    radial_velocity: Float[Array, " Z"]
+    azimuth_rate: Float[Array, " Z"]  # d theta_b / dt [rad/s]
+    angular_velocity: Float[Array, "Z 3"]  # omega (inertial components) [rad/s]
+
+    @property
+    def centre(self) -> Array:
+        x = self.axial[..., None] * jnp.array([1.0, 0.0, 0.0])
+        return x + self.radial[..., None] * radial_unit(self.azimuth)
+
+    @property
+    def velocity(self) -> Array:
+        return (
+            self.axial_velocity[..., None] * jnp.array([1.0, 0.0, 0.0])
+            + self.radial_velocity[..., None] * radial_unit(self.azimuth)
+            + (self.radial * self.azimuth_rate)[..., None] * tangential_unit(self.azimuth)
+        )
+
+
+class CageState(eqx.Module):
+    centre: Float[Array, 2]  # (y_c, z_c) [m]
+    angle: Float[Array, ""]  # theta_c [rad]
+    velocity: Float[Array, 2]
+    speed: Float[Array, ""]  # omega_c [rad/s]
+
+
+class RingState(eqx.Module):
+    """Inner ring: radial position (y_i, z_i) and velocity; its spin is prescribed."""
+
+    centre: Float[Array, 2]
+    velocity: Float[Array, 2]
+
+
+class Accumulators(eqx.Module):
+    """Smooth functionals integrated inside the solve (MODEL.md 6), per roller and flange.
+
+    pv_power:        int w(Q) (PV / PV_ref)^p dt              -> smooth peak PV (p-norm over time)
+    height_max_power: int w(Q) exp(+beta (h_c - h_ref)) dt   -> smooth max contact height
+    height_min_power: int w(Q) exp(-beta (h_c - h_ref)) dt   -> smooth min contact height
+    contact_time:    int w(Q) dt                              (w: smooth contact indicator)
+    """
+
+    pv_power: Float[Array, "Z 4"]
+    height_max_power: Float[Array, "Z 4"]
+    height_min_power: Float[Array, "Z 4"]
+    contact_time: Float[Array, "Z 4"]
+
+
+class State(eqx.Module):
+    rollers: RollerState
+    cage: CageState
+    inner_ring: RingState
+    accumulators: Accumulators
+
+
+def state_scales(num_rollers: int, pitch_radius: float) -> State:
+    """Scale of every state component (one unit of scaled state).
+
+    lengths 1 um, orbital angles 1 um of arc at the pitch radius, axis components 1 urad,
+    linear velocities 1 mm/s, angular velocities 1 rad/s (orbit: 1 mm/s at the pitch radius),
+    accumulators large (they must not steer the step size).
+    """
+    ones = jnp.ones((num_rollers,))
+    um, mm_s = 1e-6, 1e-3
+    return State(
+        rollers=RollerState(
+            axial=um * ones,
+            radial=um * ones,
+            azimuth=(um / pitch_radius) * ones,
+            axis=1e-6 * jnp.ones((num_rollers, 3)),
+            axial_velocity=mm_s * ones,
+            radial_velocity=mm_s * ones,
+            azimuth_rate=(mm_s / pitch_radius) * ones,
+            angular_velocity=jnp.ones((num_rollers, 3)),
+        ),
+        cage=CageState(
+            centre=um * jnp.ones(2),
+            angle=jnp.asarray(um / pitch_radius),
+            velocity=mm_s * jnp.ones(2),
+            speed=jnp.asarray(mm_s / pitch_radius),
+        ),
+        inner_ring=RingState(centre=um * jnp.ones(2), velocity=mm_s * jnp.ones(2)),
+        accumulators=Accumulators(
+            pv_power=1e12 * jnp.ones((num_rollers, 4)),
+            height_max_power=1e12 * jnp.ones((num_rollers, 4)),
+            height_min_power=1e12 * jnp.ones((num_rollers, 4)),
+            contact_time=1e12 * jnp.ones((num_rollers, 4)),
+        ),
+    )
+
+
+class Scaling(eqx.Module):
+    """y = nominal(t) + scale * Y, with the azimuths advancing at the kinematic cage speed."""
+
+    nominal: State
+    scale: State
+    orbit_speed: Float[Array, ""]  # omega_c of the nominal orbit [rad/s]
+
+    def _drift(self, t) -> State:
+        zero = jax.tree_util.tree_map(jnp.zeros_like, self.nominal)
+        zero = eqx.tree_at(lambda s: s.rollers.azimuth, zero, self.orbit_speed * t * jnp.ones_like(self.nominal.rollers.azimuth))
+        return eqx.tree_at(lambda s: s.cage.angle, zero, self.orbit_speed * t)
+
+    def _drift_rate(self) -> State:
+        zero = jax.tree_util.tree_map(jnp.zeros_like, self.nominal)
+        zero = eqx.tree_at(lambda s: s.rollers.azimuth, zero, self.orbit_speed * jnp.ones_like(self.nominal.rollers.azimuth))
+        return eqx.tree_at(lambda s: s.cage.angle, zero, self.orbit_speed)
+
+    def unscale(self, t, scaled: State) -> State:
+        drift = self._drift(t)
+        return jax.tree_util.tree_map(lambda n, d, s, y: n + d + s * y, self.nominal, drift, self.scale, scaled)
+
+    def scale_state(self, t, y: State) -> State:
+        drift = self._drift(t)
+        return jax.tree_util.tree_map(lambda n, d, s, v: (v - n - d) / s, self.nominal, drift, self.scale, y)
+
+    def scale_rate(self, dy: State) -> State:
+        rate = self._drift_rate()
+        return jax.tree_util.tree_map(lambda d, r, s: (d - r) / s, dy, rate, self.scale)

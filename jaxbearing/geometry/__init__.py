@@ -1,0 +1,67 @@
+"""Bearing geometry: parameter pytrees, derived mass properties, the roller end body.
+
+Owns: `Bearing` and its parts (`Roller`, `Flange`, `Cage`, `Material`, `Lubricant`), the
+`OperatingPoint`, the reference bearing (MODEL.md 2), unit conversions, the mass properties
+derived from geometry, and the shape of the roller end (corner torus and spherical cap, MODEL.md
+4.1: support function, limited circle, arc protrusion, principal curvatures).
+
+The end body lives here rather than in `jaxbearing.flange` because the roller's mass properties
+need it (the arc cap changes the volume), and mass properties sit below every contact.
+
+May import: `jaxbearing._errors`. Nothing above it.
+"""
+
+from ._inertia import cage_mass_properties, roller_mass_properties
+from ._params import (
+    Bearing,
+    Cage,
+    Flange,
+    Lubricant,
+    Material,
+    OperatingPoint,
+    Roller,
+    kinematic_cage_speed,
+    rad_s_to_rpm,
+    reference_bearing,
+    reference_operating_point,
+    rpm_to_rad_s,
+)
+from ._roller_end import (
+    LIMITED_CIRCLE_BAND,
+    SIN_ALPHA_FLOOR,
+    arc_half_length,
+    arc_protrusion,
+    arc_weight,
+    end_curvature,
+    end_principal_curvatures,
+    end_support,
+    limited_circle_radius,
+    sag,
+)
+
+__all__ = [
+    "LIMITED_CIRCLE_BAND",
+    "SIN_ALPHA_FLOOR",
+    "Bearing",
+    "Cage",
+    "Flange",
+    "Lubricant",
+    "Material",
+    "OperatingPoint",
+    "Roller",
+    "arc_half_length",
+    "arc_protrusion",
+    "arc_weight",
+    "cage_mass_properties",
+    "end_curvature",
+    "end_principal_curvatures",
+    "end_support",
+    "kinematic_cage_speed",
+    "limited_circle_radius",
+    "rad_s_to_rpm",
+    "reference_bearing",
+    "reference_operating_point",
+    "roller_mass_properties",
+    "rpm_to_rad_s",
+    "sag",
+]

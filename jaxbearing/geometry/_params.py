@@ -1,0 +1,275 @@
+"""Bearing parameters as `equinox.Module` pytrees.
+
+Float fields are JAX arrays: differentiable and vmappable (a sweep or a design search stacks
+them). Counts (number of rollers, number of raceway slices) are static metadata, so changing
+them recompiles but never enters a gradient. Everything is in SI units (m, kg, s, N, rad, Pa);
+configuration files (`jaxbearing._config`) carry engineering units in their key names.
+
+Masses and inertias are derived from geometry and density (`jaxbearing._inertia`), never typed
+in. The one exception is the inner ring, whose effective mass includes the shaft.
+
+Symbols follow the source study (Machines 2025, 13(11), 993) and `docs/model.md`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import equinox as eqx
+import jax.numpy as jnp
+from jaxtyping import Array, Float
+
+Scalar = Float[Array, ""]
+
+
+def _f(x) -> Array:
+    """Converter: every float field becomes a 64-bit JAX array."""
+    return jnp.asarray(x, dtype=jnp.float64)
+
+
+def _field():
+    return eqx.field(converter=_f)
+
+
+class Roller(eqx.Module):
+    """Cylindrical roller with a crowned generatrix and corner-rounded or arc (spherical) ends.
+
+    The end body is the convex hull of a corner torus (tube radius `corner_radius` R_cor, centre
+    circle of radius R_ce = D/2 - R_cor at x_cor = L_b1/2 - R_cor from the roller centre) and,
+    for an arc end, a spherical cap of radius `end_radius` R_end. A flat end is R_end = inf.
+    """
+
+    diameter: Scalar = _field()  # D
+    length: Scalar = _field()  # L_b1, overall length of the flat-end roller
+    central_length: Scalar = _field()  # L_b2, straight part of the generatrix
+    crown_drop: Scalar = _field()  # c_crown at the ends of the effective length
+    corner_radius: Scalar = _field()  # R_cor
+    end_radius: Scalar = _field()  # R_end (inf: flat end with corners only)
+
+    @property
+    def corner_centre_radius(self) -> Array:
+        """R_ce = D/2 - R_cor: radius of the corner torus' centre circle."""
+        return self.diameter / 2 - self.corner_radius
+
+    @property
+    def corner_centre_offset(self) -> Array:
+        """x_cor = L_b1/2 - R_cor: axial distance of the corner centre circle from the centre."""
+        return self.length / 2 - self.corner_radius
+
+    @property
+    def effective_length(self) -> Array:
+        """L_we = L_b1 - 2 R_cor: length carried by the raceway slices."""
+        return self.length - 2 * self.corner_radius
+
+    def with_flat_ends(self) -> Roller:
+        """The same roller with flat ends and corner radii (R_end = inf)."""
+        return eqx.tree_at(lambda r: r.end_radius, self, jnp.asarray(jnp.inf))
+
+
+class Flange(eqx.Module):
+    """Ring flange (the same on both sides of both rings).
+
+    The flange face is a cone of revolution about the ring axis starting at the raceway edge
+    x = +/-(L_b1 + Delta_bf)/2 and opening away from the roller by the layback angle theta_f.
+    """
+
+    height: Scalar = _field()  # H_rf, above the raceway surface
+    relief_height: Scalar = _field()  # h_rel, base undercut
+    contact_height_limit: Scalar = _field()  # h_up, upper limit of the contact height
+    layback_angle: Scalar = _field()  # theta_f [rad]
+    axial_clearance: Scalar = _field()  # Delta_bf = flange spacing - L_b1
+
+
+class Cage(eqx.Module):
+    """Outer-ring-land guided machined cage (annulus with one pocket per roller)."""
+
+    inner_diameter: Scalar = _field()
+    outer_diameter: Scalar = _field()
+    width: Scalar = _field()
+    pocket_clearance: Scalar = _field()  # C_p, circumferential, total
+    guiding_clearance: Scalar = _field()  # C_g, diametral, on the outer-ring lands
+    land_width: Scalar = _field()  # b_l, per land (two lands)
+
+
+class Material(eqx.Module):
+    """Isotropic linear-elastic material."""
+
+    elastic_modulus: Scalar = _field()  # E [Pa]
+    poisson_ratio: Scalar = _field()  # nu
+    density: Scalar = _field()  # rho [kg/m^3]
+
+
+class Lubricant(eqx.Module):
+    """Lubricant, oil-air mixture in the cavity, and the traction curve of rolling contacts.
+
+    Traction curve (MODEL.md 4.2): kappa(du) = (A + B du) exp(-C du) + D, with kappa(0) = A + D.
+    """
+
+    viscosity: Scalar = _field()  # eta_0 [Pa s]
+    pressure_viscosity: Scalar = _field()  # alpha_p [1/Pa]
+    temperature_viscosity: Scalar = _field()  # beta_T [1/K]
+    density: Scalar = _field()  # rho_oil [kg/m^3]
+    oil_fraction: Scalar = _field()  # f_oil, oil volume fraction in the cavity
+    traction_a: Scalar = _field()  # A [-]
+    traction_b: Scalar = _field()  # B [s/m]
+    traction_c: Scalar = _field()  # C [s/m]
+    traction_d: Scalar = _field()  # D [-]
+
+
+class Bearing(eqx.Module):
+    """A whole cylindrical roller bearing: geometry, materials, lubricant, friction.
+
+    `num_rollers` (Z) and `num_slices` (N_s) are static: they fix array shapes.
+    """
+
+    pitch_diameter: Scalar = _field()  # d_m
+    radial_clearance: Scalar = _field()  # P_d, diametral
+    inner_ring_mass: Scalar = _field()  # m_i, inner ring + shaft effective mass
+    flange_traction: Scalar = _field()  # mu_f
+    pocket_friction: Scalar = _field()  # mu_p
+    roller: Roller
+    flange: Flange
+    cage: Cage
+    ring_material: Material
+    roller_material: Material
+    cage_material: Material
+    lubricant: Lubricant
+    num_rollers: int = eqx.field(static=True)  # Z
+    num_slices: int = eqx.field(static=True, default=31)  # N_s (odd)
+
+    # -- derived geometry ----------------------------------------------------------------
+    @property
+    def inner_raceway_radius(self) -> Array:
+        """Radius of the inner raceway: (d_m - D)/2 - P_d/4 (clearance split between rings)."""
+        return (self.pitch_diameter - self.roller.diameter) / 2 - self.radial_clearance / 4
+
+    @property
+    def outer_raceway_radius(self) -> Array:
+        """Radius of the outer raceway: (d_m + D)/2 + P_d/4."""
+        return (self.pitch_diameter + self.roller.diameter) / 2 + self.radial_clearance / 4
+
+    @property
+    def raceway_width(self) -> Array:
+        """W_r = L_b1 + Delta_bf: flange-to-flange spacing at the raceway (paper Eq. 8)."""
+        return self.roller.length + self.flange.axial_clearance
+
+    # -- derived masses (jaxbearing._inertia) -------------------------------------------
+    @property
+    def roller_mass(self) -> Array:
+        from ._inertia import roller_mass_properties
+
+        return roller_mass_properties(self.roller, self.roller_material.density)[0]
+
+    @property
+    def roller_inertia(self) -> Array:
+        """(I_axial, I_transverse) of one roller about its centre [kg m^2]."""
+        from ._inertia import roller_mass_properties
+
+        _, i_ax, i_tr = roller_mass_properties(self.roller, self.roller_material.density)
+        return jnp.stack([i_ax, i_tr])
+
+    @property
+    def cage_mass(self) -> Array:
+        from ._inertia import cage_mass_properties
+
+        return cage_mass_properties(self)[0]
+
+    @property
+    def cage_inertia(self) -> Array:
+        """(I_polar, I_transverse) of the cage about its centre [kg m^2]."""
+        from ._inertia import cage_mass_properties
+
+        _, i_p, i_t = cage_mass_properties(self)
+        return jnp.stack([i_p, i_t])
+
+    def with_flat_ends(self) -> Bearing:
+        """The same bearing with flat-end (corner) rollers."""
+        return eqx.tree_at(lambda b: b.roller, self, self.roller.with_flat_ends())
+
+
+class OperatingPoint(eqx.Module):
+    """Inner ring driven at `inner_speed`, radial `radial_load` on the inner ring along +Z
+    (the direction of gravity), outer ring fixed."""
+
+    inner_speed: Scalar = _field()  # omega_i [rad/s]
+    radial_load: Scalar = _field()  # F_r [N]
+    gravity: Scalar = _field()  # g [m/s^2], 0 switches gravity off
+
+
+def rpm_to_rad_s(rpm):
+    return rpm * (2 * math.pi / 60)
+
+
+def rad_s_to_rpm(w):
+    return w * (60 / (2 * math.pi))
+
+
+def kinematic_cage_speed(bearing: Bearing, op: OperatingPoint) -> Array:
+    """Cage speed under pure rolling with a fixed outer ring: omega_c = omega_i (1 - D/d_m)/2.
+
+    (Harris & Kotzalas, Essential Concepts of Bearing Technology, Eq. 8.13 with zero contact
+    angle.)
+    """
+    return op.inner_speed * (1 - bearing.roller.diameter / bearing.pitch_diameter) / 2
+
+
+def reference_bearing() -> Bearing:
+    """The embedded reference bearing of `docs/model.md` section 2.
+
+    Representative, not the source study's bearing: the paper's Table 1 is not available. The
+    values are an aero-engine mainshaft roller bearing chosen so that the paper's stated values
+    (H_rf = 2 mm, contact-height limit 1.8 mm, R_end = 80 mm, theta_f = 1.6 deg,
+    Delta_bf = 0.15 mm, L_b2 = 4.5 mm) give the same kind of design zone.
+    """
+    mm = 1e-3
+    return Bearing(
+        pitch_diameter=85 * mm,
+        radial_clearance=0.020 * mm,
+        inner_ring_mass=0.5,
+        flange_traction=0.08,
+        pocket_friction=0.10,
+        roller=Roller(
+            diameter=7.5 * mm,
+            length=8.0 * mm,
+            central_length=4.5 * mm,
+            crown_drop=0.004 * mm,
+            corner_radius=0.4 * mm,
+            end_radius=80 * mm,
+        ),
+        flange=Flange(
+            height=2.0 * mm,
+            relief_height=0.3 * mm,
+            contact_height_limit=1.8 * mm,
+            layback_angle=math.radians(1.6),
+            axial_clearance=0.15 * mm,
+        ),
+        cage=Cage(
+            inner_diameter=80 * mm,
+            outer_diameter=90 * mm,
+            width=14 * mm,
+            pocket_clearance=0.20 * mm,
+            guiding_clearance=0.40 * mm,
+            land_width=3 * mm,
+        ),
+        ring_material=Material(elastic_modulus=203e9, poisson_ratio=0.28, density=7830.0),
+        roller_material=Material(elastic_modulus=203e9, poisson_ratio=0.28, density=7830.0),
+        cage_material=Material(elastic_modulus=205e9, poisson_ratio=0.29, density=7850.0),
+        lubricant=Lubricant(
+            viscosity=0.055,
+            pressure_viscosity=1.85e-8,
+            temperature_viscosity=0.0315,
+            density=960.0,
+            oil_fraction=0.05,
+            traction_a=-0.04,
+            traction_b=0.2528,
+            traction_c=2.926,
+            traction_d=0.04,
+        ),
+        num_rollers=26,
+        num_slices=31,
+    )
+
+
+def reference_operating_point() -> OperatingPoint:
+    """20,000 rpm on the inner ring, 1000 N radial load, gravity on."""
+    return OperatingPoint(inner_speed=rpm_to_rad_s(20_000.0), radial_load=1000.0, gravity=9.81)

@@ -1,0 +1,359 @@
+"""TOML configuration files in engineering units.
+
+A configuration file has one table per part of the bearing, with the unit in every key's name
+(`_mm`, `_um`, `_deg`, `_rpm`, `_GPa`, `_N`, ...); `jaxbearing config show` prints every key with
+its meaning, symbol and valid range. The schema and the ranges are `jaxbearing._validation.KEYS`.
+
+    [bearing]            pitch_diameter_mm, radial_clearance_um, num_rollers, num_slices, ...
+    [roller]             diameter_mm, length_mm, ..., end_radius_mm (inf = flat end)
+    [flange]             height_mm, relief_height_mm, contact_height_limit_mm, ...
+    [cage]               inner_diameter_mm, outer_diameter_mm, width_mm, ...
+    [materials.ring]     elastic_modulus_GPa, poisson_ratio, density_kg_m3
+    [materials.roller]   (same)
+    [materials.cage]     (same)
+    [lubricant]          viscosity_Pa_s, ..., traction_a, traction_b_s_m, traction_c_s_m, traction_d
+    [operating]          speed_rpm, radial_load_N, gravity
+    [simulation]         end, duration_ms, rtol, atol, max_steps, progress
+
+Missing keys take the reference value (docs/MODEL.md section 2); unknown keys and sections are
+errors with a "did you mean ...?" suggestion; wrong types and out-of-range values are errors
+naming the key, the value with its unit and the valid range (`jaxbearing.ConfigError`).
+
+A `Config` keeps the values exactly as given, in engineering units: that is the source of truth,
+so a file round-trips exactly through `Config.to_toml()`. Conversion to SI happens only in
+`Config.bearing()` and `Config.operating_point()`; the reference configuration converts to
+`reference_bearing()` and `reference_operating_point()` bit for bit.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import difflib
+import os
+import re
+import tomllib
+import types
+from collections.abc import Mapping
+from typing import Any
+
+import tomli_w
+
+from .._errors import ConfigError
+from ..geometry import Bearing, Cage, Flange, Lubricant, Material, OperatingPoint, Roller
+from ._validation import (
+    GRAVITY,
+    KEY_BY_PATH,
+    KEYS,
+    REFERENCE_VALUES,
+    Key,
+    check_values,
+    coerce,
+    format_value,
+    type_name,
+)
+
+_HEADER = """\
+# jaxbearing configuration. Engineering units: the unit is part of every key's name.
+# Keys left out take the reference value: a representative aero-engine mainshaft cylindrical
+# roller bearing (docs/MODEL.md section 2), not the source paper's Table 1.
+"""
+
+
+def _tree() -> dict[str, Any]:
+    """Nested {section: {subsection: {name: Key}}} of the schema, in schema order."""
+    tree: dict[str, Any] = {}
+    for key in KEYS:
+        node = tree
+        for part in key.section.split("."):
+            node = node.setdefault(part, {})
+        node[key.name] = key
+    return tree
+
+
+_TREE = _tree()
+_SECTIONS = tuple(dict.fromkeys(k.section for k in KEYS))
+
+
+@dataclasses.dataclass(frozen=True)
+class SimulationSettings:
+    """The [simulation] table: which roller ends to run and how to integrate.
+
+    `end`: "arc", "corner" or "both"; `duration_ms`: simulated time; `rtol`, `atol`: PID
+    step-size controller tolerances (on the scaled state); `max_steps`: integrator step limit;
+    `progress`: show a progress meter.
+    """
+
+    end: str
+    duration_ms: float
+    rtol: float
+    atol: float
+    max_steps: int
+    progress: bool
+
+    @property
+    def duration(self) -> float:
+        """Simulated time [s]."""
+        return self.duration_ms * 1e-3
+
+    @property
+    def ends(self) -> tuple[str, ...]:
+        """The roller-end variants to simulate: ("arc",), ("corner",) or ("arc", "corner")."""
+        return ("arc", "corner") if self.end == "both" else (self.end,)
+
+
+# -- unknown keys --------------------------------------------------------------------------------
+def _unknown(path: str, name: str, node: Mapping[str, Any], prefix: str,
+             section: bool) -> ConfigError:
+    """Error for an unknown key or section `path`, with a "did you mean ...?" suggestion."""
+    is_table = {n: isinstance(c, dict) for n, c in node.items()}
+
+    def show(n: str) -> str:
+        full = prefix + n
+        return f"[{full}]" if is_table[n] else full
+
+    what = "unknown section" if section else "unknown key"
+    homes: dict[str, list[str]] = {}  # key name -> dotted paths with that name
+    for key in KEYS:
+        homes.setdefault(key.name, []).append(key.path)
+
+    def elsewhere(n: str) -> ConfigError:
+        paths = homes[n]
+        # "density_kg_m3" in [cage] -> materials.cage.density_kg_m3
+        near = [p for p in paths if set(prefix.split(".")[:-1]) & set(p.split(".")[:-1])]
+        shown = " or ".join(f"{p} (in [{KEY_BY_PATH[p].section}])" for p in (near or paths))
+        return ConfigError(path, f"{what}; did you mean {shown}?")
+
+    if name in homes:  # the right key in the wrong section ("pitch_diameter_mm" in [roller])
+        return elsewhere(name)
+    match = difflib.get_close_matches(name, list(node), n=1, cutoff=0.6)
+    if match:
+        return ConfigError(path, f"{what}; did you mean {show(match[0])}?")
+    match = difflib.get_close_matches(name, list(homes), n=1, cutoff=0.75)
+    if match:
+        return elsewhere(match[0])
+    where = f" in [{prefix[:-1]}]" if prefix else ""
+    return ConfigError(path, f"{what}; valid{where}: " + ", ".join(show(n) for n in node))
+
+
+def _unknown_path(path: str) -> ConfigError:
+    """Error for a dotted path that names no key: unknown at its first unknown part."""
+    node: Mapping[str, Any] = _TREE
+    prefix = ""
+    parts = path.split(".")
+    for i, part in enumerate(parts):
+        child = node.get(part)
+        if isinstance(child, dict) and i < len(parts) - 1:
+            node, prefix = child, prefix + part + "."
+            continue
+        if isinstance(child, dict):
+            return ConfigError(path, "is a section, not a key")
+        if child is not None:
+            return ConfigError(path, f"{prefix}{part} is a key, not a section")
+        return _unknown(path, parts[i], node, prefix, section=i < len(parts) - 1)
+    raise AssertionError(path)  # pragma: no cover
+
+
+def _flatten(data: Any, node: Mapping[str, Any], prefix: str, out: dict[str, Any]) -> None:
+    for name, value in data.items():
+        path = prefix + str(name)
+        if not isinstance(name, str) or name not in node:
+            raise _unknown(path, str(name), node, prefix, section=isinstance(value, Mapping))
+        child = node[name]
+        if isinstance(child, dict):
+            if not isinstance(value, Mapping):
+                raise ConfigError(path, f"expected a table [{path}], got {type_name(value)}")
+            _flatten(value, child, path + ".", out)
+        else:
+            out[path] = coerce(child, value)
+
+
+def _values_from(data: Mapping[str, Any] | None) -> dict[str, Any]:
+    """Typed, merged (reference for missing keys) and validated flat values of nested `data`."""
+    given: dict[str, Any] = {}
+    if data is not None:
+        if not isinstance(data, Mapping):
+            raise ConfigError("config", f"expected a table of sections, got {type_name(data)}")
+        _flatten(data, _TREE, "", given)
+    values = {k.path: given.get(k.path, k.default) for k in KEYS}
+    check_values(values)
+    return values
+
+
+# -- the container -------------------------------------------------------------------------------
+class Config:
+    """A validated configuration: engineering-unit values (the source of truth) and accessors.
+
+    Build one with `load_config`, `loads_config`, `reference_config`, or `Config(nested_dict)`
+    (the parsed TOML layout, e.g. ``{"roller": {"end_radius_mm": 90.0}}``; missing keys take the
+    reference value). Immutable: `replace` returns a new, re-validated configuration.
+
+    `cfg["roller.end_radius_mm"]` reads one value; `to_dict()`/`to_toml()` write all of them;
+    `bearing()`, `operating_point()` and `simulation` give the model's inputs (SI pytrees).
+    """
+
+    __slots__ = ("_values",)
+
+    def __init__(self, data: Mapping[str, Any] | None = None):
+        object.__setattr__(self, "_values", types.MappingProxyType(_values_from(data)))
+
+    def __setattr__(self, name, value):
+        raise dataclasses.FrozenInstanceError(f"Config is immutable; use replace() (set {name!r})")
+
+    def __reduce__(self):
+        return (Config, (self.to_dict(),))
+
+    # -- access ---------------------------------------------------------------------------------
+    def __getitem__(self, path: str) -> Any:
+        try:
+            return self._values[path]
+        except KeyError:
+            raise KeyError(f"{path!r} is not a configuration key") from None
+
+    def keys(self) -> tuple[str, ...]:
+        """Dotted keys in schema order."""
+        return tuple(self._values)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Nested {section: {key: value}} (the TOML layout), every key, engineering units."""
+        out: dict[str, Any] = {}
+        for path, value in self._values.items():
+            node = out
+            *sections, name = path.split(".")
+            for s in sections:
+                node = node.setdefault(s, {})
+            node[name] = value
+        return out
+
+    def changed(self) -> dict[str, Any]:
+        """The keys whose values differ from the reference configuration."""
+        return {p: v for p, v in self._values.items() if v != REFERENCE_VALUES[p]}
+
+    def replace(self, changes: Mapping[str, Any] | None = None, /, **dotted: Any) -> Config:
+        """A new configuration with dotted keys changed, re-validated:
+        ``cfg.replace(**{"roller.end_radius_mm": 90})``."""
+        updates = {**(changes or {}), **dotted}
+        data = self.to_dict()
+        for path, value in updates.items():
+            if path not in KEY_BY_PATH:
+                raise _unknown_path(path)
+            node = data
+            *sections, name = path.split(".")
+            for s in sections:
+                node = node[s]
+            node[name] = value
+        return Config(data)
+
+    # -- model inputs ---------------------------------------------------------------------------
+    def bearing(self) -> Bearing:
+        """The `Bearing` pytree in SI units."""
+        parts: dict[str, dict[str, Any]] = {}
+        top: dict[str, Any] = {}
+        for key in KEYS:
+            if key.attr is None or key.attr.startswith("op."):
+                continue
+            value = self._values[key.path]
+            value = value if key.kind is int else key.to_si(value)
+            group, _, field = key.attr.rpartition(".")
+            (parts.setdefault(group, {}) if group else top)[field] = value
+        classes = {"roller": Roller, "flange": Flange, "cage": Cage, "lubricant": Lubricant,
+                   "ring_material": Material, "roller_material": Material,
+                   "cage_material": Material}
+        return Bearing(**top, **{g: classes[g](**kw) for g, kw in parts.items()})
+
+    def operating_point(self) -> OperatingPoint:
+        """The `OperatingPoint` pytree in SI units (gravity 9.81 m/s^2 or 0)."""
+        v = self._values
+        return OperatingPoint(
+            inner_speed=KEY_BY_PATH["operating.speed_rpm"].to_si(v["operating.speed_rpm"]),
+            radial_load=v["operating.radial_load_N"],
+            gravity=GRAVITY if v["operating.gravity"] else 0.0,
+        )
+
+    @property
+    def simulation(self) -> SimulationSettings:
+        """The [simulation] settings."""
+        return SimulationSettings(**{f.name: self._values[f"simulation.{f.name}"]
+                                     for f in dataclasses.fields(SimulationSettings)})
+
+    # -- writing --------------------------------------------------------------------------------
+    def to_toml(self, *, comments: bool = True) -> str:
+        """Every key as TOML, in schema order; with `comments`, a line per key giving its
+        meaning, symbol, unit and valid range. Loading the text gives an equal `Config`."""
+        lines = [_HEADER.rstrip("\n")] if comments else []
+        for section in _SECTIONS:
+            if lines:
+                lines.append("")
+            lines.append(f"[{section}]")
+            for key in KEYS:
+                if key.section != section:
+                    continue
+                if comments:
+                    lines.append(f"# {key.doc()}")
+                lines.append(_toml_line(key, self._values[key.path]))
+        return "\n".join(lines) + "\n"
+
+    # -- dunder ---------------------------------------------------------------------------------
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Config):
+            return NotImplemented
+        return self._values == other._values
+
+    def __hash__(self) -> int:
+        return hash(tuple(self._values.items()))
+
+    def __repr__(self) -> str:
+        changed = self.changed()
+        if not changed:
+            return "Config(reference)"
+        body = ", ".join(f"{p}={format_value(v)}" for p, v in changed.items())
+        return f"Config(reference with {body})"
+
+
+def _toml_line(key: Key, value: Any) -> str:
+    """`name = value` with the value written by tomli_w (floats as repr: exact round trip)."""
+    return tomli_w.dumps({key.name: value}).rstrip("\n")
+
+
+# -- loading -------------------------------------------------------------------------------------
+_TOML_POS = re.compile(r"^(?P<msg>.*) \(at line (?P<line>\d+), column (?P<col>\d+)\)$")
+
+
+def loads_config(text: str) -> Config:
+    """Parse TOML text into a validated `Config`.
+
+    A syntax error raises ConfigError whose field is the position ("line 3, column 9").
+    """
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        m = _TOML_POS.match(str(exc))
+        if m:
+            where, msg = f"line {m['line']}, column {m['col']}", m["msg"]
+        else:
+            where, _, msg = str(exc).partition(" (at ")
+            where, msg = (msg.rstrip(")") if msg else "document"), where
+        raise ConfigError(where, f"TOML syntax error: {msg[:1].lower()}{msg[1:]}") from None
+    return Config(data)
+
+
+def load_config(path: str | os.PathLike[str] | None = None) -> Config:
+    """Read and validate a TOML configuration file; None gives the reference configuration.
+
+    An unreadable file raises ConfigError with field "file"."""
+    if path is None:
+        return reference_config()
+    try:
+        with open(path, "rb") as f:
+            raw = f.read()
+    except OSError as exc:
+        raise ConfigError("file", f"cannot read: {exc.strerror or exc}") from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ConfigError("file", f"not UTF-8 text (byte {exc.start})") from None
+    return loads_config(text)
+
+
+def reference_config() -> Config:
+    """The embedded reference configuration (reference_bearing(), reference_operating_point())."""
+    return Config()

@@ -1,0 +1,82 @@
+"""Standard figures of one simulation run (matplotlib, Agg backend).
+
+* flange_boxplots.png: force, peak pressure, sliding velocity and PV per contact event, arc vs
+  corner (the paper's Figure 7);
+* contact_positions.png: contact points on the roller end face with the limited circle
+  (the paper's Figure 8);
+* cage_speed.png: cage speed over time against the kinematic cage speed.
+"""
+
+from __future__ import annotations
+
+import pathlib
+
+import numpy as np
+
+from ..io import pyplot as _plt
+
+
+def plot_run(out_dir: pathlib.Path, results: dict) -> list[pathlib.Path]:
+    from ..geometry import kinematic_cage_speed, limited_circle_radius, rad_s_to_rpm
+    from ._summary import contact_events
+
+    plt = _plt()
+    out_dir = pathlib.Path(out_dir)
+    files = []
+    events = {end: contact_events(res.histories) for end, (res, _) in results.items()}
+
+    fig, axes = plt.subplots(1, 4, figsize=(14, 3.6))
+    panels = (
+        ("flange_force_N", "contact force [N]", 1.0),
+        ("flange_pressure_Pa", "peak pressure [GPa]", 1e-9),
+        ("flange_sliding_velocity_m_s", "sliding velocity [m/s]", 1.0),
+        ("flange_pv_Pa_m_s", "PV [GPa m/s]", 1e-9),
+    )
+    for ax, (key, label, k) in zip(axes, panels):
+        data = [events[e][key] * k for e in events]
+        if all(d.size for d in data):
+            ax.boxplot(data, showmeans=True)
+            ax.set_xticks(range(1, len(events) + 1), list(events))
+        else:
+            ax.text(0.5, 0.5, "no contact events", ha="center", transform=ax.transAxes)
+        ax.set_ylabel(label)
+    fig.suptitle("Roller end / flange contact events (cf. paper Fig. 7)")
+    fig.tight_layout()
+    files.append(out_dir / "flange_boxplots.png")
+    fig.savefig(files[-1], dpi=110)
+    plt.close(fig)
+
+    fig, axes = plt.subplots(1, len(results), figsize=(4.5 * len(results), 4.2), squeeze=False)
+    for ax, (end, (res, _)) in zip(axes[0], results.items()):
+        h = res.histories
+        q = np.asarray(h["flange_force"])
+        pos = np.asarray(h["end_face_position"])[q > 1.0]
+        if pos.size:
+            ax.plot(pos[:, 0] * 1e3, pos[:, 1] * 1e3, ".", ms=2, alpha=0.5, label="contact points")
+        rho = float(limited_circle_radius(res.bearing.roller)) * 1e3
+        phi = np.linspace(0, 2 * np.pi, 200)
+        ax.plot(rho * np.cos(phi), rho * np.sin(phi), "r-", lw=1, label="limited circle")
+        ax.set_aspect("equal")
+        ax.set_xlabel("y on end face [mm]")
+        ax.set_ylabel("z on end face [mm]")
+        ax.set_title(f"{end} end (cf. paper Fig. 8)")
+        ax.legend(loc="upper right", fontsize=7)
+    fig.tight_layout()
+    files.append(out_dir / "contact_positions.png")
+    fig.savefig(files[-1], dpi=110)
+    plt.close(fig)
+
+    fig, ax = plt.subplots(figsize=(6, 3.6))
+    for end, (res, _) in results.items():
+        h = res.histories
+        ax.plot(np.asarray(h["t"]) * 1e3, rad_s_to_rpm(np.asarray(h["cage_speed"])), label=end)
+    res0 = next(iter(results.values()))[0]
+    ax.axhline(float(rad_s_to_rpm(kinematic_cage_speed(res0.bearing, res0.operating))), color="k", ls="--", label="kinematic")
+    ax.set_xlabel("time [ms]")
+    ax.set_ylabel("cage speed [rpm]")
+    ax.legend()
+    fig.tight_layout()
+    files.append(out_dir / "cage_speed.png")
+    fig.savefig(files[-1], dpi=110)
+    plt.close(fig)
+    return files

@@ -1,0 +1,110 @@
+"""Sweep results as one labelled `xarray.Dataset` (axes as coordinates), written to results.nc."""
+
+from __future__ import annotations
+
+import functools
+import json
+import os
+import pathlib
+from typing import Any
+
+import numpy as np
+
+from .._errors import UserInputError
+from ..io import KEY_BY_PATH, optional_import
+from ._batch import _ZONE_FIELDS, case_inputs, variable_names
+from ._spec import SweepSpec
+from ._storage import atomic_write, batch_path, load_spec_from_dir, read_batch
+
+
+# -- the dataset ---------------------------------------------------------------------------------
+def design_zone_cases(spec: SweepSpec) -> dict[str, np.ndarray]:
+    """Design-zone margins (`jaxbearing.design_zone`) of every case, vmapped, numpy (N,)."""
+    import jax
+
+    bearings = [case_inputs(spec, c)[0] for c in range(spec.num_cases)]
+    stacked = jax.tree_util.tree_map(lambda *xs: np.stack(xs), *bearings)
+    zone = jax.device_get(_zone_batch(stacked))
+    out = {f"zone_{f}_m": np.asarray(getattr(zone, f), dtype=np.float64) for f in _ZONE_FIELDS}
+    out["zone_feasible"] = np.asarray(zone.feasible, dtype=np.int8)
+    return out
+
+
+@functools.cache
+def _zone_fn():
+    import jax
+
+    from ..flange import design_zone
+
+    return jax.jit(jax.vmap(design_zone))
+
+
+def _zone_batch(stacked):
+    return _zone_fn()(stacked)
+
+
+def assemble(out_dir: str | os.PathLike, spec: SweepSpec | None = None):
+    """Assemble DIR/results.nc from the batch files (all must exist) and return the Dataset."""
+    xr = optional_import("xarray")
+
+    out_dir = pathlib.Path(out_dir)
+    spec = spec or load_spec_from_dir(out_dir)
+    batches = []
+    for b in range(spec.num_batches):
+        data = read_batch(out_dir, spec, b)
+        if data is None:
+            raise UserInputError(f"{out_dir}: {batch_path(out_dir, b).name} is missing; run "
+                                 "the sweep command again to compute it")
+        batches.append(data)
+    cols = {k: np.concatenate([d[k] for d in batches]) for k in batches[0]
+            if k not in ("spec_hash", "batch")}
+    shape = spec.shape
+    dims = spec.dims
+    data_vars: dict[str, Any] = {}
+    for name in variable_names():
+        attrs = {"description": f"summarise()['{name}'] of the case"}
+        data_vars[name] = (dims, cols[name].reshape(shape), attrs)
+    data_vars["status"] = (dims, cols["status"].astype(str).reshape(shape),
+                           {"description": "\"ok\" or the solver failure"})
+    data_vars["result_code"] = (dims, cols["result_code"].astype(np.int32).reshape(shape),
+                                {"description": "diffrax result code (0 = successful)"})
+    data_vars["contact_position"] = (
+        dims + ("sample", "end_face_axis"),
+        cols["contact_position"].reshape(shape + cols["contact_position"].shape[1:]),
+        {"units": "m", "description": "flange contact points on the roller end face (roller "
+         "frame y, z), evenly subsampled over all contact samples; NaN-padded"})
+    data_vars["contact_position_count"] = (dims, cols["contact_position_count"].astype(np.int32)
+                                           .reshape(shape), {"description": "valid samples"})
+    for name, values in design_zone_cases(spec).items():
+        data_vars[name] = (dims, values.reshape(shape),
+                           {"description": "jaxbearing.design_zone of the case (aligned roller, "
+                            "flange load 100 N); margins > 0 are feasible"})
+    coords: dict[str, Any] = {}
+    for a in spec.axes:
+        unit = KEY_BY_PATH[a.key].unit if a.key in KEY_BY_PATH else ""
+        vals = np.asarray(a.values, dtype=str if a.key == "end" else float)
+        coords[a.name] = (a.dim, vals, {"config_key": a.key, "units": unit})
+    coords["end_face_axis"] = ("end_face_axis", np.array(["y", "z"]))
+    ds = xr.Dataset(data_vars, coords=coords)
+    ds.attrs.update(
+        spec_hash=spec.hash,
+        spec=json.dumps(spec.canonical(), allow_nan=True),
+        base_end=spec.base.simulation.end,
+        duration_ms=spec.base.simulation.duration_ms,
+        num_saves=spec.num_saves,
+        source="jaxbearing sweep (issue 6)",
+    )
+    path = out_dir / "results.nc"
+    atomic_write(path, lambda f: f.write(ds.to_netcdf(None, engine="scipy")))
+    return ds
+
+
+def open_results(out_dir: str | os.PathLike):
+    """DIR/results.nc as an xarray Dataset (assembled from the batch files first if missing)."""
+    xr = optional_import("xarray")
+
+    path = pathlib.Path(out_dir) / "results.nc"
+    if not path.exists():
+        return assemble(out_dir)
+    with xr.open_dataset(path, engine="scipy") as ds:
+        return ds.load()

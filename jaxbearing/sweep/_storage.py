@@ -1,0 +1,105 @@
+"""Sweep output directory: atomic batch files, the spec, the log, what is already computed."""
+
+from __future__ import annotations
+
+import json
+import os
+import pathlib
+
+import numpy as np
+
+from ._spec import SweepSpec, SweepSpecError
+
+
+# -- files ---------------------------------------------------------------------------------------
+def batch_path(out_dir: pathlib.Path, batch: int) -> pathlib.Path:
+    return pathlib.Path(out_dir) / "batches" / f"batch_{batch:05d}.npz"
+
+
+def atomic_write(path: pathlib.Path, write) -> None:
+    """Write through `write(file)` to a temporary file next to `path`, fsync, os.replace."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
+    with open(tmp, "wb") as f:
+        write(f)
+        f.flush()
+        os.fsync(f.fileno())
+    os.replace(tmp, path)
+
+
+def write_batch(out_dir: pathlib.Path, spec: SweepSpec, batch: int, data: dict) -> pathlib.Path:
+    path = batch_path(out_dir, batch)
+    atomic_write(path, lambda f: np.savez(f, spec_hash=np.asarray(spec.hash),
+                                           batch=np.int64(batch), **data))
+    return path
+
+
+def read_batch(out_dir: pathlib.Path, spec: SweepSpec, batch: int) -> dict | None:
+    """The contents of a finished batch file, or None if it is missing, unreadable, of another
+    spec or of other cases."""
+    path = batch_path(out_dir, batch)
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            data = {k: z[k] for k in z.files}
+    except (OSError, ValueError, EOFError, KeyError):
+        return None
+    if str(data.get("spec_hash")) != spec.hash:
+        return None
+    if not np.array_equal(data.get("case_index"), spec.batch_cases(batch)):
+        return None
+    return data
+
+
+def append_log(out_dir: pathlib.Path, record: dict) -> None:
+    line = json.dumps(record) + "\n"
+    fd = os.open(pathlib.Path(out_dir) / "sweep.log", os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o644)
+    try:
+        os.write(fd, line.encode())
+    finally:
+        os.close(fd)
+
+
+def computed_batches(out_dir: str | os.PathLike) -> list[int]:
+    """Batch indices computed so far, from DIR/sweep.log, one entry per computation."""
+    path = pathlib.Path(out_dir) / "sweep.log"
+    if not path.exists():
+        return []
+    out = []
+    for line in path.read_text().splitlines():
+        try:
+            rec = json.loads(line)
+        except json.JSONDecodeError:
+            continue  # a line cut by a kill
+        if rec.get("event") == "batch":
+            out.append(int(rec["batch"]))
+    return out
+
+
+def prepare_dir(out_dir: pathlib.Path, spec: SweepSpec, resume: bool, process_id: int) -> None:
+    """Create DIR and DIR/spec.json; a DIR holding another sweep is an error when resuming."""
+    out_dir.mkdir(parents=True, exist_ok=True)
+    spec_file = out_dir / "spec.json"
+    if spec_file.exists() and resume:
+        try:
+            old = json.loads(spec_file.read_text())
+        except (OSError, json.JSONDecodeError):
+            old = None
+        if old is not None and old.get("hash") != spec.hash:
+            raise SweepSpecError(
+                "--out", f"{out_dir} holds another sweep (spec hash {old.get('hash')}, this one "
+                f"{spec.hash}; the spec or --batch-size changed); use another --out or --no-resume")
+    if process_id == 0:
+        doc = {"hash": spec.hash, "spec": spec.canonical()}
+        atomic_write(spec_file, lambda f: f.write(json.dumps(doc, indent=1, allow_nan=True).encode()))
+        if not resume:
+            (out_dir / "results.nc").unlink(missing_ok=True)
+
+
+def load_spec_from_dir(out_dir: str | os.PathLike) -> SweepSpec:
+    """The spec of the sweep in DIR (from DIR/spec.json)."""
+    path = pathlib.Path(out_dir) / "spec.json"
+    try:
+        doc = json.loads(path.read_text())
+    except OSError:
+        raise SweepSpecError("DIR", f"{out_dir} is not a sweep directory (no spec.json)") from None
+    return SweepSpec.from_canonical(doc["spec"])

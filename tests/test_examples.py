@@ -1,0 +1,45 @@
+"""Every file under examples/ is valid: configurations load, sweep specs validate (every case),
+the optimiser settings parse. Nothing is integrated here."""
+
+from __future__ import annotations
+
+import pathlib
+
+import pytest
+
+import jaxbearing as jb
+from optimise import load_optimise_toml
+
+EXAMPLES = pathlib.Path(__file__).resolve().parents[1] / "examples"
+
+
+def _files(pattern):
+    return sorted(EXAMPLES.glob(pattern), key=lambda p: p.name)
+
+
+def test_examples_exist():
+    names = {p.name for p in EXAMPLES.iterdir()}
+    assert {"reference.toml", "flat_end.toml", "optimise.toml"} <= names
+    assert _files("*sweep*.toml")
+
+
+@pytest.mark.parametrize("path", [p for p in _files("*.toml") if "sweep" not in p.name
+                                  and p.name != "optimise.toml"], ids=lambda p: p.name)
+def test_configuration_loads(path):
+    cfg = jb.load_config(path)
+    cfg.bearing()
+
+
+def test_reference_example_is_the_reference():
+    assert jb.load_config(EXAMPLES / "reference.toml").to_dict() == jb.reference_config().to_dict()
+
+
+@pytest.mark.parametrize("path", _files("*sweep*.toml"), ids=lambda p: p.name)
+def test_sweep_spec_validates(path):
+    spec = jb.load_sweep_spec(path)
+    assert spec.num_cases >= 2
+
+
+def test_optimise_settings_parse():
+    settings = load_optimise_toml(str(EXAMPLES / "optimise.toml"))
+    assert settings["end_radius_mm"] == [60.0, 120.0]
