@@ -43,8 +43,6 @@ from .geometry import (  # noqa: E402
     Roller,
     kinematic_cage_speed,
     rad_s_to_rpm,
-    reference_bearing,
-    reference_operating_point,
     rpm_to_rad_s,
 )
 from .io import (  # noqa: E402
@@ -52,7 +50,9 @@ from .io import (  # noqa: E402
     SimulationSettings,
     load_config,
     loads_config,
+    reference_bearing,
     reference_config,
+    reference_operating_point,
     validate_bearing,
 )
 from .run import (  # noqa: E402

@@ -43,6 +43,7 @@ import jax.numpy as jnp
 import numpy as np
 import optax
 
+from jaxbearing import UserInputError
 from jaxbearing.flange import DesignVariables
 from jaxbearing.run import forward_jacobian
 
@@ -171,16 +172,11 @@ def search(
     (u, x, objective, margins, feasible, best) for progress reporting."""
     t_start = time.perf_counter()
     if num_starts < 1:
-        from jaxbearing import UserInputError
-
         raise UserInputError(f"starts = {num_starts}: must be >= 1")
     if num_iterations < 1:
-        from jaxbearing import UserInputError
-
         raise UserInputError(f"iterations = {num_iterations}: must be >= 1")
     u = np.asarray(starts, dtype=float) if starts is not None else start_points(problem, num_starts)
     num_starts = u.shape[0]
-    k = problem.num_operating_points
     x_start = np.asarray(problem.bounds.from_scaled(u[0]))
     start_margins = np.asarray(margins_batch(problem, jnp.asarray(u[:1])))[0]
 
@@ -195,46 +191,15 @@ def search(
         )
 
     hyper = _Hyper(float(learning_rate), int(num_iterations), float(rho))
-    uj = jnp.asarray(u)
-    opt_state = jax.vmap(hyper.optimiser().init)(uj)
-    lam = jnp.zeros((num_starts, 4))
-    times = []
-
-    hist = {k_: [] for k_ in ("u", "x", "objective", "margins", "multipliers", "peak_pv")}
-    best = (np.inf, -1, -1)
-    # iteration i evaluates the objective at u_i (before its update); one extra pass
-    # evaluates the final iterate
-    for it in range(num_iterations + 1):
-        t_it = time.perf_counter()
-        u_new, opt_state_new, lam_new, val, pv, marg = _iterate(problem, hyper, uj, opt_state, lam)
-        val, pv, marg = np.asarray(val), np.asarray(pv), np.asarray(marg)
-        times.append(time.perf_counter() - t_it)
-        x = np.asarray(problem.bounds.from_scaled(uj))
-        feas = np.all(marg > 0, axis=1) & np.isfinite(val)
-        for s in np.where(feas)[0]:
-            if val[s] < best[0]:
-                best = (float(val[s]), it, int(s))
-        hist["u"].append(np.asarray(uj))
-        hist["x"].append(x)
-        hist["objective"].append(val)
-        hist["margins"].append(marg)
-        hist["multipliers"].append(np.asarray(lam))
-        hist["peak_pv"].append(pv)
-        if callback is not None:
-            callback(it, dict(u=np.asarray(uj), x=x, objective=val, margins=marg, feasible=feas,
-                              best=best[0]))
-        if it < num_iterations:
-            uj, opt_state, lam = u_new, opt_state_new, lam_new
-    history = {k_: np.stack(v) for k_, v in hist.items()}
-    wall = time.perf_counter() - t_start
+    history, best, times = _iterations(problem, hyper, jnp.asarray(u), callback)
     # the first call compiles (unless cached): its excess over the later iterations
     compile_time = max(0.0, times[0] - float(np.median(times[1:]))) if len(times) > 1 else 0.0
-    n_eval = (num_iterations + 1) * num_starts * k
-    start_obj = float(history["objective"][0, 0])
     common = dict(
-        start_design=x_start, start_objective=start_obj, start_margins=start_margins,
-        history=history, num_model_evaluations=n_eval, num_iterations=num_iterations,
-        wall_time_s=wall, compile_time_s=compile_time,
+        start_design=x_start, start_objective=float(history["objective"][0, 0]),
+        start_margins=start_margins, history=history,
+        num_model_evaluations=(num_iterations + 1) * num_starts * problem.num_operating_points,
+        num_iterations=num_iterations, wall_time_s=time.perf_counter() - t_start,
+        compile_time_s=compile_time,
     )
     if best[1] < 0:
         return SearchResult(status="no_feasible_iterate", feasible=False, design=None,
@@ -245,6 +210,37 @@ def search(
         peak_pv=history["peak_pv"][i, s], margins=history["margins"][i, s],
         best_start=s, best_iteration=i, **common,
     )
+
+
+def _iterations(problem: DesignProblem, hyper: _Hyper, uj, callback):
+    """Run the search from the scaled starts `uj` (S, 3): (history of stacked per-iteration
+    arrays, best feasible (objective, iteration, start), wall time of each iteration).
+    Iteration i evaluates the objective at u_i (before its update); one extra pass evaluates
+    the final iterate."""
+    opt_state = jax.vmap(hyper.optimiser().init)(uj)
+    lam = jnp.zeros((uj.shape[0], 4))
+    times = []
+    hist = {k_: [] for k_ in ("u", "x", "objective", "margins", "multipliers", "peak_pv")}
+    best = (np.inf, -1, -1)
+    for it in range(hyper.num_iterations + 1):
+        t_it = time.perf_counter()
+        u_new, opt_state_new, lam_new, val, pv, marg = _iterate(problem, hyper, uj, opt_state, lam)
+        val, pv, marg = np.asarray(val), np.asarray(pv), np.asarray(marg)
+        times.append(time.perf_counter() - t_it)
+        x = np.asarray(problem.bounds.from_scaled(uj))
+        feas = np.all(marg > 0, axis=1) & np.isfinite(val)
+        for s in np.where(feas)[0]:
+            if val[s] < best[0]:
+                best = (float(val[s]), it, int(s))
+        for key, value in (("u", np.asarray(uj)), ("x", x), ("objective", val), ("margins", marg),
+                           ("multipliers", np.asarray(lam)), ("peak_pv", pv)):
+            hist[key].append(value)
+        if callback is not None:
+            callback(it, dict(u=np.asarray(uj), x=x, objective=val, margins=marg, feasible=feas,
+                              best=best[0]))
+        if it < hyper.num_iterations:
+            uj, opt_state, lam = u_new, opt_state_new, lam_new
+    return {k_: np.stack(v) for k_, v in hist.items()}, best, times
 
 
 def grid_search(problem: DesignProblem, n_end_radius: int, n_layback: int, axial_clearance: float,

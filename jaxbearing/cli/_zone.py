@@ -120,90 +120,85 @@ def _height_feasible(z):
     )
 
 
-def write_maps(bearing, flange_load: float, out_dir: str) -> list[str]:
+def _draw_map(x, y, field, *, colorbar, contours, feasible, star, xlabel, ylabel, title,
+              legend_loc, path, **contourf_kw) -> str:
+    """One design-zone map: filled `field` over (x, y), zero lines of each (margin, colour,
+    label) in `contours`, the feasible region hatched, the current design `star` (or None)."""
     import numpy as np
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
 
     from ..io import pyplot
 
     plt = pyplot()
+    fig, ax = plt.subplots(figsize=(7.5, 5.5), dpi=110)
+    cf = ax.contourf(x, y, field, **contourf_kw)
+    fig.colorbar(cf, ax=ax, label=colorbar)
+    handles = []
+    for margin, colour, label in contours:
+        ax.contour(x, y, np.asarray(margin), levels=[0.0], colors=colour, linewidths=2)
+        handles.append(Line2D([], [], color=colour, lw=2, label=label))
+    if feasible.any():
+        ax.contourf(x, y, feasible.astype(float), levels=[0.5, 1.5], colors="none", hatches=["//"])
+    handles.append(Patch(facecolor="none", edgecolor="k", hatch="//", label="feasible"))
+    if star is not None:
+        ax.plot(*([v] for v in star), marker="*", ms=16, color="magenta", mec="k", ls="none")
+    handles.append(Line2D([], [], marker="*", ms=12, color="magenta", mec="k", ls="none",
+                          label="current design"))
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
+    ax.legend(handles=handles, loc=legend_loc, fontsize=8, framealpha=0.85)
+    fig.savefig(path)
+    plt.close(fig)
+    return path
+
+
+def write_maps(bearing, flange_load: float, out_dir: str) -> list[str]:
+    """The paper's Figure 14 for `bearing`: contact height over (R_end, theta_f) and actual
+    axial clearance over (R_end, Delta_bf), with the design-zone limits and the current design."""
+    import numpy as np
     from matplotlib.colors import TwoSlopeNorm
-    from matplotlib.lines import Line2D
-    from matplotlib.patches import Patch
 
     os.makedirs(out_dir, exist_ok=True)
     (r_mm, t_deg, hz), (_, c_mm, cz) = zone_maps(bearing, flange_load)
     r_now = float(bearing.roller.end_radius) / MM
     t_now = math.degrees(float(bearing.flange.layback_angle))
     c_now = float(bearing.flange.axial_clearance) / MM
-    paths = []
-
-    # -- contact height over R_end x theta_f -----------------------------------------------
-    fig, ax = plt.subplots(figsize=(7.5, 5.5), dpi=110)
-    cf = ax.contourf(r_mm, t_deg, np.asarray(hz.contact_height) / MM, levels=24, cmap="viridis")
-    fig.colorbar(cf, ax=ax, label="contact height h_c [mm]")
+    in_range = END_RADIUS_RANGE_MM[0] <= r_now <= END_RADIUS_RANGE_MM[1]
     # the limited-circle line is drawn from the arc contact radius R_end sin(theta_f), which
     # is smooth across it (the actual contact radius has a kink there); the relief line is
     # drawn only where the contact is on the arc (on the corner the ellipse is much narrower)
     rr, tt = np.meshgrid(r_mm * MM, np.radians(t_deg))
     arc_radius_margin = np.asarray(hz.limited_circle_radius) - rr * np.sin(tt)
     on_arc = np.asarray(hz.on_arc) > 0.5
-    lines = [
-        (hz.height_margin, "tab:red", "upper limit h_c = h_up"),
-        (np.where(on_arc, hz.relief_margin, np.nan), "tab:orange",
-         "relief (lower) limit h_c - a = h_rel"),
-        (arc_radius_margin, "white", "limited circle rho_c = rho_lim"),
-    ]
-    handles = []
-    for field, colour, label in lines:
-        ax.contour(r_mm, t_deg, np.asarray(field), levels=[0.0], colors=colour, linewidths=2)
-        handles.append(Line2D([], [], color=colour, lw=2, label=label))
-    feas = _height_feasible(hz).astype(float)
-    if feas.any():
-        ax.contourf(r_mm, t_deg, feas, levels=[0.5, 1.5], colors="none", hatches=["//"])
-    handles.append(Patch(facecolor="none", edgecolor="k", hatch="//", label="feasible"))
-    if END_RADIUS_RANGE_MM[0] <= r_now <= END_RADIUS_RANGE_MM[1]:
-        ax.plot([r_now], [t_now], marker="*", ms=16, color="magenta", mec="k", ls="none")
-    handles.append(Line2D([], [], marker="*", ms=12, color="magenta", mec="k", ls="none",
-                          label="current design"))
-    ax.set_xlabel("end radius R_end [mm]")
-    ax.set_ylabel("flange layback angle theta_f [deg]")
-    ax.set_title(
-        f"Contact height (Delta_bf = {c_now:.3f} mm, flange load {flange_load:.0f} N)"
+    height = _draw_map(
+        r_mm, t_deg, np.asarray(hz.contact_height) / MM, levels=24, cmap="viridis",
+        colorbar="contact height h_c [mm]",
+        contours=[
+            (hz.height_margin, "tab:red", "upper limit h_c = h_up"),
+            (np.where(on_arc, hz.relief_margin, np.nan), "tab:orange",
+             "relief (lower) limit h_c - a = h_rel"),
+            (arc_radius_margin, "white", "limited circle rho_c = rho_lim"),
+        ],
+        feasible=_height_feasible(hz), star=(r_now, t_now) if in_range else None,
+        xlabel="end radius R_end [mm]", ylabel="flange layback angle theta_f [deg]",
+        title=f"Contact height (Delta_bf = {c_now:.3f} mm, flange load {flange_load:.0f} N)",
+        legend_loc="upper right", path=os.path.join(out_dir, "zone_height_map.png"),
     )
-    ax.legend(handles=handles, loc="upper right", fontsize=8, framealpha=0.85)
-    path = os.path.join(out_dir, "zone_height_map.png")
-    fig.savefig(path)
-    plt.close(fig)
-    paths.append(path)
-
-    # -- actual axial clearance over R_end x Delta_bf ---------------------------------------
-    fig, ax = plt.subplots(figsize=(7.5, 5.5), dpi=110)
     lam = np.asarray(cz.actual_axial_clearance) / MM
     span = max(float(np.max(np.abs(lam))), 1e-6)
-    cf = ax.contourf(
+    clearance = _draw_map(
         r_mm, c_mm, lam, levels=np.linspace(-span, span, 25), cmap="coolwarm_r",
         norm=TwoSlopeNorm(0.0, -span, span),
+        colorbar="actual axial clearance Lambda_bf [mm]",
+        contours=[(lam, "k", "Lambda_bf = 0 (contact line)")],
+        feasible=np.asarray(cz.clearance_margin) > 0, star=(r_now, c_now) if in_range else None,
+        xlabel="end radius R_end [mm]", ylabel="axial clearance Delta_bf [mm]",
+        title=f"Actual axial clearance (theta_f = {t_now:.2f} deg)",
+        legend_loc="lower right", path=os.path.join(out_dir, "zone_clearance_map.png"),
     )
-    fig.colorbar(cf, ax=ax, label="actual axial clearance Lambda_bf [mm]")
-    ax.contour(r_mm, c_mm, lam, levels=[0.0], colors="k", linewidths=2)
-    handles = [Line2D([], [], color="k", lw=2, label="Lambda_bf = 0 (contact line)")]
-    ok = (np.asarray(cz.clearance_margin) > 0).astype(float)
-    if ok.any():
-        ax.contourf(r_mm, c_mm, ok, levels=[0.5, 1.5], colors="none", hatches=["//"])
-    handles.append(Patch(facecolor="none", edgecolor="k", hatch="//", label="feasible"))
-    if END_RADIUS_RANGE_MM[0] <= r_now <= END_RADIUS_RANGE_MM[1]:
-        ax.plot([r_now], [c_now], marker="*", ms=16, color="magenta", mec="k", ls="none")
-    handles.append(Line2D([], [], marker="*", ms=12, color="magenta", mec="k", ls="none",
-                          label="current design"))
-    ax.set_xlabel("end radius R_end [mm]")
-    ax.set_ylabel("axial clearance Delta_bf [mm]")
-    ax.set_title(f"Actual axial clearance (theta_f = {t_now:.2f} deg)")
-    ax.legend(handles=handles, loc="lower right", fontsize=8, framealpha=0.85)
-    path = os.path.join(out_dir, "zone_clearance_map.png")
-    fig.savefig(path)
-    plt.close(fig)
-    paths.append(path)
-    return paths
+    return [height, clearance]
 
 
 def run(args) -> int:

@@ -29,6 +29,7 @@ import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
+from jaxtyping import Array
 
 from ..flange import FLANGE_ORDER, all_flange_contacts
 from ..forces import (
@@ -117,30 +118,39 @@ def contact_loads(state: State, params: Params) -> Loads:
 
 
 def physical_rates(t, state: State, params: Params) -> State:
-    """d(state)/dt in physical units."""
+    """d(state)/dt in physical units: every contact of the state (`contact_loads`), then the
+    rates of the rollers, the cage, the inner ring and the smooth flange functionals."""
     del t
-    b, op, fn = params.bearing, params.operating, params.functionals
-    r = state.rollers
     loads = contact_loads(state, params)
-    fl = loads.flange
+    return State(
+        rollers=_roller_rates(state.rollers, loads, params),
+        cage=_cage_rates(state.cage, loads, params),
+        inner_ring=_inner_ring_rates(state.inner_ring, loads, params),
+        accumulators=_functional_rates(loads.flange, params.functionals),
+    )
 
+
+def _gravity(op: OperatingPoint) -> Array:
+    return op.gravity * jnp.array([0.0, 0.0, 1.0])
+
+
+def _roller_rates(r: RollerState, loads: Loads, params: Params) -> RollerState:
+    """Newton's law in the orbiting (axial, radial, azimuth) coordinates with centrifugal and
+    Coriolis terms, and Euler's equations of the axisymmetric roller (gyroscopic terms kept)."""
+    b, fl = params.bearing, loads.flange
     m_b = b.roller_mass
     i_a, i_t = b.roller_inertia[0], b.roller_inertia[1]
-    g = op.gravity * jnp.array([0.0, 0.0, 1.0])
     e = r.axis / jnp.linalg.norm(r.axis, axis=-1, keepdims=True)
     w = r.angular_velocity
-
-    # -- rollers -----------------------------------------------------------------------
-    orbital_v = r.velocity
     spin = jnp.sum(w * e, axis=-1)
-    drag_f, drag_m = jax.vmap(roller_drag, in_axes=(None, 0, 0))(b, orbital_v, spin)
+    drag_f, drag_m = jax.vmap(roller_drag, in_axes=(None, 0, 0))(b, r.velocity, spin)
     force = (
         loads.inner.force_on_roller
         + loads.outer.force_on_roller
         + jnp.sum(fl.force_on_roller, axis=1)
         + loads.pocket.force_on_roller
         + drag_f
-        + m_b * g
+        + m_b * _gravity(params.operating)
     )
     moment = (
         loads.inner.moment_on_roller
@@ -150,63 +160,64 @@ def physical_rates(t, state: State, params: Params) -> State:
         + drag_m[:, None] * e
     )
     e_rad, e_tan = radial_unit(r.azimuth), tangential_unit(r.azimuth)
-    f_x = force[:, 0]
     f_r = jnp.sum(force * e_rad, axis=-1)
     f_t = jnp.sum(force * e_tan, axis=-1)
-    axial_acc = f_x / m_b
-    radial_acc = f_r / m_b + r.radial * r.azimuth_rate**2
-    azimuth_acc = (f_t / m_b - 2 * r.radial_velocity * r.azimuth_rate) / r.radial
-
     axis_rate, omega_dot = axisymmetric_body_rates(r.axis, w, moment, i_a, i_t)
-
-    rollers = RollerState(
+    return RollerState(
         axial=r.axial_velocity,
         radial=r.radial_velocity,
         azimuth=r.azimuth_rate,
         axis=axis_rate,
-        axial_velocity=axial_acc,
-        radial_velocity=radial_acc,
-        azimuth_rate=azimuth_acc,
+        axial_velocity=force[:, 0] / m_b,
+        radial_velocity=f_r / m_b + r.radial * r.azimuth_rate**2,
+        azimuth_rate=(f_t / m_b - 2 * r.radial_velocity * r.azimuth_rate) / r.radial,
         angular_velocity=omega_dot,
     )
 
-    # -- cage --------------------------------------------------------------------------
-    cage = state.cage
+
+def _cage_rates(cage: CageState, loads: Loads, params: Params) -> CageState:
+    """Cage: radial motion under pocket, land and weight forces; rotation under pocket, land
+    and drag torques."""
+    b = params.bearing
     cage_c = jnp.concatenate([jnp.zeros(1), cage.centre])
     cage_v = jnp.concatenate([jnp.zeros(1), cage.velocity])
     land_f, land_m = cage_land_forces(b, cage_c, cage_v, cage.speed)
-    cage_force = jnp.sum(loads.pocket.force_on_cage, axis=0) + land_f + b.cage_mass * g
-    cage_torque = (
-        jnp.sum(loads.pocket.moment_on_cage[:, 0]) + land_m + cage_drag_torque(b, cage.speed)
+    force = (
+        jnp.sum(loads.pocket.force_on_cage, axis=0) + land_f + b.cage_mass * _gravity(params.operating)
     )
-    cage_rates = CageState(
+    torque = jnp.sum(loads.pocket.moment_on_cage[:, 0]) + land_m + cage_drag_torque(b, cage.speed)
+    return CageState(
         centre=cage.velocity,
         angle=cage.speed,
-        velocity=cage_force[1:] / b.cage_mass,
-        speed=cage_torque / b.cage_inertia[0],
+        velocity=force[1:] / b.cage_mass,
+        speed=torque / b.cage_inertia[0],
     )
 
-    # -- inner ring --------------------------------------------------------------------
+
+def _inner_ring_rates(ring: RingState, loads: Loads, params: Params) -> RingState:
+    """Inner ring: radial motion under raceway and inner-flange forces, the applied radial load
+    and its weight (spin prescribed)."""
+    b, op, fl = params.bearing, params.operating, loads.flange
     inner_flanges = jnp.asarray([ring_sign > 0 for ring_sign, _ in FLANGE_ORDER])
-    ring_force = (
+    force = (
         jnp.sum(loads.inner.force_on_ring, axis=0)
         + jnp.sum(jnp.where(inner_flanges[None, :, None], fl.force_on_ring, 0.0), axis=(0, 1))
         + op.radial_load * jnp.array([0.0, 0.0, 1.0])
-        + b.inner_ring_mass * g
+        + b.inner_ring_mass * _gravity(op)
     )
-    ring_rates = RingState(
-        centre=state.inner_ring.velocity, velocity=ring_force[1:] / b.inner_ring_mass
-    )
+    return RingState(centre=ring.velocity, velocity=force[1:] / b.inner_ring_mass)
 
-    # -- smooth peak functionals -------------------------------------------------------
+
+def _functional_rates(fl, fn: Functionals) -> Accumulators:
+    """Integrands of the smooth peak functionals (p-norm of PV, log-sum-exp of contact height),
+    each weighted by the contact indicator Q / (Q + Q_ref)."""
     q = fl.normal_force
     w_c = q / (q + fn.contact_load)
     # clipped so that states diffrax may visit during step rejection stay finite
     dh = jnp.clip(fl.contact_height - fn.height_reference, -5e-3, 5e-3)
-    acc = Accumulators(
+    return Accumulators(
         pv_power=w_c * (fl.pv / fn.pv_reference) ** fn.pv_exponent,
         height_max_power=w_c * jnp.exp(fn.height_sharpness * dh),
         height_min_power=w_c * jnp.exp(-fn.height_sharpness * dh),
         contact_time=w_c,
     )
-    return State(rollers=rollers, cage=cage_rates, inner_ring=ring_rates, accumulators=acc)

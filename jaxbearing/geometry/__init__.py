@@ -22,8 +22,6 @@ from ._params import (
     Roller,
     kinematic_cage_speed,
     rad_s_to_rpm,
-    reference_bearing,
-    reference_operating_point,
     rpm_to_rad_s,
 )
 from ._roller_end import (
@@ -59,8 +57,6 @@ __all__ = [
     "kinematic_cage_speed",
     "limited_circle_radius",
     "rad_s_to_rpm",
-    "reference_bearing",
-    "reference_operating_point",
     "roller_mass_properties",
     "rpm_to_rad_s",
     "sag",

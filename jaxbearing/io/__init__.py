@@ -8,7 +8,15 @@ May import: `jaxbearing._errors`, `jaxbearing.geometry`.
 """
 
 from ._checks import is_concrete, require
-from ._config import Config, SimulationSettings, load_config, loads_config, reference_config
+from ._config import (
+    Config,
+    SimulationSettings,
+    load_config,
+    loads_config,
+    reference_bearing,
+    reference_config,
+    reference_operating_point,
+)
 from ._extras import optional_import, pyplot
 from ._validation import KEY_BY_PATH, KEYS, format_value, type_name, validate_bearing
 
@@ -23,7 +31,9 @@ __all__ = [
     "loads_config",
     "optional_import",
     "pyplot",
+    "reference_bearing",
     "reference_config",
+    "reference_operating_point",
     "require",
     "type_name",
     "validate_bearing",

@@ -355,5 +355,22 @@ def load_config(path: str | os.PathLike[str] | None = None) -> Config:
 
 
 def reference_config() -> Config:
-    """The embedded reference configuration (reference_bearing(), reference_operating_point())."""
+    """The embedded reference configuration: every key at its reference value (`KEYS`)."""
     return Config()
+
+
+def reference_bearing() -> Bearing:
+    """The embedded reference bearing of MODEL.md section 2, built from the reference values of
+    the configuration schema (the one place they are written down, `io/_validation.py`).
+
+    Representative, not the source study's bearing: the paper's Table 1 is not available. The
+    values are an aero-engine mainshaft roller bearing chosen so that the paper's stated values
+    (H_rf = 2 mm, contact-height limit 1.8 mm, R_end = 80 mm, theta_f = 1.6 deg,
+    Delta_bf = 0.15 mm, L_b2 = 4.5 mm) give the same kind of design zone.
+    """
+    return Config().bearing()
+
+
+def reference_operating_point() -> OperatingPoint:
+    """20,000 rpm on the inner ring, 1000 N radial load, gravity on (the reference configuration)."""
+    return Config().operating_point()

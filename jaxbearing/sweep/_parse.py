@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import difflib
 import math
 import numbers
 import os
@@ -87,25 +88,47 @@ def _coordinate_names(keys: Sequence[str]) -> dict[str, str]:
 
 
 def build_spec(data: Mapping[str, Any], base_dir: str | os.PathLike | None = None) -> SweepSpec:
-    """A validated `SweepSpec` from the parsed TOML of a spec (see the module docstring).
+    """A validated `SweepSpec` from the parsed TOML of a spec (see `jaxbearing.sweep._spec`).
 
     Every case is validated through `Config.replace`; errors name the axis."""
     unknown = [k for k in data if k not in ("sweep", "base", "axes")]
     if unknown:
         raise SweepSpecError(unknown[0], "unknown table; a sweep spec has [sweep], [base] "
                              "and [axes]")
-    sweep = data.get("sweep", {})
+    sweep = _sweep_table(data.get("sweep", {}))
+    base = _base_config(sweep, data.get("base", {}), base_dir)
+    values = _axis_values_by_key(data.get("axes", {}))
+    if "end" not in values and base.simulation.end == "both":
+        values["end"] = ("arc", "corner")
+    axes, dims, shape = _dimensions(sweep, values)
+    spec = SweepSpec(
+        base=base,
+        axes=axes,
+        dims=dims,
+        shape=shape,
+        batch_size=_positive_int("sweep.batch_size", sweep.get("batch_size", 8)),
+        num_saves=_positive_int("sweep.num_saves", sweep.get("num_saves", 400)),
+        max_positions=_positive_int("sweep.max_positions", sweep.get("max_positions", 500)),
+    )
+    validate_cases(spec)
+    return spec
+
+
+def _sweep_table(sweep) -> Mapping[str, Any]:
+    """The [sweep] table, its field names checked ("did you mean")."""
     if not isinstance(sweep, Mapping):
         raise SweepSpecError("sweep", f"expected a table, got {type_name(sweep)}")
     for k in sweep:
         if k not in _SWEEP_FIELDS:
-            import difflib
-
             near = difflib.get_close_matches(k, _SWEEP_FIELDS, n=1)
             hint = f"did you mean sweep.{near[0]}?" if near else "valid: " + ", ".join(_SWEEP_FIELDS)
             raise SweepSpecError(f"sweep.{k}", f"unknown field; {hint}")
+    return sweep
 
-    # base configuration: file (relative to the spec) and/or inline [base] tables
+
+def _base_config(sweep: Mapping[str, Any], inline, base_dir) -> Config:
+    """The base configuration: `sweep.base` (a file relative to the spec, or "reference"), with
+    the inline [base.*] tables merged over it."""
     base_ref = sweep.get("base", "reference")
     if not isinstance(base_ref, str):
         raise SweepSpecError("sweep.base", f"expected a config file path or \"reference\", "
@@ -120,29 +143,31 @@ def build_spec(data: Mapping[str, Any], base_dir: str | os.PathLike | None = Non
             base = load_config(path)
         except ConfigError as exc:
             raise SweepSpecError("sweep.base", f"{path}: {exc}") from None
-    inline = data.get("base", {})
-    if inline:
-        if not isinstance(inline, Mapping):
-            raise SweepSpecError("base", f"expected a table, got {type_name(inline)}")
-        merged = base.to_dict()
-        for section, table in inline.items():
-            if isinstance(table, Mapping) and isinstance(merged.get(section), dict):
-                for name, value in table.items():
-                    if isinstance(value, Mapping) and isinstance(merged[section].get(name), dict):
-                        merged[section][name].update(value)
-                    else:
-                        merged[section][name] = value
-            else:
-                merged[section] = table
-        try:
-            base = Config(merged)
-        except ConfigError as exc:
-            raise SweepSpecError(f"base.{exc.field}", str(exc).partition(": ")[2]) from None
+    if not inline:
+        return base
+    if not isinstance(inline, Mapping):
+        raise SweepSpecError("base", f"expected a table, got {type_name(inline)}")
+    merged = base.to_dict()
+    for section, table in inline.items():
+        if isinstance(table, Mapping) and isinstance(merged.get(section), dict):
+            for name, value in table.items():
+                if isinstance(value, Mapping) and isinstance(merged[section].get(name), dict):
+                    merged[section][name].update(value)
+                else:
+                    merged[section][name] = value
+        else:
+            merged[section] = table
+    try:
+        return Config(merged)
+    except ConfigError as exc:
+        raise SweepSpecError(f"base.{exc.field}", str(exc).partition(": ")[2]) from None
 
-    axes_raw = data.get("axes", {})
+
+def _flat_axes(axes_raw) -> dict[str, Any]:
+    """{dotted key: raw values}: TOML dotted keys without quotes arrive nested
+    ({"operating": {"speed_rpm": [...]}})."""
     if not isinstance(axes_raw, Mapping):
         raise SweepSpecError("axes", f"expected a table of axes, got {type_name(axes_raw)}")
-    # TOML dotted keys without quotes arrive nested: {"operating": {"speed_rpm": [...]}}
     flat: dict[str, Any] = {}
 
     def walk(node, prefix):
@@ -157,8 +182,13 @@ def build_spec(data: Mapping[str, Any], base_dir: str | os.PathLike | None = Non
     if not flat:
         raise SweepSpecError("axes", "no axes: give at least one, e.g. "
                              "\"operating.speed_rpm\" = [10000, 20000]")
+    return flat
+
+
+def _axis_values_by_key(axes_raw) -> dict[str, tuple]:
+    """{axis key: values}, each axis key and value checked (engineering units, no duplicates)."""
     values: dict[str, tuple] = {}
-    for key, raw in flat.items():
+    for key, raw in _flat_axes(axes_raw).items():
         _check_axis_key(key)
         vals = _axis_values(key, raw)
         if key == "end":
@@ -178,13 +208,11 @@ def build_spec(data: Mapping[str, Any], base_dir: str | os.PathLike | None = Non
             dup = next(v for v in vals if vals.count(v) > 1)
             raise SweepSpecError(key, f"value {format_value(dup)} appears twice")
         values[key] = vals
-    if "end" not in values and base.simulation.end == "both":
-        values["end"] = ("arc", "corner")
+    return values
 
-    # dimensions: every axis its own, unless zipped
-    mode = sweep.get("mode", "grid")
-    if mode not in ("grid", "zip"):
-        raise SweepSpecError("sweep.mode", f"{format_value(mode)} is not \"grid\" or \"zip\"")
+
+def _zip_groups(sweep: Mapping[str, Any], values: Mapping[str, tuple], mode: str) -> dict[str, int]:
+    """{axis key: zip group} from `sweep.mode` / `sweep.zip`; zipped axes have equal lengths."""
     groups_raw = sweep.get("zip", [])
     if mode == "zip":
         if groups_raw:
@@ -210,6 +238,15 @@ def build_spec(data: Mapping[str, Any], base_dir: str | os.PathLike | None = Non
             other = next(k for k in group if lengths[k] != lengths[first])
             raise SweepSpecError(other, f"zipped axes must have equal lengths: {other} has "
                                  f"{lengths[other]} values, {first} has {lengths[first]}")
+    return grouped
+
+
+def _dimensions(sweep: Mapping[str, Any], values: Mapping[str, tuple]):
+    """(axes, dims, shape): every axis its own dimension, unless zipped."""
+    mode = sweep.get("mode", "grid")
+    if mode not in ("grid", "zip"):
+        raise SweepSpecError("sweep.mode", f"{format_value(mode)} is not \"grid\" or \"zip\"")
+    grouped = _zip_groups(sweep, values, mode)
     names = _coordinate_names(list(values))
     dims: list[str] = []
     shape: list[int] = []
@@ -228,18 +265,7 @@ def build_spec(data: Mapping[str, Any], base_dir: str | os.PathLike | None = Non
             dims.append(dim)
             shape.append(len(vals))
         axes.append(Axis(key, names[key], vals, dim))
-
-    spec = SweepSpec(
-        base=base,
-        axes=tuple(axes),
-        dims=tuple(dims),
-        shape=tuple(shape),
-        batch_size=_positive_int("sweep.batch_size", sweep.get("batch_size", 8)),
-        num_saves=_positive_int("sweep.num_saves", sweep.get("num_saves", 400)),
-        max_positions=_positive_int("sweep.max_positions", sweep.get("max_positions", 500)),
-    )
-    validate_cases(spec)
-    return spec
+    return tuple(axes), tuple(dims), tuple(shape)
 
 
 def validate_cases(spec: SweepSpec) -> None:
