@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test bench install clean
+.PHONY: demo test lint format bench install clean
 
 $(BIN)/python:
 	@command -v $(PYTHON) >/dev/null 2>&1 || { echo "error: $(PYTHON) not found (set PYTHON=...)"; exit 1; }
@@ -20,7 +20,15 @@ install: $(STAMP)
 demo: $(STAMP)
 	MPLBACKEND=Agg $(BIN)/jaxbearing demo
 
-test: $(STAMP)
+lint: $(STAMP)
+	$(BIN)/ruff check jaxbearing optimise tests benchmarks
+	$(BIN)/ruff format --check jaxbearing optimise tests benchmarks
+
+format: $(STAMP)
+	$(BIN)/ruff check --fix jaxbearing optimise tests benchmarks
+	$(BIN)/ruff format jaxbearing optimise tests benchmarks
+
+test: $(STAMP) lint
 	MPLBACKEND=Agg $(BIN)/python -m pytest -q
 
 bench: $(STAMP)

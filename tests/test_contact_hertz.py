@@ -280,7 +280,7 @@ def test_gradient_and_hessian_through_penetration(delta):
         # loaded: the approach of the contact load is the penetration (delta >> width)
         np.testing.assert_allclose(_through_penetration(delta, rx, ry)[-1], delta, rtol=1e-6)
         # and d Q / d delta = 1.5 K delta^0.5 (Hertz), d p_max / d delta from p ~ Q^(1/3)
-        q, k = _through_penetration(delta, rx, ry)[0], _stiff(rx, ry, E_PRIME)
+        k = _stiff(rx, ry, E_PRIME)
         np.testing.assert_allclose(_pen_d1(delta, rx, ry)[0][0], 1.5 * k * delta**0.5, rtol=1e-6)
         p = _through_penetration(delta, rx, ry)[3]
         np.testing.assert_allclose(_pen_d1(delta, rx, ry)[0][3], p / 3 * 1.5 / delta, rtol=1e-6)
