@@ -4,7 +4,9 @@
   (compiled, with wall times and a `SimulationResult`), `simulation_result`,
   `flange_functionals` (smooth peak PV and contact heights for gradients), `Perturbation`
   (seeded initial roller scatter), `initial_state`, `smooth_functionals`;
-- statistics: `contact_events`, `summarise`;
+- statistics: `contact_events`, `summarise`; of settled running with 95 % confidence
+  intervals: `steady_statistics`, `revolution_statistics`, `confidence_intervals`,
+  `batch_means`, `student_t_interval`, `Estimate`;
 - design metrics through the dynamics: `design_metrics`, `design_jacobian`, `DesignMetrics`,
   `seated_perturbation`, `forward_jacobian`;
 - `plot_run`: the figures of one run.
@@ -37,6 +39,14 @@ from ._simulate import (
     smooth_functionals,
     solve,
 )
+from ._statistics import (
+    Estimate,
+    batch_means,
+    confidence_intervals,
+    revolution_statistics,
+    steady_statistics,
+    student_t_interval,
+)
 from ._summary import contact_events, summarise
 
 __all__ = [
@@ -45,10 +55,13 @@ __all__ = [
     "GRADIENT_MODE_NOTE",
     "GRADIENT_RTOL",
     "DesignMetrics",
+    "Estimate",
     "Perturbation",
     "SimulationResult",
     "Solution",
     "SolveArgs",
+    "batch_means",
+    "confidence_intervals",
     "contact_events",
     "design_jacobian",
     "design_metrics",
@@ -56,11 +69,14 @@ __all__ = [
     "forward_jacobian",
     "initial_state",
     "plot_run",
+    "revolution_statistics",
     "scaled_field",
     "seated_perturbation",
     "simulate",
     "simulation_result",
     "smooth_functionals",
     "solve",
+    "steady_statistics",
+    "student_t_interval",
     "summarise",
 ]
