@@ -7,6 +7,8 @@
 - statistics: `contact_events`, `summarise`; of settled running with 95 % confidence
   intervals: `steady_statistics`, `revolution_statistics`, `confidence_intervals`,
   `batch_means`, `student_t_interval`, `Estimate`;
+- settled running: `simulate_steady` (settling detection over cage revolutions, a window,
+  seeds), `summarise_steady`, `solve_from` (continue from any state), `check_steady_options`;
 - design metrics through the dynamics: `design_metrics`, `design_jacobian`, `DesignMetrics`,
   `seated_perturbation`, `forward_jacobian`;
 - `plot_run`: the figures of one run.
@@ -26,6 +28,14 @@ from ._design import (
     seated_perturbation,
 )
 from ._plots import plot_run
+from ._settle import (
+    SeedRun,
+    SteadyResult,
+    check_steady_options,
+    simulate_steady,
+    solve_from,
+    summarise_steady,
+)
 from ._simulate import (
     Perturbation,
     SimulationResult,
@@ -57,10 +67,13 @@ __all__ = [
     "DesignMetrics",
     "Estimate",
     "Perturbation",
+    "SeedRun",
     "SimulationResult",
     "Solution",
+    "SteadyResult",
     "SolveArgs",
     "batch_means",
+    "check_steady_options",
     "confidence_intervals",
     "contact_events",
     "design_jacobian",
@@ -73,10 +86,13 @@ __all__ = [
     "scaled_field",
     "seated_perturbation",
     "simulate",
+    "simulate_steady",
     "simulation_result",
     "smooth_functionals",
     "solve",
+    "solve_from",
     "steady_statistics",
     "student_t_interval",
     "summarise",
+    "summarise_steady",
 ]
