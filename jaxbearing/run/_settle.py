@@ -1,5 +1,5 @@
 """Settled running: integrate in cage revolutions until the cage speed stops drifting, then
-measure over a window of whole revolutions (issue 11; docs/model.md 9).
+measure over a window of whole revolutions (issue 11; docs/model.md 16).
 
 * `solve_from` continues the integration from any physical state (one call per revolution); it
   returns the saved histories and the final state. Its integrator settings are those of `solve`
