@@ -32,8 +32,10 @@ from ._settle import (
     SeedRun,
     SteadyResult,
     check_steady_options,
+    simulate,
     simulate_steady,
     solve_from,
+    summarise,
     summarise_steady,
 )
 from ._simulate import (
@@ -44,7 +46,6 @@ from ._simulate import (
     flange_functionals,
     initial_state,
     scaled_field,
-    simulate,
     simulation_result,
     smooth_functionals,
     solve,
@@ -57,7 +58,7 @@ from ._statistics import (
     steady_statistics,
     student_t_interval,
 )
-from ._summary import contact_events, summarise
+from ._summary import contact_events
 
 __all__ = [
     "GRADIENT_ATOL",

@@ -33,7 +33,9 @@ from ..dynamics import Functionals, Params, Scaling, State, state_scales
 from ..geometry import Bearing, OperatingPoint, kinematic_cage_speed, rad_s_to_rpm
 from ..io import require
 from ._simulate import Perturbation, SolveArgs, _save, initial_state, scaled_field
+from ._simulate import simulate as _simulate_fixed
 from ._statistics import steady_statistics
+from ._summary import summarise as _summarise_fixed
 
 #: defaults of the settled run
 SETTLE_TOLERANCE = 1e-3  # relative change of the revolution-mean cage speed
@@ -273,3 +275,25 @@ def summarise_steady(result: SteadyResult, threshold: float = 1.0) -> dict:
         block.update(steady_statistics([r.window for r in ok], [r.edges for r in ok], result.bearing,
                                        result.operating, threshold))
     return block
+
+
+def simulate(bearing: Bearing, op: OperatingPoint, *, settle=None, **kwargs):
+    """`jaxbearing.simulate`: without `settle`, one fixed-duration run from the quasi-static
+    start (`_simulate.simulate`, a `SimulationResult`); with `settle` ("auto", "off" or a
+    settling time in ms), a settled run (`simulate_steady`, a `SteadyResult`; `window_revs`,
+    `seeds`, `tolerance`, `settle_cap_ms` and the solver options go there)."""
+    if settle is None:
+        return _simulate_fixed(bearing, op, **kwargs)
+    kwargs.pop("duration", None)
+    kwargs.pop("num_saves", None)
+    if kwargs.get("perturbation", 1) is None:
+        kwargs["perturbation"] = Perturbation()
+    return simulate_steady(bearing, op, settle=settle, **kwargs)
+
+
+def summarise(result, threshold: float = 1.0) -> dict:
+    """`jaxbearing.summarise`: the summary.json block of a fixed run (`_summary.summarise`) or of
+    a settled run (`summarise_steady`)."""
+    if isinstance(result, SteadyResult):
+        return summarise_steady(result, threshold)
+    return _summarise_fixed(result, threshold)

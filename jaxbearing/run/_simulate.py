@@ -303,22 +303,11 @@ def simulate(
     progress: bool = False,
     perturbation: Perturbation | None = Perturbation(),
     functionals: Functionals = Functionals(),
-    settle=None,
-    **steady,
 ) -> SimulationResult:
     """Integrate the bearing for `duration` seconds from the quasi-static state.
 
     Compiles once per bearing structure (cached) and reports compile and run time separately.
-    With `settle` ("auto", "off" or a settling time in ms) the run is a settled run instead
-    (`simulate_steady`: skid start, settling, a window of `window_revs` cage revolutions,
-    `seeds` seeds; further keywords go there) and a `SteadyResult` is returned.
     """
-    if settle is not None:
-        from ._settle import simulate_steady
-
-        return simulate_steady(bearing, op, settle=settle, rtol=rtol, atol=atol, max_steps=max_steps,
-                               progress=progress, functionals=functionals,
-                               perturbation=perturbation or Perturbation(), **steady)
     from ..io import validate_bearing
 
     validate_bearing(bearing, op)

@@ -64,12 +64,7 @@ def _stats(values: np.ndarray) -> dict:
 
 
 def summarise(result, threshold: float = 1.0) -> dict:
-    """The summary.json block of one run (keys documented in the `simulate` command); for a
-    settled run (`simulate(..., settle=...)`) the block of `summarise_steady`."""
-    if hasattr(result, "runs"):
-        from ._settle import summarise_steady
-
-        return summarise_steady(result, threshold)
+    """The summary.json block of one run (keys documented in the `simulate` command)."""
     h = result.histories
     events = contact_events(h, threshold)
     kin = float(rad_s_to_rpm(kinematic_cage_speed(result.bearing, result.operating)))
