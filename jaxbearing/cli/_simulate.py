@@ -6,6 +6,8 @@ import json
 import math
 import pathlib
 
+from . import _steady
+
 _TABLE_ROWS = (
     ("flange_force_N", "flange force", "N", 1.0),
     ("flange_pressure_Pa", "peak pressure", "GPa", 1e-9),
@@ -30,6 +32,7 @@ def register(sub) -> None:
     p.add_argument("--duration-ms", type=float, help="simulated time [ms]")
     p.add_argument("--out", help="output directory (summary.json, histories .npz, plots)")
     p.add_argument("--no-progress", action="store_true", help="no progress meter")
+    _steady.add_arguments(p)
     p.set_defaults(func=run)
 
 
@@ -51,8 +54,9 @@ def _load(args):
     return cfg
 
 
-def run_cases(cfg, progress: bool = True) -> dict:
-    """Run the configured end type(s); returns {end: (result, summary)}."""
+def run_cases(cfg, progress: bool = True, steady: dict | None = None) -> dict:
+    """Run the configured end type(s); returns {end: (result, summary)}. `steady`: keyword
+    arguments of a settled run (`_steady.options`)."""
     from ..run import simulate, summarise
 
     sim = cfg.simulation
@@ -67,7 +71,8 @@ def run_cases(cfg, progress: bool = True) -> dict:
 
             raise ConfigError("roller.end_radius_mm", "inf (flat end) cannot be simulated as an arc end; use --end corner")
         if progress:
-            print(f"[{end} end] simulating {sim.duration_ms:g} ms ...", flush=True)
+            what = "until settled" if steady else f"{sim.duration_ms:g} ms"
+            print(f"[{end} end] simulating {what} ...", flush=True)
         res = simulate(
             b,
             op,
@@ -76,6 +81,7 @@ def run_cases(cfg, progress: bool = True) -> dict:
             atol=sim.atol,
             max_steps=sim.max_steps,
             progress=progress,
+            **(steady or {}),
         )
         out[end] = (res, summarise(res))
     return out
@@ -125,10 +131,13 @@ def write_outputs(out_dir: pathlib.Path, results: dict) -> None:
 def run(args) -> int:
     cfg = _load(args)
     progress = cfg.simulation.progress and not args.no_progress
-    results = run_cases(cfg, progress=progress)
+    steady = _steady.options(args)
+    results = run_cases(cfg, progress=progress, steady=steady)
     summaries = {e: s for e, (_, s) in results.items()}
-    print(format_table(summaries))
+    print(_steady.format_table(summaries) if steady else format_table(summaries))
     if args.out:
         write_outputs(pathlib.Path(args.out), results)
         print(f"results written to {args.out}")
+    if steady:
+        return _steady.exit_code(summaries)
     return 0 if all(s["status"] == "ok" for s in summaries.values()) else 1

@@ -4,7 +4,11 @@
   (compiled, with wall times and a `SimulationResult`), `simulation_result`,
   `flange_functionals` (smooth peak PV and contact heights for gradients), `Perturbation`
   (seeded initial roller scatter), `initial_state`, `smooth_functionals`;
-- statistics: `contact_events`, `summarise`;
+- statistics: `contact_events`, `summarise`; of settled running with 95 % confidence
+  intervals: `steady_statistics`, `revolution_statistics`, `confidence_intervals`,
+  `batch_means`, `student_t_interval`, `Estimate`;
+- settled running: `simulate_steady` (settling detection over cage revolutions, a window,
+  seeds), `summarise_steady`, `solve_from` (continue from any state), `check_steady_options`;
 - design metrics through the dynamics: `design_metrics`, `design_jacobian`, `DesignMetrics`,
   `seated_perturbation`, `forward_jacobian`;
 - `plot_run`: the figures of one run.
@@ -24,6 +28,16 @@ from ._design import (
     seated_perturbation,
 )
 from ._plots import plot_run
+from ._settle import (
+    SeedRun,
+    SteadyResult,
+    check_steady_options,
+    simulate,
+    simulate_steady,
+    solve_from,
+    summarise,
+    summarise_steady,
+)
 from ._simulate import (
     Perturbation,
     SimulationResult,
@@ -32,12 +46,19 @@ from ._simulate import (
     flange_functionals,
     initial_state,
     scaled_field,
-    simulate,
     simulation_result,
     smooth_functionals,
     solve,
 )
-from ._summary import contact_events, summarise
+from ._statistics import (
+    Estimate,
+    batch_means,
+    confidence_intervals,
+    revolution_statistics,
+    steady_statistics,
+    student_t_interval,
+)
+from ._summary import contact_events
 
 __all__ = [
     "GRADIENT_ATOL",
@@ -45,10 +66,16 @@ __all__ = [
     "GRADIENT_MODE_NOTE",
     "GRADIENT_RTOL",
     "DesignMetrics",
+    "Estimate",
     "Perturbation",
+    "SeedRun",
     "SimulationResult",
     "Solution",
+    "SteadyResult",
     "SolveArgs",
+    "batch_means",
+    "check_steady_options",
+    "confidence_intervals",
     "contact_events",
     "design_jacobian",
     "design_metrics",
@@ -56,11 +83,17 @@ __all__ = [
     "forward_jacobian",
     "initial_state",
     "plot_run",
+    "revolution_statistics",
     "scaled_field",
     "seated_perturbation",
     "simulate",
+    "simulate_steady",
     "simulation_result",
     "smooth_functionals",
     "solve",
+    "solve_from",
+    "steady_statistics",
+    "student_t_interval",
     "summarise",
+    "summarise_steady",
 ]

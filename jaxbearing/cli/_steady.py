@@ -1,0 +1,100 @@
+"""Settled runs on the command line: the `--settle` options of `simulate` and their table.
+
+`--settle auto|off|MS` turns `simulate` into a settled run (`jaxbearing.run.simulate_steady`):
+quasi-static start, settling (`auto`: until the revolution-mean cage speed changes by less
+than `--settle-tolerance` between consecutive cage revolutions, at most `--settle-cap-ms`; MS: a
+fixed settling time; `off`: none), then a window of `--window-revs` revolutions for each of
+`--seeds` seeds. Every statistic is printed with its 95 % confidence interval.
+"""
+
+from __future__ import annotations
+
+_ROWS = (
+    ("flange_force_N", "flange force", "N", 1.0),
+    ("flange_pressure_Pa", "peak pressure", "GPa", 1e-9),
+    ("flange_sliding_velocity_m_s", "sliding velocity", "m/s", 1.0),
+    ("flange_pv_Pa_m_s", "PV", "GPa m/s", 1e-9),
+    ("contact_height_m", "contact height", "mm", 1e3),
+    ("contact_radius_m", "contact radius", "mm", 1e3),
+)
+
+
+def add_arguments(p) -> None:
+    g = p.add_argument_group("settled running (statistics with 95 % confidence intervals)")
+    g.add_argument("--settle", help='"auto" (detect settling), "off" (measure from the start) or a '
+                   "settling time in ms; without it, one fixed-duration run from the start")
+    g.add_argument("--window-revs", type=float, default=8, help="measurement window [cage revolutions] (default 8)")
+    g.add_argument("--seeds", type=float, default=1, help="independent seeded runs (default 1: batch means)")
+    g.add_argument("--settle-tolerance", type=float, default=1e-3,
+                   help="relative change of the revolution-mean cage speed that counts as settled (default 1e-3)")
+    g.add_argument("--settle-cap-ms", type=float, default=300.0, help="longest settling time [ms] (default 300)")
+
+
+def options(args) -> dict | None:
+    """Keyword arguments of `simulate` for a settled run, checked; None without `--settle`."""
+    if args.settle is None:
+        return None
+    from ..run import check_steady_options
+
+    settle = args.settle if args.settle in ("auto", "off") else args.settle
+    names = {"settle": "--settle", "window_revs": "--window-revs", "seeds": "--seeds",
+             "tolerance": "--settle-tolerance", "cap_ms": "--settle-cap-ms"}
+    check_steady_options(settle, args.window_revs, args.seeds, args.settle_tolerance, args.settle_cap_ms, names)
+    return dict(settle=settle if settle in ("auto", "off") else float(settle), window_revs=int(args.window_revs),
+                seeds=int(args.seeds), tolerance=args.settle_tolerance, settle_cap_ms=args.settle_cap_ms)
+
+
+def _ci(est, k, fmt=".4g") -> str:
+    if not isinstance(est, dict) or est.get("value") is None:
+        return "-"
+    if est.get("ci95_low") is None:
+        return f"{est['value'] * k:{fmt}} (no CI)"
+    return f"{est['value'] * k:{fmt}} [{est['ci95_low'] * k:{fmt}}, {est['ci95_high'] * k:{fmt}}]"
+
+
+def format_table(summaries: dict) -> str:
+    """Statistic per row, one column per end type: value [95 % CI]."""
+    ends = list(summaries)
+    w = 36
+    head = f"{'quantity (per cage revolution)':<34}{'unit':>8}" + "".join(f"{e:>{w}}" for e in ends)
+    lines = [head, "-" * len(head)]
+    for key, label, unit, k in _ROWS:
+        for stat in ("max", "mean", "median", "p95"):
+            row = f"{label + ', ' + stat:<34}{unit:>8}"
+            for e in ends:
+                row += f"{_ci(summaries[e].get(key, {}).get(stat), k):>{w}}"
+            lines.append(row)
+    extra = (
+        ("contact radius, p99", "mm", lambda s: s.get("contact_radius_m", {}).get("p99"), 1e3),
+        ("corner-contact share, time", "%", lambda s: s.get("corner_contact_share", {}).get("time"), 100.0),
+        ("corner-contact share, events", "%", lambda s: s.get("corner_contact_share", {}).get("events"), 100.0),
+        ("cage speed", "rpm", lambda s: s.get("cage_speed_rpm"), 1.0),
+        ("cage slip", "%", lambda s: s.get("cage_slip"), 100.0),
+        ("roller skew, mean |.|", "mrad", lambda s: s.get("roller_skew_rad", {}).get("mean_abs"), 1e3),
+        ("roller skew, max |.|", "mrad", lambda s: s.get("roller_skew_rad", {}).get("max_abs"), 1e3),
+    )
+    for label, unit, get, k in extra:
+        lines.append(f"{label:<34}{unit:>8}" + "".join(f"{_ci(get(summaries[e]), k):>{w}}" for e in ends))
+    lines.append("")
+    for e in ends:
+        s = summaries[e]
+        rho = s.get("limited_circle_radius_m")
+        lines.append(
+            f"[{e}] status {s['status']}; settled {str(s['settled']).lower()} ({s['settle_mode']}, "
+            f"{s['settle_time_ms']:.1f} ms); window {s['window_revs']} revolutions = {s['window_ms']:.1f} ms; "
+            f"seeds {len(s['seeds'])}; CI: {s.get('ci_method', '-')}; rho_lim "
+            f"{'-' if rho is None else format(rho * 1e3, '.3f')} mm; wall {s['wall_time_s']:.1f} s "
+            f"(+ compile {s['compile_time_s']:.1f} s)"
+        )
+        if s["settle_mode"] == "auto" and not s["settled"]:
+            lines.append(f"[{e}] NOT SETTLED: the cage speed still changed by more than "
+                         f"{s['settle_tolerance']:.2g} per revolution at the cap of {s['settle_cap_ms']:.0f} ms; "
+                         "the statistics come from a transient (fix a settling time with --settle MS)")
+    return "\n".join(lines)
+
+
+def exit_code(summaries: dict) -> int:
+    """0 when every end type ran and (with --settle auto) settled; 1 otherwise."""
+    ok = all(s["status"] == "ok" for s in summaries.values())
+    settled = all(s["settled"] or s["settle_mode"] != "auto" for s in summaries.values())
+    return 0 if ok and settled else 1

@@ -1,0 +1,299 @@
+"""Settled running: integrate in cage revolutions until the cage speed stops drifting, then
+measure over a window of whole revolutions (issue 11; docs/model.md 16).
+
+* `solve_from` continues the integration from any physical state (one call per revolution); it
+  returns the saved histories and the final state. Its integrator settings are those of `solve`
+  (Tsit5, PID controller on the scaled state under the max norm); the scaling's nominal orbit
+  restarts at every chunk from the chunk's own start state and cage speed, so the scaled
+  azimuths never accumulate the cage slip over a long run.
+* Settling (`settle="auto"`): chunks of one cage revolution (2 pi / the previous revolution's
+  mean cage speed) until the revolution-mean cage speed changes by less than `tolerance`
+  (relative) between two consecutive revolutions, at most `settle_cap_ms`. `settle=MS` runs a
+  fixed MS ms first (declared settled by the user); `settle="off"` measures from the start
+  (`settled` is then False: nothing was verified).
+* The window is `window_revs` further revolutions; its statistics and intervals come from
+  `_statistics`. With `seeds = N` the whole run is repeated for N seeded initial scatters
+  (`Perturbation.seed` = 0 .. N-1) one after another: on a 2-core CPU one solve already keeps
+  both cores busy and a vmapped batch is slower per case (README, Performance).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+
+import diffrax
+import jax
+import jax.numpy as jnp
+import numpy as np
+import optimistix as optx
+
+from ..dynamics import Functionals, Params, Scaling, State, state_scales
+from ..geometry import Bearing, OperatingPoint, kinematic_cage_speed, rad_s_to_rpm
+from ..io import require
+from ._simulate import Perturbation, SolveArgs, _save, initial_state, scaled_field
+from ._simulate import simulate as _simulate_fixed
+from ._statistics import steady_statistics
+from ._summary import summarise as _summarise_fixed
+
+#: defaults of the settled run
+SETTLE_TOLERANCE = 1e-3  # relative change of the revolution-mean cage speed
+SETTLE_CAP_MS = 300.0
+WINDOW_REVS = 8
+SAVES_PER_REV = 1320  # 5 us at the reference cage speed, as `simulate`'s default 4000 per 20 ms
+
+
+def solve_from(params: Params, start: State, duration, *, num_saves: int, rtol, atol, max_steps: int):
+    """Integrate from the physical state `start` over [0, duration]: (histories, final state,
+    diffrax result code, steps). Accumulators restart from zero. jit-able."""
+    b = params.bearing
+    zero_acc = jax.tree_util.tree_map(jnp.zeros_like, start.accumulators)
+    start = State(rollers=start.rollers, cage=start.cage, inner_ring=start.inner_ring, accumulators=zero_acc)
+    scaling = Scaling(nominal=start, scale=state_scales(b.num_rollers, b.pitch_diameter / 2),
+                      orbit_speed=start.cage.speed)
+    args = SolveArgs(params=params, scaling=scaling)
+    saveat = diffrax.SaveAt(subs=[diffrax.SubSaveAt(ts=jnp.linspace(0.0, duration, num_saves + 1)[:-1], fn=_save),
+                                  diffrax.SubSaveAt(t1=True)])
+    controller = diffrax.PIDController(rtol=rtol, atol=atol, pcoeff=0.3, icoeff=0.4, norm=optx.max_norm,
+                                       dtmin=1e-13)
+    sol = diffrax.diffeqsolve(
+        diffrax.ODETerm(scaled_field), diffrax.Tsit5(), t0=0.0, t1=duration, dt0=1e-7,
+        y0=scaling.scale_state(0.0, start), args=args, saveat=saveat, stepsize_controller=controller,
+        max_steps=max_steps, throw=False,
+    )
+    hist, final = sol.ys
+    final = scaling.unscale(duration, jax.tree_util.tree_map(lambda a: a[-1], final))
+    return hist, final, jnp.asarray(sol.result._value, jnp.int32), jnp.asarray(sol.stats["num_steps"])
+
+
+_COMPILED: dict = {}
+
+
+def _compiled(params, start, num_saves, max_steps):
+    leaves, treedef = jax.tree_util.tree_flatten((params, start))
+    key = (treedef, tuple((jnp.shape(x), jnp.result_type(x)) for x in leaves), num_saves, max_steps)
+    if key not in _COMPILED:
+        def run(p, s, d, r, a):
+            return solve_from(p, s, d, num_saves=num_saves, rtol=r, atol=a, max_steps=max_steps)
+
+        f = jnp.asarray(1.0)
+        _COMPILED[key] = jax.jit(run).lower(params, start, f, f, f).compile()
+    return _COMPILED[key]
+
+
+@dataclasses.dataclass
+class SeedRun:
+    """One seed's settled run: the window's histories (absolute times) and its revolutions."""
+
+    seed: int
+    window: dict
+    edges: np.ndarray  # revolution boundaries of the window [s]
+    settle_time: float  # [s]
+    settled: bool
+    revolution_speeds_rpm: list  # revolution-mean cage speed of every revolution run
+    revolution_ends: list  # end time of every revolution run [s]
+    status: str
+    num_steps: int
+
+
+def check_steady_options(settle, window_revs, seeds, tolerance, cap_ms, names=None) -> None:
+    """One-line `UserInputError` naming the option for a bad value of the settled-run options."""
+    n = {"settle": "settle", "window_revs": "window_revs", "seeds": "seeds",
+         "tolerance": "settle_tolerance", "cap_ms": "settle_cap_ms", **(names or {})}
+    if not (isinstance(settle, str) and settle in ("auto", "off")):
+        require(n["settle"], _as_float(n["settle"], settle), lambda v: np.isfinite(v) & (v >= 0),
+                '"auto", "off" or a settling time >= 0 ms')
+    require(n["window_revs"], window_revs, lambda v: (v >= 2) & (v == np.round(v)),
+            "an integer >= 2 (cage revolutions; batch means need two batches)")
+    require(n["seeds"], seeds, lambda v: (v >= 1) & (v == np.round(v)), "an integer >= 1")
+    require(n["tolerance"], tolerance, lambda v: (v > 0) & (v < 1), "in (0, 1) (relative change)")
+    require(n["cap_ms"], cap_ms, lambda v: np.isfinite(v) & (v > 0), "> 0 ms")
+
+
+def _as_float(name, value):
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        from .._errors import UserInputError
+
+        raise UserInputError(f'{name} = {value!r}: must be "auto", "off" or a settling time >= 0 ms') from None
+
+
+def _run_seed(params, start, *, settle, window_revs, tolerance, cap, rtol, atol, max_steps, saves, progress):
+    """Settle then measure one seed (module docstring)."""
+    compiled = _compiled(params, start, saves, max_steps)
+    state, t, steps = start, 0.0, 0
+    speeds, ends, windows, edges = [], [], [], []
+    settled, settle_time, status = settle == "off", 0.0, "ok"
+    fixed = None if isinstance(settle, str) else float(settle) * 1e-3
+    measuring = settle == "off" or fixed == 0.0
+    while True:
+        rev = 2 * math.pi / abs(float(state.cage.speed))
+        if not measuring and fixed is not None:
+            rev = min(rev, fixed - t)
+        hist, final, code, n = compiled(params, state, jnp.asarray(rev), jnp.asarray(rtol), jnp.asarray(atol))
+        hist = {k: np.asarray(v) for k, v in hist.items() if k != "accumulators"}
+        steps += int(n)
+        if int(code) != 0 or not np.all(np.isfinite(hist["cage_speed"])):
+            status = f"failed: the solver did not succeed in the revolution ending at {(t + rev) * 1e3:.2f} ms"
+            break
+        hist["t"] = hist["t"] + t
+        t += rev
+        state = final
+        speeds.append(float(rad_s_to_rpm(np.mean(hist["cage_speed"]))))
+        ends.append(t)
+        if progress:
+            print(f"  t = {t * 1e3:7.2f} ms: cage {speeds[-1]:9.2f} rpm over the last revolution"
+                  f"{' (window)' if measuring else ''}", flush=True)
+        if measuring:
+            windows.append(hist)
+            edges.append(t - rev)
+            if len(windows) == window_revs:
+                edges.append(t)
+                break
+            continue
+        if fixed is not None:
+            done = t >= fixed - 1e-12
+        else:
+            done = len(speeds) >= 2 and abs(speeds[-1] - speeds[-2]) <= tolerance * abs(speeds[-1])
+        if done:
+            settled, settle_time, measuring = True, t, True
+        elif t >= cap:
+            settled, settle_time, measuring = False, t, True
+    window = {k: np.concatenate([w[k] for w in windows]) for k in windows[0]} if windows else {}
+    return window, np.asarray(edges), settle_time, settled, speeds, ends, status, steps
+
+
+@dataclasses.dataclass
+class SteadyResult:
+    """A settled run over `seeds` seeds (`SeedRun`s) and how it was obtained."""
+
+    runs: list
+    settle: object
+    window_revs: int
+    tolerance: float
+    cap: float
+    start: str
+    wall_time_s: float
+    compile_time_s: float
+    bearing: Bearing
+    operating: OperatingPoint
+
+    @property
+    def ok(self) -> bool:
+        return all(r.status == "ok" for r in self.runs)
+
+    @property
+    def settled(self) -> bool:
+        return all(r.settled for r in self.runs)
+
+    @property
+    def status(self) -> str:
+        return "ok" if self.ok else next(r.status for r in self.runs if r.status != "ok")
+
+    @property
+    def histories(self) -> dict:
+        """The first seed's window (for plots and the histories file)."""
+        return self.runs[0].window
+
+
+def simulate_steady(
+    bearing: Bearing,
+    op: OperatingPoint,
+    *,
+    settle="auto",
+    window_revs: int = WINDOW_REVS,
+    seeds: int = 1,
+    tolerance: float = SETTLE_TOLERANCE,
+    settle_cap_ms: float = SETTLE_CAP_MS,
+    start: str = "quasi-static",
+    rtol: float = 1e-3,
+    atol: float = 1e-6,
+    max_steps: int = 2_000_000,
+    saves_per_rev: int = SAVES_PER_REV,
+    perturbation: Perturbation = Perturbation(),
+    functionals: Functionals = Functionals(),
+    progress: bool = False,
+) -> SteadyResult:
+    """Settle (module docstring), then measure `window_revs` cage revolutions, for each of
+    `seeds` seeded initial scatters, each from the quasi-static start of `simulate` (kinematic
+    speeds; `start`, reserved for the skid start of issue 11, which is not finished)."""
+    from ..io import validate_bearing
+
+    validate_bearing(bearing, op)
+    check_steady_options(settle, window_revs, seeds, tolerance, settle_cap_ms)
+    if start != "quasi-static":
+        from .._errors import UserInputError
+
+        raise UserInputError(f'start = {start!r}: must be "quasi-static" (the skid start is not finished)')
+    params = Params(bearing=bearing, operating=op, functionals=functionals)
+    runs, wall0, compile_time = [], time.perf_counter(), 0.0
+    for seed in range(int(seeds)):
+        y0 = initial_state(bearing, op, dataclasses.replace(perturbation, seed=perturbation.seed + seed))
+        c0 = time.perf_counter()
+        _compiled(params, y0, int(saves_per_rev), int(max_steps))
+        compile_time += time.perf_counter() - c0
+        if progress:
+            print(f"seed {seed}: settling ({settle}), then {window_revs} revolutions", flush=True)
+        out = _run_seed(params, y0, settle=settle, window_revs=int(window_revs), tolerance=tolerance,
+                        cap=settle_cap_ms * 1e-3, rtol=rtol, atol=atol, max_steps=int(max_steps),
+                        saves=int(saves_per_rev), progress=progress)
+        runs.append(SeedRun(perturbation.seed + seed, *out))
+    wall = time.perf_counter() - wall0 - compile_time
+    return SteadyResult(runs=runs, settle=settle, window_revs=int(window_revs), tolerance=tolerance,
+                        cap=settle_cap_ms * 1e-3, start=start, wall_time_s=wall, compile_time_s=compile_time,
+                        bearing=bearing, operating=op)
+
+
+def summarise_steady(result: SteadyResult, threshold: float = 1.0) -> dict:
+    """The summary.json block of a settled run: how it settled, and every statistic of the
+    window as {"value", "ci95_low", "ci95_high", "n"} (`_statistics`)."""
+    runs = result.runs
+    ok = [r for r in runs if r.status == "ok" and r.window]
+    block = {
+        "status": "ok" if result.ok else next(r.status for r in runs if r.status != "ok"),
+        "settled": bool(result.settled),
+        "settle_mode": result.settle if isinstance(result.settle, str) else "fixed",
+        "settle_time_ms": max(r.settle_time for r in runs) * 1e3,
+        "settle_tolerance": float(result.tolerance),
+        "settle_cap_ms": result.cap * 1e3,
+        "window_revs": result.window_revs,
+        "window_ms": float(np.mean([r.edges[-1] - r.edges[0] for r in ok])) * 1e3 if ok else 0.0,
+        "seeds": [r.seed for r in runs],
+        "start": result.start,
+        "kinematic_cage_speed_rpm": float(rad_s_to_rpm(kinematic_cage_speed(result.bearing, result.operating))),
+        "per_seed": [{"seed": r.seed, "settled": r.settled, "settle_time_ms": r.settle_time * 1e3,
+                      "status": r.status, "num_steps": r.num_steps,
+                      "revolution_end_ms": [t * 1e3 for t in r.revolution_ends],
+                      "revolution_cage_speed_rpm": r.revolution_speeds_rpm} for r in runs],
+        "num_steps": sum(r.num_steps for r in runs),
+        "wall_time_s": result.wall_time_s,
+        "compile_time_s": result.compile_time_s,
+    }
+    if ok:
+        block.update(steady_statistics([r.window for r in ok], [r.edges for r in ok], result.bearing,
+                                       result.operating, threshold))
+    return block
+
+
+def simulate(bearing: Bearing, op: OperatingPoint, *, settle=None, **kwargs):
+    """`jaxbearing.simulate`: without `settle`, one fixed-duration run from the quasi-static
+    start (`_simulate.simulate`, a `SimulationResult`); with `settle` ("auto", "off" or a
+    settling time in ms), a settled run (`simulate_steady`, a `SteadyResult`; `window_revs`,
+    `seeds`, `tolerance`, `settle_cap_ms` and the solver options go there)."""
+    if settle is None:
+        return _simulate_fixed(bearing, op, **kwargs)
+    kwargs.pop("duration", None)
+    kwargs.pop("num_saves", None)
+    if kwargs.get("perturbation", 1) is None:
+        kwargs["perturbation"] = Perturbation()
+    return simulate_steady(bearing, op, settle=settle, **kwargs)
+
+
+def summarise(result, threshold: float = 1.0) -> dict:
+    """`jaxbearing.summarise`: the summary.json block of a fixed run (`_summary.summarise`) or of
+    a settled run (`summarise_steady`)."""
+    if isinstance(result, SteadyResult):
+        return summarise_steady(result, threshold)
+    return _summarise_fixed(result, threshold)

@@ -1,0 +1,190 @@
+"""Statistics of settled running with 95 % confidence intervals (issue 11, docs/model.md 16).
+
+A dynamic run is a correlated time series: consecutive contact events and cage-speed samples are
+not independent, so the naive standard error of all samples is far too small. Two estimators:
+
+* **Non-overlapping batch means** over cage revolutions (one seed). The measurement window is
+  split into b >= 2 batches, one per cage revolution; each batch gives one value X_i of the
+  statistic (the mean cage speed over that revolution, the largest flange force of the events
+  whose peak falls in it, ...). The point estimate is the grand mean X = (1/b) sum X_i and the
+  interval is
+
+      X +/- t_{b-1, 0.975} S / sqrt(b),      S^2 = sum (X_i - X)^2 / (b - 1)
+
+  (Law & Kelton, Simulation Modeling and Analysis, 3rd ed., section 9.5.3; Schmeiser 1982,
+  "Batch size effects in the analysis of simulation output", Oper. Res. 30, 556). Assumptions:
+  the run is stationary over the window (settled, `_settle`), and batches one revolution long are
+  long enough that the batch values are nearly independent and nearly normal. Both hold when the
+  correlation time of the statistic is short against one revolution; the cage-speed
+  autocorrelation after settling (ms) is short against a revolution (6.6 ms at 9118 rpm), and
+  the coverage of the interval on AR(1) series with that ratio is tested in
+  tests/test_statistics.py. Dependent batches make the interval too narrow, never too wide.
+* **Ensemble of seeds** (N >= 2 independent runs with different seeded initial scatter,
+  `Perturbation.seed`). Each run's batch-means estimate is one replicate Y_k; the interval is the
+  Student-t interval of the Y_k with N - 1 degrees of freedom. Replicates are independent by
+  construction, so only stationarity and approximate normality of Y_k are assumed.
+
+The quantity estimated for an event statistic is its expectation *per cage revolution*: "max"
+is the expected largest value within one revolution, "p95" the expected 95th percentile of one
+revolution's events. Unlike the maximum of a whole window (which grows with the window length),
+these are properties of the running bearing with a finite variance, so an interval exists.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+from scipy import stats as _sp_stats
+
+from ..geometry import kinematic_cage_speed, limited_circle_radius, rad_s_to_rpm
+from ._summary import _EVENT_QUANTITIES, contact_events
+
+CONFIDENCE = 0.95
+
+#: reductions of one revolution's contact events, in summary.json order
+EVENT_REDUCTIONS = {
+    "max": np.max,
+    "mean": np.mean,
+    "median": np.median,
+    "p95": lambda v: np.percentile(v, 95.0),
+}
+
+
+@dataclasses.dataclass(frozen=True)
+class Estimate:
+    """A point estimate with its 95 % confidence interval over `n` batches or seeds."""
+
+    value: float
+    ci95_low: float
+    ci95_high: float
+    n: int
+
+    @property
+    def half_width(self) -> float:
+        return 0.5 * (self.ci95_high - self.ci95_low)
+
+    def as_dict(self) -> dict:
+        def num(x):
+            return float(x) if np.isfinite(x) else None
+
+        return {"value": num(self.value), "ci95_low": num(self.ci95_low),
+                "ci95_high": num(self.ci95_high), "n": int(self.n)}
+
+
+def student_t_interval(samples, confidence: float = CONFIDENCE) -> Estimate:
+    """Mean of independent, roughly normal `samples` (NaNs dropped) with its Student-t interval
+    mean +/- t_{n-1,(1+c)/2} s/sqrt(n). One sample: the value with an unbounded interval (NaN
+    bounds); none: all NaN."""
+    x = np.asarray(samples, dtype=float).ravel()
+    x = x[np.isfinite(x)]
+    n = x.size
+    if n == 0:
+        return Estimate(np.nan, np.nan, np.nan, 0)
+    mean = float(np.mean(x))
+    if n == 1:
+        return Estimate(mean, np.nan, np.nan, 1)
+    half = float(_sp_stats.t.ppf(0.5 + confidence / 2, n - 1) * np.std(x, ddof=1) / np.sqrt(n))
+    return Estimate(mean, mean - half, mean + half, n)
+
+
+def batch_means(series, num_batches: int, confidence: float = CONFIDENCE) -> Estimate:
+    """Non-overlapping batch-means estimate of the mean of a stationary `series`: `num_batches`
+    equal consecutive batches (a remainder at the end is dropped), Student-t interval over the
+    batch means with num_batches - 1 degrees of freedom (Law & Kelton 9.5.3)."""
+    x = np.asarray(series, dtype=float).ravel()
+    size = x.size // num_batches
+    if num_batches < 2 or size < 1:
+        raise ValueError(f"num_batches = {num_batches}: need 2 <= num_batches <= len(series) = {x.size}")
+    return student_t_interval(x[: size * num_batches].reshape(num_batches, size).mean(axis=1), confidence)
+
+
+def _window(hist: dict, t0: float, t1: float) -> dict:
+    t = np.asarray(hist["t"])
+    keep = (t >= t0) & (t < t1)
+    return {k: np.asarray(v)[keep] for k, v in hist.items()}
+
+
+def revolution_statistics(hist: dict, edges, rho_lim: float, kinematic_speed: float,
+                          threshold: float = 1.0) -> dict[str, np.ndarray]:
+    """Every reported statistic, one value per revolution [edges[i], edges[i+1]) (NaN where a
+    revolution has no contact for a contact statistic). Keys are "group.reduction"."""
+    edges = np.asarray(edges, dtype=float)
+    nrev = edges.size - 1
+    events = contact_events(hist, threshold)
+    rev_of_event = np.searchsorted(edges, events["time"], side="right") - 1
+    out: dict[str, np.ndarray] = {}
+    for key in _EVENT_QUANTITIES:
+        for red, fn in EVENT_REDUCTIONS.items():
+            vals = np.full(nrev, np.nan)
+            for i in range(nrev):
+                v = events[key][rev_of_event == i]
+                if v.size:
+                    vals[i] = fn(v)
+            out[f"{key}.{red}"] = vals
+    for name in ("cage_speed_rpm", "cage_slip", "roller_skew_rad.mean_abs", "roller_skew_rad.max_abs",
+                 "corner_contact_share.time", "corner_contact_share.events", "contact_radius_m.p99",
+                 "flange_contact_events_per_rev"):
+        out[name] = np.full(nrev, np.nan)
+    kin_rpm = float(rad_s_to_rpm(kinematic_speed))
+    for i in range(nrev):
+        w = _window(hist, edges[i], edges[i + 1])
+        if w["t"].size == 0:
+            continue
+        rpm = float(rad_s_to_rpm(np.mean(w["cage_speed"])))
+        out["cage_speed_rpm"][i] = rpm
+        out["cage_slip"][i] = (kin_rpm - rpm) / kin_rpm
+        skew = np.abs(w["roller_skew"])
+        out["roller_skew_rad.mean_abs"][i] = np.mean(skew)
+        out["roller_skew_rad.max_abs"][i] = np.max(skew)
+        touching = w["flange_force"] > threshold
+        beyond = w["contact_radius"] > rho_lim
+        if touching.any():
+            out["corner_contact_share.time"][i] = np.mean(beyond[touching])
+            out["contact_radius_m.p99"][i] = np.percentile(w["contact_radius"][touching], 99.0)
+        sel = rev_of_event == i
+        out["flange_contact_events_per_rev"][i] = np.sum(sel)
+        if sel.any():
+            out["corner_contact_share.events"][i] = np.mean(events["contact_radius_m"][sel] > rho_lim)
+    return out
+
+
+def _nest(flat: dict[str, Estimate]) -> dict:
+    """{"a.b": est, "c": est} -> {"a": {"b": {...}}, "c": {...}}."""
+    out: dict = {}
+    for key, est in flat.items():
+        group, _, red = key.partition(".")
+        if red:
+            out.setdefault(group, {})[red] = est.as_dict()
+        else:
+            out[group] = est.as_dict()
+    return out
+
+
+def confidence_intervals(per_revolution: list[dict[str, np.ndarray]]) -> tuple[dict[str, Estimate], str]:
+    """95 % intervals of every statistic: batch means over the revolutions of one seed, or the
+    Student-t interval over seeds of each seed's batch-means value (module docstring)."""
+    keys = per_revolution[0].keys()
+    if len(per_revolution) == 1:
+        method = "batch means over cage revolutions (Student-t, b-1 dof)"
+        return {k: student_t_interval(per_revolution[0][k]) for k in keys}, method
+    method = "ensemble of seeds (Student-t over per-seed batch means, N-1 dof)"
+    out = {}
+    for k in keys:
+        per_seed = [np.nanmean(r[k]) if np.isfinite(r[k]).any() else np.nan for r in per_revolution]
+        out[k] = student_t_interval(per_seed)
+    return out, method
+
+
+def steady_statistics(windows: list[dict], edges: list, bearing, op, threshold: float = 1.0) -> dict:
+    """The statistics block of a settled run: `windows` are the measurement-window histories of
+    each seed, `edges` their revolution boundaries [s]."""
+    rho_lim = float(limited_circle_radius(bearing.roller))
+    kin = float(kinematic_cage_speed(bearing, op))
+    per_rev = [revolution_statistics(h, e, rho_lim, kin, threshold) for h, e in zip(windows, edges)]
+    est, method = confidence_intervals(per_rev)
+    block = _nest(est)
+    block["ci_method"] = method
+    block["limited_circle_radius_m"] = rho_lim
+    block["kinematic_cage_speed_rpm"] = float(rad_s_to_rpm(kin))
+    return block
