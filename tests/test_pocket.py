@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 
 from jaxbearing import reference_bearing
-from jaxbearing.forces import HUNT_CROSSLEY_ALPHA, PocketContact, pocket_contact
+from jaxbearing.contact import HUNT_CROSSLEY_ALPHA
+from jaxbearing.forces import PocketContact, pocket_contact
 
 X = np.array([1.0, 0.0, 0.0])
 ZERO = np.zeros(3)

@@ -19,9 +19,8 @@ from scipy.optimize import minimize_scalar
 
 import jaxbearing as jb
 from jaxbearing import UserInputError
-from jaxbearing.contact import effective_modulus, line_contact_stiffness
+from jaxbearing.contact import HUNT_CROSSLEY_ALPHA, effective_modulus, line_contact_stiffness
 from jaxbearing.forces import (
-    HUNT_CROSSLEY_ALPHA,
     crown_drop,
     raceway_contact,
     raceway_slice_geometry,

@@ -10,9 +10,17 @@ at, below and above zero penetration and at zero sliding (MODEL.md section 4).
 - Line contact (ISO/TS 16281, MODEL.md 4.2): `line_contact_stiffness`, `line_slice_loads`.
 - Smoothing: `smooth_penetration`, `smooth_power`, `hertz_force`, `safe_norm`,
   `smooth_direction`.
+- Damping (Hunt & Crossley 1975): `hunt_crossley_factor`, `restitution_coefficient`,
+  `HUNT_CROSSLEY_ALPHA`.
 - Traction and friction: `traction_coefficient`, `traction_force`, `friction_force`.
 """
 
+from ._damping import (
+    DAMPING_FACTOR_WIDTH,
+    HUNT_CROSSLEY_ALPHA,
+    hunt_crossley_factor,
+    restitution_coefficient,
+)
 from ._hertz import (
     HAMROCK_BREWE_ERROR,
     LOAD_FLOOR,
@@ -46,6 +54,10 @@ from ._smooth import (
 from ._traction import friction_force, traction_coefficient, traction_force
 
 __all__ = [
+    "DAMPING_FACTOR_WIDTH",
+    "HUNT_CROSSLEY_ALPHA",
+    "hunt_crossley_factor",
+    "restitution_coefficient",
     "HAMROCK_BREWE_ERROR",
     "ISO_LINE_CONSTANT",
     "LINE_EXPONENT",

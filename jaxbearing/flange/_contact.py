@@ -48,9 +48,11 @@ import jax.numpy as jnp
 from jaxtyping import Array, ArrayLike, Float
 
 from ..contact import (
+    HUNT_CROSSLEY_ALPHA,
     PENETRATION_WIDTH,
     SLIDING_EPS,
     hertz_force,
+    hunt_crossley_factor,
     point_contact_ellipse,
     point_contact_peak_pressure,
     point_contact_stiffness,
@@ -77,7 +79,9 @@ class FlangeContact(eqx.Module):
     normal_force: Float[Array, "*batch"]  # Q = K delta^1.5 (softplus-smoothed)
     peak_pressure: Float[Array, "*batch"]  # p_max = 3 Q / (2 pi a b)
     sliding_velocity: Float[Array, "*batch 3"]  # u, tangential part (paper Eqs. 12/26)
-    sliding_speed: Float[Array, "*batch"]  # |u|
+    sliding_speed: Float[Array, "*batch"]  # |u|, material sliding speed (the default)
+    roller_surface_speed: Float[Array, "*batch"]  # |w x (C - p)| tangential: the paper's Fig. 7c
+    approach_rate: Float[Array, "*batch"]  # d(delta)/dt, positive while closing in
     pv: Float[Array, "*batch"]  # p_max |u|
     contact_point: Float[Array, "*batch 3"]  # C, extreme point of the end body
     contact_height: Float[Array, "*batch"]  # h_c above the raceway surface
@@ -103,6 +107,8 @@ def roller_flange_contact(
     ring_centre: Vec3,
     ring_velocity: Vec3,
     ring_angular_velocity: Vec3,
+    *,
+    damping: ArrayLike = HUNT_CROSSLEY_ALPHA,
 ) -> FlangeContact:
     """Contact of one roller end with one ring flange (MODEL.md 4.1; the caller vmaps).
 
@@ -110,7 +116,14 @@ def roller_flange_contact(
     (`jaxbearing._roller_end.end_support`); contact point C = its extreme point.
 
     Sliding velocity (paper Eqs. 12 and 26): u = (v + w x (C - p)) - (v_r + w_r x (C - c_r)),
-    minus its component along n.
+    minus its component along n: the material sliding velocity, from which PV is formed. The
+    paper's Figure 7c ranks corner contacts as sliding faster than arc contacts, which is what
+    the roller's own surface speed at the contact, |w x (C - p)| (tangential part; the flange's
+    motion ignored), gives: reported as `roller_surface_speed`, never used in PV.
+
+    Normal damping (Hunt & Crossley 1975, as on the raceways and pockets): the elastic load is
+    multiplied by s(1 + 1.5 alpha d(delta)/dt), d(delta)/dt = (v_roller(C) - v_ring(C)) . n,
+    alpha = `damping` [s/m] (`jaxbearing.contact.hunt_crossley_factor`).
 
     Hertz point contact of the end surface against the plane (Hamrock & Brewe 1983, via
     `jaxbearing.contact`): principal radii R_end, R_end on the arc; R_cor across the corner and
@@ -134,17 +147,22 @@ def roller_flange_contact(
     c_r = jnp.asarray(ring_centre)
     e_prime = flange_effective_modulus(bearing)
 
-    stiffness = point_contact_stiffness(g.radius_meridian, g.radius_parallel, e_prime)
-    q = hertz_force(g.interference, stiffness, PENETRATION_WIDTH)
-    # both are 0, with zero derivatives, for Q below jaxbearing.contact's load floor
-    p_max = point_contact_peak_pressure(q, g.radius_meridian, g.radius_parallel, e_prime)
-    semi = jnp.stack(point_contact_ellipse(q, g.radius_meridian, g.radius_parallel, e_prime))
-
     v_roller = roller_velocity + jnp.cross(roller_angular_velocity, c - p)
     v_ring = ring_velocity + jnp.cross(ring_angular_velocity, c - c_r)
     u = v_roller - v_ring
-    u = u - jnp.dot(u, n) * n
+    approach_rate = jnp.dot(u, n)  # n points from the roller into the flange
+    u = u - approach_rate * n
     speed = safe_norm(u)
+    spin_surface = jnp.cross(roller_angular_velocity, c - p)
+    surface_speed = safe_norm(spin_surface - jnp.dot(spin_surface, n) * n)
+
+    stiffness = point_contact_stiffness(g.radius_meridian, g.radius_parallel, e_prime)
+    q = hertz_force(g.interference, stiffness, PENETRATION_WIDTH) * hunt_crossley_factor(
+        approach_rate, damping
+    )
+    # both are 0, with zero derivatives, for Q below jaxbearing.contact's load floor
+    p_max = point_contact_peak_pressure(q, g.radius_meridian, g.radius_parallel, e_prime)
+    semi = jnp.stack(point_contact_ellipse(q, g.radius_meridian, g.radius_parallel, e_prime))
 
     f_t = -bearing.flange_traction * q * smooth_direction(u, SLIDING_EPS)
     force = -q * n + f_t
@@ -154,6 +172,8 @@ def roller_flange_contact(
         peak_pressure=p_max,
         sliding_velocity=u,
         sliding_speed=speed,
+        roller_surface_speed=surface_speed,
+        approach_rate=approach_rate,
         pv=p_max * speed,
         contact_point=c,
         contact_height=g.contact_height,

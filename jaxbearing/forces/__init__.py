@@ -34,7 +34,6 @@ from ._pocket import (
     pocket_stiffness,
 )
 from ._raceway import (
-    HUNT_CROSSLEY_ALPHA,
     RacewayContact,
     crown_curvature,
     crown_drop,
@@ -49,7 +48,6 @@ from ._raceway import (
 __all__ = [
     "FILM_ECCENTRICITY_KNEE",
     "FILM_ECCENTRICITY_MAX",
-    "HUNT_CROSSLEY_ALPHA",
     "NUM_POCKET_SLICES",
     "PocketContact",
     "RacewayContact",

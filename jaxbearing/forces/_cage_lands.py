@@ -71,22 +71,22 @@ neglected), plus the rub friction torque R F_friction. eta is the mixture viscos
 
 from __future__ import annotations
 
-import jax
 import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array, ArrayLike, Float
 
 from ..contact import (
+    HUNT_CROSSLEY_ALPHA,
     PENETRATION_WIDTH,
     SLIDING_EPS,
     effective_modulus,
     hertz_force,
+    hunt_crossley_factor,
     line_contact_stiffness,
     safe_norm,
 )
 from ..geometry import Bearing
 from ._drag import mixture_viscosity
-from ._raceway import HUNT_CROSSLEY_ALPHA
 
 #: eps_1: below this eccentricity ratio the film force is exactly Ocvirk's.
 FILM_ECCENTRICITY_KNEE = 0.8
@@ -94,8 +94,6 @@ FILM_ECCENTRICITY_KNEE = 0.8
 FILM_ECCENTRICITY_MAX = 0.95
 #: Line-contact exponent of the rub contact (Palmgren, ISO/TS 16281).
 _LINE_EXPONENT = 10.0 / 9.0
-#: Width of the softplus keeping the Hunt-Crossley factor positive (as in `_raceway`).
-_DAMPING_FACTOR_WIDTH = 0.02
 
 _X = np.array([1.0, 0.0, 0.0])
 _YZ = np.array([0.0, 1.0, 1.0])
@@ -175,9 +173,7 @@ def cage_land_forces(
     q_el = hertz_force(
         e_len - clearance, land_contact_stiffness(bearing), penetration_width, _LINE_EXPONENT
     )
-    factor = _DAMPING_FACTOR_WIDTH * jax.nn.softplus(
-        (1.0 + 1.5 * damping * v_n) / _DAMPING_FACTOR_WIDTH
-    )
+    factor = hunt_crossley_factor(v_n, damping)
     q = q_el * factor
     slide = jnp.dot(vel, t) + omega * radius
     friction = -bearing.pocket_friction * q * slide / jnp.sqrt(slide**2 + speed_eps**2)

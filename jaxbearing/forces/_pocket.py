@@ -33,7 +33,7 @@ Damping (Hunt & Crossley 1975, J. Appl. Mech. 42:440-445), as in `_raceway`:
 N_k = q_k s(1 + 3/2 alpha d(delta_k)/dt), d(delta_k)/dt = (v_roller - v_cage) . n_s at the
 contact point. It is proportional to the elastic load, so it vanishes with the contact and is
 continuous when a slice opens or closes; s() is a softplus of width 0.02 that keeps the factor
-positive (no adhesive pull on fast separation). alpha defaults to `_raceway.HUNT_CROSSLEY_ALPHA`.
+positive (no adhesive pull on fast separation). alpha defaults to `contact.HUNT_CROSSLEY_ALPHA`.
 
 Friction (Coulomb, mu_p = `Bearing.pocket_friction`): -mu_p N_k u/sqrt(|u|^2 + u_eps^2) on the
 roller, u the tangential part (to the wall) of the sliding velocity of the roller material
@@ -49,26 +49,25 @@ the cage centre.
 from __future__ import annotations
 
 import equinox as eqx
-import jax
 import jax.numpy as jnp
 from jaxtyping import Array, ArrayLike, Float
 
 from ..contact import (
+    HUNT_CROSSLEY_ALPHA,
     PENETRATION_WIDTH,
     SLIDING_EPS,
     effective_modulus,
+    hunt_crossley_factor,
     line_contact_stiffness,
     line_slice_loads,
     safe_norm,
     smooth_direction,
 )
 from ..geometry import Bearing
-from ._raceway import HUNT_CROSSLEY_ALPHA, slice_positions
+from ._raceway import slice_positions
 
 #: Default number of slices of the roller-pocket line contact.
 NUM_POCKET_SLICES = 5
-#: Width of the softplus keeping the Hunt-Crossley factor positive (as in `_raceway`).
-_DAMPING_FACTOR_WIDTH = 0.02
 
 
 class PocketContact(eqx.Module):
@@ -152,9 +151,7 @@ def pocket_contact(
     v_cage = cage_velocity + jnp.cross(cage_angular_velocity, x - c_c)
     v_rel = v_roller - v_cage  # (2, N, 3)
     approach_rate = jnp.sum(v_rel * normal[:, None, :], axis=-1)  # d(delta)/dt
-    factor = _DAMPING_FACTOR_WIDTH * jax.nn.softplus(
-        (1.0 + 1.5 * damping * approach_rate) / _DAMPING_FACTOR_WIDTH
-    )
+    factor = hunt_crossley_factor(approach_rate, damping)
     n_load = q_el * factor  # (2, N)
 
     slide = v_rel - approach_rate[..., None] * normal[:, None, :]

@@ -69,9 +69,11 @@ from jaxtyping import Array, ArrayLike, Float
 
 from .._errors import UserInputError
 from ..contact import (
+    HUNT_CROSSLEY_ALPHA,
     PENETRATION_WIDTH,
     SLIDING_EPS,
     effective_modulus,
+    hunt_crossley_factor,
     line_contact_stiffness,
     line_slice_loads,
     safe_norm,
@@ -79,10 +81,6 @@ from ..contact import (
 )
 from ..geometry import Bearing, Roller, sag
 
-#: Hunt-Crossley damping coefficient alpha [s/m] (Hunt & Crossley 1975: 0.08-0.32 s/m, steel).
-HUNT_CROSSLEY_ALPHA = 0.3
-#: width of the softplus that keeps the Hunt-Crossley factor 1 + 1.5 alpha d(delta)/dt positive.
-_DAMPING_FACTOR_WIDTH = 0.02
 #: load weight added to each slice in the load-weighted mean sliding speed [N] (avoids 0/0).
 _MEAN_WEIGHT_EPS = 1e-12
 
@@ -256,9 +254,7 @@ def raceway_contact(
     v_rel = v_roller - v_ring
     v_n = jnp.sum(v_rel * n, axis=-1)
     approach_rate = -v_n  # d(delta)/dt: positive while the bodies close in
-    factor = _DAMPING_FACTOR_WIDTH * jax.nn.softplus(
-        (1.0 + 1.5 * damping * approach_rate) / _DAMPING_FACTOR_WIDTH
-    )
+    factor = hunt_crossley_factor(approach_rate, damping)
     normal = q_el * factor
 
     u = v_rel - v_n[:, None] * n

@@ -113,6 +113,7 @@ def _save(t, y_scaled, args: SolveArgs):
         flange_force=fl.normal_force,
         flange_pressure=fl.peak_pressure,
         flange_sliding_speed=fl.sliding_speed,
+        flange_roller_surface_speed=fl.roller_surface_speed,
         flange_pv=fl.pv,
         contact_height=fl.contact_height,
         contact_radius=fl.contact_radius,

@@ -17,6 +17,8 @@ _EVENT_QUANTITIES = {
     "flange_force_N": ("flange_force", "max"),
     "flange_pressure_Pa": ("flange_pressure", "max"),
     "flange_sliding_velocity_m_s": ("flange_sliding_speed", "at_peak"),
+    # the paper's Figure 7c definition: the roller's own surface speed at the contact point
+    "flange_roller_surface_speed_m_s": ("flange_roller_surface_speed", "at_peak"),
     "flange_pv_Pa_m_s": ("flange_pv", "max"),
     "contact_height_m": ("contact_height", "at_peak"),
     "contact_radius_m": ("contact_radius", "at_peak"),
