@@ -4,8 +4,10 @@ Pure functions of geometry and loads, broadcasting over leading axes, in SI unit
 jit/vmap/grad-friendly: every law is smoothed so that values, gradients and Hessians are finite
 at, below and above zero penetration and at zero sliding (MODEL.md section 4).
 
-- Point contact (Hamrock & Brewe 1983): `effective_modulus`, `point_contact_stiffness`,
-  `point_contact_ellipse`, `point_contact_peak_pressure`, `point_contact_deflection`,
+- Point contact, exact Hertz solution (Johnson 1985, sec. 4.2): `effective_modulus`,
+  `point_contact_stiffness`, `point_contact_ellipse`, `point_contact_peak_pressure`,
+  `point_contact_deflection`, `point_contact_ellipticity`, `point_contact_parameters`,
+  `complete_elliptic_integrals`; the Hamrock & Brewe (1983) fit for comparison:
   `hamrock_brewe_parameters`.
 - Line contact (ISO/TS 16281, MODEL.md 4.2): `line_contact_stiffness`, `line_slice_loads`.
 - Smoothing: `smooth_penetration`, `smooth_power`, `hertz_force`, `safe_norm`,
@@ -17,10 +19,13 @@ from ._hertz import (
     HAMROCK_BREWE_ERROR,
     LOAD_FLOOR,
     MAX_CURVATURE_RATIO,
+    complete_elliptic_integrals,
     effective_modulus,
     hamrock_brewe_parameters,
     point_contact_deflection,
     point_contact_ellipse,
+    point_contact_ellipticity,
+    point_contact_parameters,
     point_contact_peak_pressure,
     point_contact_stiffness,
 )
@@ -56,6 +61,7 @@ __all__ = [
     "STEEL_ELASTIC_MODULUS",
     "STEEL_E_PRIME",
     "STEEL_POISSON_RATIO",
+    "complete_elliptic_integrals",
     "effective_modulus",
     "friction_force",
     "hamrock_brewe_parameters",
@@ -65,6 +71,8 @@ __all__ = [
     "log_smooth_penetration",
     "point_contact_deflection",
     "point_contact_ellipse",
+    "point_contact_ellipticity",
+    "point_contact_parameters",
     "point_contact_peak_pressure",
     "point_contact_stiffness",
     "safe_norm",
