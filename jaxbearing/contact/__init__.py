@@ -1,4 +1,4 @@
-"""Contact-mechanics primitives: Hertz point contact, sliced line contact, smoothing, traction.
+"""Contact-mechanics primitives: Hertz and line contact, smoothing, damping, traction.
 
 Pure functions of geometry and loads, broadcasting over leading axes, in SI units, and
 jit/vmap/grad-friendly: every law is smoothed so that values, gradients and Hessians are finite
@@ -13,8 +13,16 @@ at, below and above zero penetration and at zero sliding (MODEL.md section 4).
 - Smoothing: `smooth_penetration`, `smooth_power`, `hertz_force`, `safe_norm`,
   `smooth_direction`.
 - Traction and friction: `traction_coefficient`, `traction_force`, `friction_force`.
+- Normal damping (Hunt & Crossley 1975): `hunt_crossley_force`, `hunt_crossley_factor`,
+  `HUNT_CROSSLEY_ALPHA`.
 """
 
+from ._damping import (
+    DAMPING_FACTOR_WIDTH,
+    HUNT_CROSSLEY_ALPHA,
+    hunt_crossley_factor,
+    hunt_crossley_force,
+)
 from ._hertz import (
     HAMROCK_BREWE_ERROR,
     LOAD_FLOOR,
@@ -51,7 +59,9 @@ from ._smooth import (
 from ._traction import friction_force, traction_coefficient, traction_force
 
 __all__ = [
+    "DAMPING_FACTOR_WIDTH",
     "HAMROCK_BREWE_ERROR",
+    "HUNT_CROSSLEY_ALPHA",
     "ISO_LINE_CONSTANT",
     "LINE_EXPONENT",
     "LOAD_FLOOR",
@@ -66,6 +76,8 @@ __all__ = [
     "friction_force",
     "hamrock_brewe_parameters",
     "hertz_force",
+    "hunt_crossley_factor",
+    "hunt_crossley_force",
     "line_contact_stiffness",
     "line_slice_loads",
     "log_smooth_penetration",
