@@ -1,4 +1,4 @@
-"""Contact-mechanics primitives: Hertz and line contact, smoothing, damping, traction.
+"""Contact-mechanics primitives: Hertz and line contact, smoothing, damping, EHL film, traction.
 
 Pure functions of geometry and loads, broadcasting over leading axes, in SI units, and
 jit/vmap/grad-friendly: every law is smoothed so that values, gradients and Hessians are finite
@@ -15,6 +15,10 @@ at, below and above zero penetration and at zero sliding (MODEL.md section 4).
 - Traction and friction: `traction_coefficient`, `traction_force`, `friction_force`.
 - Normal damping (Hunt & Crossley 1975): `hunt_crossley_force`, `hunt_crossley_factor`,
   `HUNT_CROSSLEY_ALPHA`.
+- Lubricated point contact: Hamrock & Dowson (1977) film thickness `minimum_film_thickness`,
+  `central_film_thickness`, `ehl_parameters`; `viscosity_at_temperature`,
+  `entrainment_velocity`, `entrainment_radii`; film parameter `film_parameter`; load-sharing
+  mixed traction `asperity_load_fraction`, `mixed_traction_coefficient`, `mixed_traction_force`.
 """
 
 from ._damping import (
@@ -22,6 +26,22 @@ from ._damping import (
     HUNT_CROSSLEY_ALPHA,
     hunt_crossley_factor,
     hunt_crossley_force,
+)
+from ._film import (
+    ASPERITY_EXPONENT,
+    ASPERITY_MIDPOINT,
+    FILM_LOAD_FLOOR,
+    ROUGHNESS_FLOOR,
+    asperity_load_fraction,
+    central_film_thickness,
+    ehl_parameters,
+    entrainment_radii,
+    entrainment_velocity,
+    film_parameter,
+    minimum_film_thickness,
+    mixed_traction_coefficient,
+    mixed_traction_force,
+    viscosity_at_temperature,
 )
 from ._hertz import (
     HAMROCK_BREWE_ERROR,
@@ -59,7 +79,10 @@ from ._smooth import (
 from ._traction import friction_force, traction_coefficient, traction_force
 
 __all__ = [
+    "ASPERITY_EXPONENT",
+    "ASPERITY_MIDPOINT",
     "DAMPING_FACTOR_WIDTH",
+    "FILM_LOAD_FLOOR",
     "HAMROCK_BREWE_ERROR",
     "HUNT_CROSSLEY_ALPHA",
     "ISO_LINE_CONSTANT",
@@ -67,12 +90,19 @@ __all__ = [
     "LOAD_FLOOR",
     "MAX_CURVATURE_RATIO",
     "PENETRATION_WIDTH",
+    "ROUGHNESS_FLOOR",
     "SLIDING_EPS",
     "STEEL_ELASTIC_MODULUS",
     "STEEL_E_PRIME",
     "STEEL_POISSON_RATIO",
+    "asperity_load_fraction",
+    "central_film_thickness",
     "complete_elliptic_integrals",
     "effective_modulus",
+    "ehl_parameters",
+    "entrainment_radii",
+    "entrainment_velocity",
+    "film_parameter",
     "friction_force",
     "hamrock_brewe_parameters",
     "hertz_force",
@@ -81,6 +111,9 @@ __all__ = [
     "line_contact_stiffness",
     "line_slice_loads",
     "log_smooth_penetration",
+    "minimum_film_thickness",
+    "mixed_traction_coefficient",
+    "mixed_traction_force",
     "point_contact_deflection",
     "point_contact_ellipse",
     "point_contact_ellipticity",
@@ -93,4 +126,5 @@ __all__ = [
     "smooth_power",
     "traction_coefficient",
     "traction_force",
+    "viscosity_at_temperature",
 ]
