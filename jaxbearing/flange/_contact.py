@@ -125,7 +125,7 @@ def roller_flange_contact(
     multiplied by s(1 + 1.5 alpha d(delta)/dt), d(delta)/dt = (v_roller(C) - v_ring(C)) . n,
     alpha = `damping` [s/m] (`jaxbearing.contact.hunt_crossley_factor`).
 
-    Hertz point contact of the end surface against the plane (Hamrock & Brewe 1983, via
+    Hertz point contact of the end surface against the plane (exact elliptic solution, via
     `jaxbearing.contact`): principal radii R_end, R_end on the arc; R_cor across the corner and
     rho_c / sin(alpha) along it on the corner torus, blended C1 across the limited circle
     (`end_principal_curvatures`). Q = K delta^1.5 (softplus of width PENETRATION_WIDTH),

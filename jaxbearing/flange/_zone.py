@@ -68,7 +68,7 @@ def design_zone(
     flange at +X is evaluated by `jaxbearing.flange` (support function of the end body), the
     corner contact by the same code with flat ends, the arc protrusion e by the support function
     along the roller axis, e = h(x) - L_b1/2. The contact-ellipse half-width along the flange
-    height comes from the Hertz solution (Hamrock & Brewe 1983, via `jaxbearing.contact`) with
+    height comes from the exact Hertz solution (`jaxbearing.contact`) with
     the principal radii at the contact point and the normal load `flange_load` (N).
     `min_clearance` (m) is the required actual axial clearance.
     """
