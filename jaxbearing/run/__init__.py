@@ -3,7 +3,8 @@
 - `solve` (pure, jit/vmap/grad-able diffrax integration of the scaled state), `simulate`
   (compiled, with wall times and a `SimulationResult`), `simulation_result`,
   `flange_functionals` (smooth peak PV and contact heights for gradients), `Perturbation`
-  (seeded initial roller scatter), `initial_state`, `smooth_functionals`;
+  (seeded initial roller scatter), `initial_state`, `smooth_functionals`, `result_code` and
+  `RESULT_NAMES` (the outcome code of a solve), `SolveProgress` (the text progress meter);
 - statistics: `contact_events`, `summarise`;
 - design metrics through the dynamics: `design_metrics`, `design_jacobian`, `DesignMetrics`,
   `seated_perturbation`, `forward_jacobian`;
@@ -24,13 +25,16 @@ from ._design import (
     seated_perturbation,
 )
 from ._plots import plot_run
+from ._progress import SolveProgress
 from ._simulate import (
+    RESULT_NAMES,
     Perturbation,
     SimulationResult,
     Solution,
     SolveArgs,
     flange_functionals,
     initial_state,
+    result_code,
     scaled_field,
     simulate,
     simulation_result,
@@ -40,6 +44,7 @@ from ._simulate import (
 from ._summary import contact_events, summarise
 
 __all__ = [
+    "RESULT_NAMES",
     "GRADIENT_ATOL",
     "GRADIENT_HORIZON",
     "GRADIENT_MODE_NOTE",
@@ -48,6 +53,7 @@ __all__ = [
     "Perturbation",
     "SimulationResult",
     "Solution",
+    "SolveProgress",
     "SolveArgs",
     "contact_events",
     "design_jacobian",
@@ -56,6 +62,7 @@ __all__ = [
     "forward_jacobian",
     "initial_state",
     "plot_run",
+    "result_code",
     "scaled_field",
     "seated_perturbation",
     "simulate",
