@@ -142,7 +142,7 @@ class Rule:
             bad = ~(np.isfinite(v) & self._in_range(v))
         if np.any(bad):
             first = float(v if v.ndim == 0 else v[bad].ravel()[0])
-            fail(_short(first) if math.isfinite(first) else repr(first))
+            fail(repr(float(f"{first:.12g}")) if math.isfinite(first) else repr(first))
 
 def real(lo=None, hi=None, *, lo_closed=False, hi_closed=False, unit="", note="") -> Rule:
     """A rule for a finite real number in the range lo..hi (open ends unless closed)."""
