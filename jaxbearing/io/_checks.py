@@ -69,8 +69,7 @@ def _shown(value) -> str:
 class Rule:
     """The valid values of one argument.
 
-    `kind`: "real" (a finite number, or an array of them, in the range lo..hi; "(" open or "["
-    closed ends), "count" (an integer, never a bool or a float, in lo..hi) or "bool".
+    `kind`: "real" (one finite number, in the range lo..hi; "(" open or "[" closed ends), "count" (an integer, never a bool or a float, in lo..hi) or "bool".
     `unit` is shown after the range; `note` after that (what a special value means).
     """
 
@@ -138,6 +137,8 @@ class Rule:
             fail(_shown(value))
         if kind not in "iuf":
             fail(_shown(value))
+        if v.ndim:
+            fail(f"an array of shape {v.shape} (one value is needed)")
         with np.errstate(invalid="ignore"):
             bad = ~(np.isfinite(v) & self._in_range(v))
         if np.any(bad):
