@@ -94,7 +94,7 @@ class Bounds:
             pair = getattr(self, name)
             if len(pair) != 2:
                 raise UserInputError(f"bounds.{name}_{unit} = {pair!r}: expected (lower, upper)")
-            lo, hi = (float(v) * k for v in pair)
+            lo, hi = (float(f"{float(v) * k:.12g}") for v in pair)  # 60 deg, not 59.99999999999999
             for which, v in (("lower", lo), ("upper", hi)):
                 require(f"bounds.{name}_{unit} {which} bound", v, lambda x: np.isfinite(x) & ok(x), valid)
             if lo > hi:
@@ -105,9 +105,9 @@ class Bounds:
         convex and meet the corner torus; the same range as `roller.end_radius_mm`)."""
         if not is_concrete(bearing.roller.diameter):
             return
-        half_d = float(np.max(np.asarray(bearing.roller.diameter))) / 2 / MM
+        half_d = float(f"{float(np.max(np.asarray(bearing.roller.diameter))) / 2 / MM:.12g}")
         for which, v in zip(("lower", "upper"), self.end_radius):
-            require(f"bounds.end_radius_mm {which} bound", float(v) / MM, lambda x: x > half_d,
+            require(f"bounds.end_radius_mm {which} bound", float(f"{float(v) / MM:.12g}"), lambda x: x > half_d,
                     f"> D/2 = {half_d:g} mm (half the roller diameter of the bearing)")
 
     @property
