@@ -124,6 +124,8 @@ def _compile_dopri5_rms(field: _common.FlatField, duration):
     import jax.numpy as jnp
     import optimistix as optx
 
+    from jaxbearing.run import result_code
+
     def run(y0, args_flat, t1):
         sol = diffrax.diffeqsolve(
             diffrax.ODETerm(field.__call__),
@@ -143,7 +145,7 @@ def _compile_dopri5_rms(field: _common.FlatField, duration):
             max_steps=1_000_000,
             throw=False,
         )
-        return sol.ys[-1], sol.result._value, sol.stats["num_steps"], sol.stats["num_rejected_steps"]
+        return sol.ys[-1], result_code(sol.result), sol.stats["num_steps"], sol.stats["num_rejected_steps"]
 
     return _common.compile_jit(run, field.y0, field.args_flat, jnp.asarray(duration))
 

@@ -10,7 +10,6 @@ design found (none in the bounds, or no iterate reached the zone).
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import pathlib
 import sys
@@ -46,7 +45,18 @@ def build_parser() -> argparse.ArgumentParser:
         "peak flange PV over R_end, layback angle and axial clearance inside the design zone.",
     )
     sub = p.add_subparsers(dest="command", metavar="COMMAND")
-    r = sub.add_parser("run", help="run the multi-start projected augmented-Lagrangian search")
+    from jaxbearing.cli import exit_codes_text
+
+    r = sub.add_parser(
+        "run", help="run the multi-start projected augmented-Lagrangian search",
+        description="Search the roller-end/flange design (end radius R_end, layback angle "
+        "theta_f, axial clearance Delta_bf) that minimises the smooth peak flange PV of short "
+        "dynamic runs over an envelope of speeds and loads, inside the design zone (relief, "
+        "height limit, limited circle, actual axial clearance). Several starts run in parallel "
+        "(projected augmented Lagrangian with Adam, forward-mode gradients through the solve). "
+        "Writes DIR/result.json (strict JSON) and DIR/search_paths.png when the search ends; a "
+        "killed run writes nothing and leaves earlier results as they were.",
+        epilog=exit_codes_text(), formatter_class=argparse.RawDescriptionHelpFormatter)
     r.add_argument("--config", help="jaxbearing TOML configuration (bearing and operating point; "
                    "default: the embedded reference bearing)")
     r.add_argument("--bounds", dest="bounds_file", help="optimiser TOML file with [bounds], "
@@ -158,11 +168,15 @@ def run(args) -> int:
 
     from jaxbearing import load_config
     from jaxbearing.flange import MARGIN_NAMES
+    from jaxbearing.io import write_json
 
     from ._plot import plot_search
     from ._search import search
 
-    cfg = load_config(args.config)
+    try:
+        cfg = load_config(args.config)
+    except UserInputError as exc:
+        raise UserInputError(f"{args.config}: {exc}") from None
     bearing, op = cfg.bearing(), cfg.operating_point()
     s = _settings(args)
     problem, options = problem_from_settings(bearing, op, s)
@@ -193,7 +207,7 @@ def run(args) -> int:
 
     res = search(problem, callback=progress, **options)
     result = _result_json(problem, options, res)
-    (out / "result.json").write_text(json.dumps(result, indent=2))
+    write_json(out / "result.json", result)
     plot_path = out / "search_paths.png"
     plot_search(problem, res, plot_path)
 

@@ -49,6 +49,7 @@ from jaxbearing.flange import (
     design_zone_grid,
     zone_margins,
 )
+from jaxbearing.io import check_model_inputs, check_solver_arguments, is_concrete, require
 from jaxbearing.run import design_metrics, seated_perturbation
 
 MM = 1e-3
@@ -79,23 +80,35 @@ class Bounds:
     layback_angle: tuple[float, float] = (1.0 * DEG, 2.0 * DEG)
     axial_clearance: tuple[float, float] = (0.10 * MM, 0.30 * MM)
 
+    #: (field, unit, SI -> unit factor, valid range in that unit, its text); R_end > D/2 is
+    #: checked against the actual roller in `check(bearing)`
+    _RANGES = (
+        ("end_radius", "mm", 1 / MM, lambda v: v > 0, "> 0 mm (and > D/2 of the roller)"),
+        ("layback_angle", "deg", 1 / DEG, lambda v: (v >= 0) & (v < 45), "in [0, 45) deg"),
+        ("axial_clearance", "mm", 1 / MM, lambda v: v > 0, "> 0 mm"),
+    )
+
     def __post_init__(self):
-        checks = (
-            ("end_radius", "mm", 1 / MM, lambda v: v > 3.75 * MM, "> D/2"),
-            ("layback_angle", "deg", 1 / DEG, lambda v: 0 <= v < 45 * DEG, "in [0, 45) deg"),
-            ("axial_clearance", "mm", 1 / MM, lambda v: v > 0, "> 0"),
-        )
-        for name, unit, k, ok, valid in checks:
-            lo, hi = (float(v) for v in getattr(self, name))
+        """Each bound finite and in its range (`jaxbearing.io.require`), lower <= upper."""
+        for name, unit, k, ok, valid in self._RANGES:
+            pair = getattr(self, name)
+            if len(pair) != 2:
+                raise UserInputError(f"bounds.{name}_{unit} = {pair!r}: expected (lower, upper)")
+            lo, hi = (float(f"{float(v) * k:.12g}") for v in pair)  # 60 deg, not 59.99999999999999
             for which, v in (("lower", lo), ("upper", hi)):
-                if not (math.isfinite(v) and ok(v)):
-                    raise UserInputError(
-                        f"bounds.{name}_{unit} {which} bound = {v * k:g}: must be finite and {valid}"
-                    )
+                require(f"bounds.{name}_{unit} {which} bound", v, lambda x: np.isfinite(x) & ok(x), valid)
             if lo > hi:
-                raise UserInputError(
-                    f"bounds.{name}_{unit} = [{lo * k:g}, {hi * k:g}]: lower bound above upper bound"
-                )
+                raise UserInputError(f"bounds.{name}_{unit} = [{lo:g}, {hi:g}]: lower bound above upper bound")
+
+    def check(self, bearing: Bearing) -> None:
+        """The end-radius bounds against the roller of `bearing`: R_end > D/2 (the end must be
+        convex and meet the corner torus; the same range as `roller.end_radius_mm`)."""
+        if not is_concrete(bearing.roller.diameter):
+            return
+        half_d = float(f"{float(np.max(np.asarray(bearing.roller.diameter))) / 2 / MM:.12g}")
+        for which, v in zip(("lower", "upper"), self.end_radius):
+            require(f"bounds.end_radius_mm {which} bound", float(f"{float(v) / MM:.12g}"), lambda x: x > half_d,
+                    f"> D/2 = {half_d:g} mm (half the roller diameter of the bearing)")
 
     @property
     def lower(self) -> np.ndarray:
@@ -239,16 +252,22 @@ class DesignProblem(eqx.Module):
     initial_skew: float = eqx.field(static=True, default=DEFAULT_SKEW)
 
     def __check_init__(self):
+        """Every setting before anything is traced: the solver arguments
+        (`jaxbearing.io.check_solver_arguments`), the bounds against this bearing's roller, the
+        bearing and the operating points (`check_model_inputs`), and the search's own options."""
         if self.aggregate not in ("max", "mean"):
             raise UserInputError(f"aggregate = {self.aggregate!r}: must be 'max' or 'mean'")
-        if not (self.temperature > 0):
-            raise UserInputError(f"temperature = {self.temperature}: must be > 0 GPa m/s")
-        if not (self.duration > 0):
-            raise UserInputError(f"duration = {self.duration}: must be > 0 s")
+        require("temperature", self.temperature, lambda v: np.isfinite(v) & (v > 0), "> 0 GPa m/s and finite")
+        check_solver_arguments(duration=self.duration, rtol=self.rtol, atol=self.atol,
+                               max_steps=self.max_steps)
         if self.perturbation is not None and isinstance(self.perturbation, str) and self.perturbation != "seated":
             raise UserInputError(f"perturbation = {self.perturbation!r}: must be 'seated', a Perturbation or None")
-        if not (self.flange_load > 0):
-            raise UserInputError(f"flange_load = {self.flange_load}: must be > 0 N")
+        require("flange_load", self.flange_load, lambda v: np.isfinite(v) & (v > 0), "> 0 N and finite")
+        require("min_clearance", self.min_clearance, np.isfinite, "finite (m)")
+        require("initial_skew", self.initial_skew, lambda v: np.isfinite(v) & (v >= 0), ">= 0 rad and finite")
+        require("tighten", self.tighten, lambda v: np.isfinite(v) & (v >= 0), ">= 0 and finite")
+        self.bounds.check(self.bearing)
+        check_model_inputs(self.bearing, self.operating)
 
     @property
     def num_operating_points(self) -> int:

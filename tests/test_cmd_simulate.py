@@ -67,9 +67,21 @@ def test_invalid_override_one_line_exit_2(tmp_path, capsys):
 
 
 def test_forced_solver_failure_nonzero_exit(tmp_path, capsys):
-    cfg = _config(tmp_path, "[simulation]\nduration_ms = 0.6\nmax_steps = 30\nprogress = false\nend = \"arc\"\n")
+    """A failed solve: exit 1, the progress meter says where it stopped (no jump to 100 %), the
+    table marks the failed run's values, summary.json is strict JSON (issue 16)."""
+    cfg = _config(tmp_path, "[simulation]\nduration_ms = 0.6\nmax_steps = 30\nprogress = true\nend = \"arc\"\n")
     out = tmp_path / "out"
     assert main(["simulate", "--config", cfg, "--out", str(out)]) == 1
-    doc = json.loads((out / "summary.json").read_text())
+    printed = capsys.readouterr().out
+    assert "stopped at" in printed and "100%" not in printed
+    assert "! [arc] the run failed" in printed
+
+    def strict(token):
+        raise ValueError(f"non-standard JSON token {token}")
+
+    doc = json.loads((out / "summary.json").read_text(), parse_constant=strict)
     assert doc["status"].startswith("failed")
     assert "max_steps" in doc["status"]
+    assert doc["smooth_peak_pv_Pa_m_s"] is None
+    assert doc["null_reasons"]["smooth_peak_pv_Pa_m_s"] == "nan: the run failed (see status)"
+    assert "not reliable" in doc["warning"]

@@ -44,7 +44,7 @@ def test_bounds_scaling_roundtrip_and_fixed_variable():
 
 @pytest.mark.parametrize(
     "kw,text",
-    [(dict(end_radius_mm=[2, 120]), "bounds.end_radius_mm lower bound = 2"),
+    [(dict(end_radius_mm=[-2, 120]), "bounds.end_radius_mm lower bound = -2"),  # > D/2: make_problem
      (dict(layback_angle_deg=[2.0, 1.0]), "lower bound above upper bound"),
      (dict(axial_clearance_mm=[0.1]), "expected \\[lower, upper\\]"),
      (dict(layback_angle_deg=[1.0, 50.0]), "bounds.layback_angle_deg upper bound = 50")],

@@ -3,7 +3,8 @@
     jaxbearing config show                 the full reference configuration, every key commented
     jaxbearing config show --config FILE   FILE merged over the reference
     jaxbearing config check FILE [FILE...] "FILE: ok", or one line "FILE: <field>: <message>"
-                                           on stderr and exit status 2
+                                           on stderr and exit status 2; the same checks as
+                                           `jaxbearing simulate --config FILE`
 """
 
 from __future__ import annotations
@@ -39,13 +40,15 @@ def run_show(args) -> int:
 
 
 def run_check(args) -> int:
+    """Each file as `jaxbearing simulate --config FILE` would run it (without options): the
+    ranges of every key, then `check_runnable` (one code path with `simulate`)."""
     from .._errors import ConfigError
-    from ..io import load_config
+    from ..io import check_runnable, load_config
 
     status = 0
     for path in args.files:
         try:
-            load_config(path)
+            check_runnable(load_config(path))
         except ConfigError as exc:
             print(f"{path}: {exc}", file=sys.stderr)
             status = 2

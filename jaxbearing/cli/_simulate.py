@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-import json
 import math
 import pathlib
 
+from .._errors import UserInputError
 from . import _steady
 
 _TABLE_ROWS = (
@@ -36,27 +36,67 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
+#: command-line option -> the configuration key it overrides
+_OVERRIDES = {
+    "speed_rpm": ("--speed-rpm", "operating.speed_rpm"),
+    "load_N": ("--load-N", "operating.radial_load_N"),
+    "duration_ms": ("--duration-ms", "simulation.duration_ms"),
+    "end": ("--end", "simulation.end"),
+}
+
+
 def _load(args):
+    """The configuration to run: the file (errors name it), the overrides (errors name the
+    option), and the checks a run needs (`check_runnable`, as `config check` does)."""
+    from ..io import check_runnable
+
+    cfg = load_named_config(args.config)
+    overrides = {key: getattr(args, attr) for attr, (_, key) in _OVERRIDES.items()
+                 if getattr(args, attr) is not None}
+    try:
+        cfg = cfg.replace(**overrides) if overrides else cfg
+    except UserInputError as exc:
+        raise _named(exc, next((opt for opt, key in _OVERRIDES.values()
+                                if key == getattr(exc, "field", None)), None)) from None
+    try:
+        check_runnable(cfg)
+    except UserInputError as exc:
+        raise _named(exc, args.config) from None
+    return cfg
+
+
+def _named(exc: Exception, where: str | None) -> UserInputError:
+    """The error with `where` (a file or option) in front of its one line."""
+    return UserInputError(f"{where}: {exc}" if where else str(exc))
+
+
+def load_named_config(path):
+    """`load_config(path)` whose errors start with the file name."""
     from ..io import load_config
 
-    cfg = load_config(args.config)
-    overrides = {}
-    if args.speed_rpm is not None:
-        overrides["operating.speed_rpm"] = args.speed_rpm
-    if args.load_N is not None:
-        overrides["operating.radial_load_N"] = args.load_N
-    if args.duration_ms is not None:
-        overrides["simulation.duration_ms"] = args.duration_ms
-    if args.end is not None:
-        overrides["simulation.end"] = args.end
-    if overrides:
-        cfg = cfg.replace(**overrides)
-    return cfg
+    try:
+        return load_config(path)
+    except UserInputError as exc:
+        raise _named(exc, str(path) if path is not None else None) from None
+
+
+def _check_out(out: str | None) -> None:
+    """--out must be a directory or creatable as one (checked before anything is computed)."""
+    if out is None:
+        return
+    path = pathlib.Path(out)
+    if path.exists() and not path.is_dir():
+        raise UserInputError(f"--out {out}: exists and is not a directory; name a directory")
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise UserInputError(f"--out {out}: cannot create the directory: {exc.strerror or exc}") from None
 
 
 def run_cases(cfg, progress: bool = True, steady: dict | None = None) -> dict:
     """Run the configured end type(s); returns {end: (result, summary)}. `steady`: keyword
     arguments of a settled run (`_steady.options`)."""
+    from ..io import check_runnable
     from ..run import simulate, summarise
 
     sim = cfg.simulation
@@ -64,12 +104,9 @@ def run_cases(cfg, progress: bool = True, steady: dict | None = None) -> dict:
     op = cfg.operating_point()
     ends = ("arc", "corner") if sim.end == "both" else (sim.end,)
     out = {}
+    check_runnable(cfg)
     for end in ends:
         b = bearing.with_flat_ends() if end == "corner" else bearing
-        if end == "arc" and not math.isfinite(float(b.roller.end_radius)):
-            from .._errors import ConfigError
-
-            raise ConfigError("roller.end_radius_mm", "inf (flat end) cannot be simulated as an arc end; use --end corner")
         if progress:
             what = "until settled" if steady else f"{sim.duration_ms:g} ms"
             print(f"[{end} end] simulating {what} ...", flush=True)
@@ -87,20 +124,35 @@ def run_cases(cfg, progress: bool = True, steady: dict | None = None) -> dict:
     return out
 
 
+#: mark after a value of a failed run in the table
+FAILED_MARK = "!"
+
+
+def _cell(v, k: float, failed: bool) -> str:
+    if v is None or not math.isfinite(v):
+        return "-"
+    return format(v * k, ".4g") + (FAILED_MARK if failed else "")
+
+
 def format_table(summaries: dict) -> str:
+    """Max / mean / median of every flange quantity per end type; a value of a failed run is
+    marked with FAILED_MARK and explained under the table."""
     ends = list(summaries)
-    lines = []
-    head = f"{'quantity':<22}{'unit':>9}" + "".join(f"{e + ' max':>12}{e + ' mean':>12}{e + ' median':>13}" for e in ends)
-    lines.append(head)
-    lines.append("-" * len(head))
+    failed = {e: summaries[e]["status"] != "ok" for e in ends}
+    stats = ("max", "mean", "median")
+    widths = {e: max(12, len(f"{e} median") + 2) for e in ends}
+    head = f"{'quantity':<22}{'unit':>9}" + "".join(
+        f"{e + ' ' + st:>{widths[e]}}" for e in ends for st in stats)
+    lines = [head, "-" * len(head)]
     for key, label, unit, k in _TABLE_ROWS:
         row = f"{label:<22}{unit:>9}"
         for e in ends:
-            st = summaries[e][key]
-            for stat, w in (("max", 12), ("mean", 12), ("median", 13)):
-                v = st[stat]
-                row += f"{'-' if v is None else format(v * k, '.4g'):>{w}}"
+            row += "".join(f"{_cell(summaries[e][key][st], k, failed[e]):>{widths[e]}}" for st in stats)
         lines.append(row)
+    for e in ends:
+        if failed[e]:
+            lines.append(f"{FAILED_MARK} [{e}] the run failed: statistics cover only the simulated "
+                         "time before the failure and are not reliable")
     lines.append("")
     for e in ends:
         s = summaries[e]
@@ -117,19 +169,34 @@ def format_table(summaries: dict) -> str:
 def write_outputs(out_dir: pathlib.Path, results: dict) -> None:
     import numpy as np
 
+    from ..io import write_json
     from ..run import plot_run
 
     out_dir.mkdir(parents=True, exist_ok=True)
-    summaries = {e: s for e, (_, s) in results.items()}
+    summaries = {e: _strict_summary(s) for e, (_, s) in results.items()}
     doc = summaries[next(iter(summaries))] if len(summaries) == 1 else dict(summaries)
-    (out_dir / "summary.json").write_text(json.dumps(doc, indent=2, allow_nan=True))
+    write_json(out_dir / "summary.json", doc)
     for end, (res, _) in results.items():
         np.savez_compressed(out_dir / f"histories_{end}.npz", **res.histories)
     plot_run(out_dir, results)
 
 
+def _strict_summary(summary: dict) -> dict:
+    """A summary block as strict JSON: non-finite values null with their reason
+    (`jaxbearing.io.with_null_reasons`); a failed run gets a `warning` on its statistics."""
+    from ..io import with_null_reasons
+
+    block = dict(summary)
+    failed = block.get("status", "ok") != "ok"
+    if failed:
+        block["warning"] = ("the run failed: statistics cover only the simulated time before the "
+                            "failure and are not reliable")
+    return with_null_reasons(block, "the run failed (see status)" if failed else "no value")
+
+
 def run(args) -> int:
     cfg = _load(args)
+    _check_out(args.out)
     progress = cfg.simulation.progress and not args.no_progress
     steady = _steady.options(args)
     results = run_cases(cfg, progress=progress, steady=steady)

@@ -19,7 +19,8 @@ def register(sub) -> None:
         "sharded over the local devices (and over processes with --coordinator), writing each "
         "finished batch to DIR/batches/ at once; the same command resumes a killed sweep. "
         "Results: DIR/results.nc (xarray Dataset: sweep axes as coordinates, summary statistics, "
-        "status and design-zone margins of every case).",
+        "status and design-zone margins of every case). DIR is locked while the sweep runs; "
+        "batch files that do not load are moved to DIR/batches/damaged/ and computed again.",
     )
     p.add_argument("spec", help="sweep spec (TOML: [sweep], [base], [axes])")
     p.add_argument("--out", required=True, help="output directory")
@@ -34,6 +35,9 @@ def register(sub) -> None:
                    "JAXBEARING_PROCESS_ID)")
     p.add_argument("--wait-timeout-s", type=float, default=24 * 3600.0,
                    help="process 0: how long to wait for the other processes' batches")
+    p.add_argument("--wait-for-lock", type=float, nargs="?", const=float("inf"), default=0.0,
+                   metavar="SECONDS", help="when another sweep is writing into DIR, wait for it "
+                   "(up to SECONDS; no value: as long as it takes) instead of exiting with status 2")
     p.add_argument("--dry-run", action="store_true", help="validate the spec, list the axes "
                    "and the number of cases and batches, compute nothing")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
@@ -62,7 +66,7 @@ def run(args) -> int:
           f"({jax.local_devices()[0].platform})", file=sys.stderr)
     ds = run_sweep(spec, args.out, resume=args.resume, process_id=process_id,
                    num_processes=num_processes, progress=not args.no_progress,
-                   wait_timeout_s=args.wait_timeout_s)
+                   wait_timeout_s=args.wait_timeout_s, lock_wait_s=args.wait_for_lock)
     if ds is None:
         print(f"process {process_id}: batches written to {args.out}/batches")
         return 0

@@ -54,14 +54,11 @@ ch. 8, zero contact angle).
 
 from __future__ import annotations
 
-import math
-
 import equinox as eqx
 import jax
 import jax.numpy as jnp
 from jaxtyping import Array, Float
 
-from .._errors import UserInputError
 from ..contact import PENETRATION_WIDTH
 from ..forces import (
     raceway_stiffness,
@@ -69,6 +66,7 @@ from ..forces import (
     uniform_approach_interference,
 )
 from ..geometry import Bearing, OperatingPoint, kinematic_cage_speed
+from ..io import check_model_inputs
 
 #: bisection steps of each roller's 1-D equilibrium (bracket of ~1e-4 m down to below 1e-20 m).
 _BISECTION_STEPS = 64
@@ -247,36 +245,15 @@ def _solve_ring(prob: _Problem):
     return d
 
 
-def _concrete(x):
-    """float(x) when x is a concrete value, None under tracing (checks then happen eagerly only)."""
-    try:
-        return float(x)
-    except (TypeError, jax.errors.ConcretizationTypeError, jax.errors.TracerArrayConversionError):
-        return None
-
-
-def _check_inputs(bearing: Bearing, op: OperatingPoint) -> None:
-    checks = (
-        ("operating.radial_load", op.radial_load, "N", lambda v: v >= 0, ">= 0 (load along +Z)"),
-        ("operating.gravity", op.gravity, "m/s^2", lambda v: v >= 0, ">= 0 (along +Z)"),
-        ("operating.inner_speed", op.inner_speed, "rad/s", lambda v: True, "finite"),
-        ("bearing.pitch_diameter", bearing.pitch_diameter, "m",
-         lambda v: v > float(bearing.roller.diameter), "> roller diameter"),
-    )
-    for name, value, unit, ok, valid in checks:
-        v = _concrete(value)
-        if v is not None and not (math.isfinite(v) and ok(v)):
-            raise UserInputError(f"{name} = {v} {unit} is out of range: must be {valid}")
-
-
 def quasi_static(bearing: Bearing, op: OperatingPoint) -> QuasiStatic:
     """Quasi-static radial load distribution with centrifugal force, gravity, clearance and
     crowned slices (module docstring). jit-able; differentiable w.r.t. every float parameter.
 
-    Raises `UserInputError` (when called with concrete values) for a negative radial load or
-    gravity, a non-finite speed, or a pitch diameter not larger than the roller diameter.
+    Raises `ConfigError` (a `UserInputError`, naming the configuration key) for any value out of
+    its configuration range (`jaxbearing.io.check_model_inputs`: a negative radial load or
+    gravity, a non-finite speed, rollers that do not fit...); traced values are not checked.
     """
-    _check_inputs(bearing, op)
+    check_model_inputs(bearing, op)
     z = bearing.num_rollers
     psi = 2 * jnp.pi * jnp.arange(z) / z
     e = _radial_unit(psi)

@@ -2,15 +2,35 @@
 
 Owns: every configuration key (path with unit, range, meaning; `KEYS`), reading and writing
 TOML in engineering units (`Config`, `load_config`), validation of pytrees built in Python
-(`validate_bearing`) and the range checks of SI entry-point arguments (`require`).
+(`validate_bearing`), the range checks of SI entry-point arguments (`require`, the table of
+solver arguments `SOLVER_ARGUMENTS` and `check_solver_arguments`, `check_solve_inputs` that
+every model entry point calls before tracing), the checks a configuration needs to be run
+(`check_runnable`), and result files that are whole or absent, in strict JSON (`atomic_write`,
+`write_json`, `dumps_strict`), and the lock on an output directory (`acquire_lock`).
 
 May import: `jaxbearing._errors`, `jaxbearing.geometry`.
 """
 
-from ._checks import is_concrete, require
+from ._checks import (
+    FUNCTIONALS_FIELDS,
+    PERTURBATION_FIELDS,
+    SIMULATE_NUM_SAVES,
+    SOLVER_ARGUMENTS,
+    Rule,
+    check_arguments,
+    check_fields,
+    check_model_inputs,
+    check_solve_inputs,
+    check_solver_arguments,
+    count,
+    is_concrete,
+    real,
+    require,
+)
 from ._config import (
     Config,
     SimulationSettings,
+    check_runnable,
     load_config,
     loads_config,
     reference_bearing,
@@ -18,23 +38,56 @@ from ._config import (
     reference_operating_point,
 )
 from ._extras import optional_import, pyplot
+from ._files import (
+    NULL_REASONS,
+    atomic_write,
+    dumps_strict,
+    remove_stale_temporaries,
+    to_strict_json,
+    with_null_reasons,
+    write_json,
+)
+from ._lock import DirectoryInUse, DirectoryLock, acquire_lock
 from ._validation import KEY_BY_PATH, KEYS, format_value, type_name, validate_bearing
 
 __all__ = [
+    "FUNCTIONALS_FIELDS",
     "KEYS",
     "KEY_BY_PATH",
+    "NULL_REASONS",
+    "PERTURBATION_FIELDS",
+    "SIMULATE_NUM_SAVES",
+    "SOLVER_ARGUMENTS",
     "Config",
+    "DirectoryInUse",
+    "DirectoryLock",
+    "Rule",
     "SimulationSettings",
+    "acquire_lock",
+    "atomic_write",
+    "check_arguments",
+    "check_fields",
+    "check_model_inputs",
+    "check_runnable",
+    "check_solve_inputs",
+    "check_solver_arguments",
+    "count",
+    "dumps_strict",
     "format_value",
     "is_concrete",
     "load_config",
     "loads_config",
     "optional_import",
     "pyplot",
+    "real",
     "reference_bearing",
     "reference_config",
     "reference_operating_point",
+    "remove_stale_temporaries",
     "require",
+    "to_strict_json",
     "type_name",
     "validate_bearing",
+    "with_null_reasons",
+    "write_json",
 ]

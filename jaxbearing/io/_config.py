@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import dataclasses
 import difflib
+import math
 import os
 import re
 import tomllib
@@ -321,8 +322,10 @@ _TOML_POS = re.compile(r"^(?P<msg>.*) \(at line (?P<line>\d+), column (?P<col>\d
 def loads_config(text: str) -> Config:
     """Parse TOML text into a validated `Config`.
 
-    A syntax error raises ConfigError whose field is the position ("line 3, column 9").
+    A syntax error raises ConfigError whose field is the position ("line 3, column 9"). A UTF-8
+    byte-order mark at the start (some Windows editors write one) is ignored.
     """
+    text = text.removeprefix("\ufeff")
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -348,10 +351,25 @@ def load_config(path: str | os.PathLike[str] | None = None) -> Config:
     except OSError as exc:
         raise ConfigError("file", f"cannot read: {exc.strerror or exc}") from None
     try:
-        text = raw.decode("utf-8")
+        text = raw.decode("utf-8-sig")  # without a leading byte-order mark
     except UnicodeDecodeError as exc:
-        raise ConfigError("file", f"not UTF-8 text (byte {exc.start})") from None
+        hint = ("; it starts with a UTF-16 byte-order mark: save it as UTF-8"
+                if raw[:2] in (b"\xff\xfe", b"\xfe\xff") else "")
+        raise ConfigError("file", f"not UTF-8 text (byte {exc.start}){hint}") from None
     return loads_config(text)
+
+
+def check_runnable(cfg: Config) -> None:
+    """The checks a configuration needs to be simulated, beyond the range of each key: an arc
+    end needs a finite end radius. `jaxbearing simulate` and `jaxbearing config check` both call
+    this (one code path), after any command-line overrides. Raises ConfigError."""
+    for end in cfg.simulation.ends:
+        if end == "arc" and not math.isfinite(cfg["roller.end_radius_mm"]):
+            raise ConfigError(
+                "roller.end_radius_mm",
+                f'inf (flat end) cannot be simulated as an arc end (simulation.end = '
+                f'"{cfg.simulation.end}"): set simulation.end = "corner" (--end corner) or give '
+                "a finite end radius")
 
 
 def reference_config() -> Config:

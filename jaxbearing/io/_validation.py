@@ -568,49 +568,64 @@ def _leaf(bearing, op, attr: str):
     return obj
 
 
-def validate_bearing(bearing, op=None) -> None:
+def _traced(x) -> bool:
+    import jax
+
+    return any(isinstance(v, jax.core.Tracer) for v in jax.tree_util.tree_leaves(x))
+
+
+def validate_bearing(bearing, op=None, *, traced: str = "error") -> None:
     """Validate a `Bearing` (and optionally an `OperatingPoint`) built directly in Python.
 
     Values are converted to configuration units so that a failure reads like a configuration
     error, naming the configuration key (e.g. ``roller.end_radius_mm: 3.0 mm is out of range:
-    must be in (diameter_mm/2 = 3.75, inf] mm``). Leaves must be concrete (call this outside
-    `jax.jit`); stacked (batched) pytrees are checked element by element. Gravity, a bool in
-    configuration files, must here be finite and in [0, 100] m/s^2.
+    must be in (diameter_mm/2 = 3.75, inf] mm``). Stacked (batched) pytrees are checked element
+    by element. Gravity, a bool in configuration files, must here be finite and in [0, 100]
+    m/s^2.
+
+    Leaves must be concrete: under `jax.jit`/`grad`/`vmap` they are tracers, which raise
+    TypeError (`traced="error"`, the default) or, with `traced="skip"` (what the model's entry
+    points use), leave out every check that reads a traced leaf and check the rest.
 
     Raises ConfigError on the first violation; returns None.
     """
-    import jax
-
-    trees = [bearing] if op is None else [bearing, op]
-    leaves = jax.tree_util.tree_leaves(trees)
-    if any(isinstance(x, jax.core.Tracer) for x in leaves):
-        raise TypeError("validate_bearing needs concrete values: call it outside jax.jit/grad/vmap")
+    if traced not in ("error", "skip"):
+        raise ValueError(f"traced = {traced!r}: must be 'error' or 'skip'")
     keys = [k for k in KEYS
             if k.attr is not None and (op is not None or not k.attr.startswith("op."))]
-    arrays = {k.path: np.asarray(_leaf(bearing, op, k.attr)) for k in keys
-              if k.kind is not int}
-    shape = np.broadcast_shapes(*(a.shape for a in arrays.values()))
-    if op is not None:
-        g = np.broadcast_to(np.asarray(op.gravity, dtype=float), shape)
-        bad = ~(np.isfinite(g) & (g >= 0) & (g <= 100))
-        if bad.any():
-            idx = tuple(int(i) for i in np.argwhere(bad)[0])
-            where = f"(batch element {idx}) " if shape else ""
-            raise ConfigError("operating.gravity", f"{where}{format_value(float(g[idx]))} m/s^2 is "
-                              "out of range: must be in [0, 100] m/s^2 (9.81 = on, 0 = off)")
+    leaves = {k.path: _leaf(bearing, op, k.attr) for k in keys}
+    skipped = {p for p, v in leaves.items() if _traced(v)}
+    if skipped and traced == "error":
+        raise TypeError("validate_bearing needs concrete values: call it outside jax.jit/grad/vmap")
+    # a key is checked when neither it nor a key its range reads is traced
+    keys = [k for k in keys if k.path not in skipped]
+    checked = [k.path for k in keys if not set(k.deps) & skipped]
+    arrays = {k.path: np.asarray(leaves[k.path]) for k in keys if k.kind is not int}
+    shape = np.broadcast_shapes(*(a.shape for a in arrays.values())) if arrays else ()
+    if op is not None and not _traced(op.gravity):
+        _check_gravity(np.broadcast_to(np.asarray(op.gravity, dtype=float), shape), shape)
     for idx in np.ndindex(shape):
         values = dict(REFERENCE_VALUES)
         for k in keys:
             if k.kind is int:
-                values[k.path] = coerce(k, _leaf(bearing, op, k.attr))
+                values[k.path] = coerce(k, leaves[k.path])
             elif k.kind is bool:  # gravity
                 values[k.path] = bool(np.broadcast_to(arrays[k.path], shape)[idx] > 0)
             else:
                 values[k.path] = k.from_si(float(np.broadcast_to(arrays[k.path], shape)[idx]))
         try:
-            check_values(values, [k.path for k in keys])
+            check_values(values, checked)
         except ConfigError as exc:
             if not shape:
                 raise
             msg = str(exc).removeprefix(f"{exc.field}: ")
             raise ConfigError(exc.field, f"(batch element {idx}) {msg}") from None
+
+
+def _check_gravity(g: np.ndarray, shape: tuple) -> None:
+    bad = ~(np.isfinite(g) & (g >= 0) & (g <= 100))
+    if bad.any():
+        idx = tuple(int(i) for i in np.argwhere(bad)[0])
+        where = f"(batch element {idx}) " if shape else ""
+        raise ConfigError("operating.gravity", f"{where}{format_value(float(g[idx]))} m/s^2 is "
+                          "out of range: must be in [0, 100] m/s^2 (9.81 = on, 0 = off)")

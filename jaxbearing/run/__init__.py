@@ -3,7 +3,8 @@
 - `solve` (pure, jit/vmap/grad-able diffrax integration of the scaled state), `simulate`
   (compiled, with wall times and a `SimulationResult`), `simulation_result`,
   `flange_functionals` (smooth peak PV and contact heights for gradients), `Perturbation`
-  (seeded initial roller scatter), `initial_state`, `smooth_functionals`;
+  (seeded initial roller scatter), `initial_state`, `smooth_functionals`, `result_code` and
+  `RESULT_NAMES` (the outcome code of a solve), `SolveProgress` (the text progress meter);
 - statistics: `contact_events`, `summarise`; of settled running with 95 % confidence
   intervals: `steady_statistics`, `revolution_statistics`, `confidence_intervals`,
   `batch_means`, `student_t_interval`, `Estimate`;
@@ -28,6 +29,7 @@ from ._design import (
     seated_perturbation,
 )
 from ._plots import plot_run
+from ._progress import SolveProgress
 from ._settle import (
     SeedRun,
     SteadyResult,
@@ -39,12 +41,14 @@ from ._settle import (
     summarise_steady,
 )
 from ._simulate import (
+    RESULT_NAMES,
     Perturbation,
     SimulationResult,
     Solution,
     SolveArgs,
     flange_functionals,
     initial_state,
+    result_code,
     scaled_field,
     simulation_result,
     smooth_functionals,
@@ -61,6 +65,7 @@ from ._statistics import (
 from ._summary import contact_events
 
 __all__ = [
+    "RESULT_NAMES",
     "GRADIENT_ATOL",
     "GRADIENT_HORIZON",
     "GRADIENT_MODE_NOTE",
@@ -71,6 +76,7 @@ __all__ = [
     "SeedRun",
     "SimulationResult",
     "Solution",
+    "SolveProgress",
     "SteadyResult",
     "SolveArgs",
     "batch_means",
@@ -83,6 +89,7 @@ __all__ = [
     "forward_jacobian",
     "initial_state",
     "plot_run",
+    "result_code",
     "revolution_statistics",
     "scaled_field",
     "seated_perturbation",

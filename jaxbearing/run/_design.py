@@ -62,6 +62,7 @@ from jaxtyping import Array, ArrayLike, Float
 from .._errors import UserInputError
 from ..flange import DEFAULT_FLANGE_LOAD, DesignVariables, check_design, design_zone
 from ..geometry import Bearing, OperatingPoint
+from ..io import SOLVER_ARGUMENTS, check_model_inputs, check_solver_arguments
 from ._simulate import Perturbation, flange_functionals
 
 #: horizon [s] at which AD and central finite differences of the flange functionals agree to 1%
@@ -142,6 +143,17 @@ def seated_perturbation(bearing: Bearing, *, seed: int = 0, skew: float = 1e-4) 
     return Perturbation(seed=seed, axial=half_gap / u_max, skew=skew)
 
 
+def _check_design_inputs(bearing, op, design, duration, solve_kwargs, flange_load=None,
+                         min_clearance=None):
+    """Before tracing: the solver arguments among `solve_kwargs` and the duration, the base
+    bearing and operating point (`check_model_inputs`) and the design (`check_design`); `solve`
+    checks the rest."""
+    check_solver_arguments(duration=duration, **{k: v for k, v in solve_kwargs.items()
+                                                 if k in SOLVER_ARGUMENTS})
+    check_model_inputs(bearing, op)
+    check_design(bearing, design, flange_load=flange_load, min_clearance=min_clearance)
+
+
 def design_metrics(
     bearing: Bearing,
     op: OperatingPoint,
@@ -164,7 +176,7 @@ def design_metrics(
     (pass `adjoint=diffrax.ForwardMode()`), with respect to `design` and every float leaf of
     `bearing` and `op`; vmappable over stacked `DesignVariables`.
     """
-    check_design(bearing, design)
+    _check_design_inputs(bearing, op, design, duration, solve_kwargs, flange_load, min_clearance)
     b = design.apply(bearing)
     if "perturbation" not in solve_kwargs:
         solve_kwargs = dict(solve_kwargs, perturbation=seated_perturbation(b))
@@ -210,7 +222,7 @@ def design_jacobian(
     `seated_perturbation` as in `design_metrics`."""
     if mode not in ("forward", "reverse"):
         raise UserInputError(f"mode = {mode!r}: must be 'forward' or 'reverse'")
-    check_design(bearing, design)
+    _check_design_inputs(bearing, op, design, duration, solve_kwargs)
     if mode == "forward":
         solve_kwargs = dict(solve_kwargs, adjoint=diffrax.ForwardMode())
 

@@ -27,6 +27,7 @@ import numpy as np
 import optimistix as optx
 from jaxtyping import Array
 
+from .._errors import UserInputError
 from ..dynamics import (
     Accumulators,
     CageState,
@@ -43,6 +44,8 @@ from ..dynamics import (
     tangential_unit,
 )
 from ..geometry import Bearing, OperatingPoint, kinematic_cage_speed
+from ..io import SIMULATE_NUM_SAVES, check_solve_inputs
+from ._progress import SolveProgress
 
 
 @dataclasses.dataclass(frozen=True)
@@ -182,9 +185,40 @@ class Solution(eqx.Module):
 
     histories: dict
     accumulators: Accumulators
-    result: Array  # diffrax RESULTS code (0 = successful)
+    result: Array  # outcome code: index into RESULT_NAMES (0 = successful)
     num_steps: Array
     num_rejected_steps: Array
+
+
+#: outcomes of a solve, by their `diffrax.RESULTS` names; `Solution.result` is the index here
+#: (0 = successful; len(RESULT_NAMES) = an outcome not listed). A stable code, independent of
+#: diffrax's internal numbering.
+RESULT_NAMES = ("successful", "max_steps_reached", "dt_min_reached", "nonfinite",
+                "max_steps_rejected", "event_occurred", "internal_error")
+_RESULT_TEXT = {
+    "max_steps_reached": "the step limit max_steps was reached",
+    "dt_min_reached": "the step size collapsed below dtmin (non-finite or unresolvable dynamics)",
+}
+
+
+def result_code(result) -> Array:
+    """The index in `RESULT_NAMES` of a `diffrax.RESULTS` value (public API: comparisons with
+    the RESULTS members), int32; works under jit and vmap."""
+    code = jnp.asarray(len(RESULT_NAMES), dtype=jnp.int32)
+    for i, name in reversed(tuple(enumerate(RESULT_NAMES))):
+        member = getattr(diffrax.RESULTS, name, None)
+        if member is not None:
+            code = jnp.where(result == member, jnp.int32(i), code)
+    return code
+
+
+def _check_solve(bearing, op, duration, *, adjoint=None, **kwargs) -> None:
+    """`check_solve_inputs` of the solver arguments, perturbation, functionals and pytrees;
+    `adjoint` must be a diffrax adjoint or None."""
+    if adjoint is not None and not isinstance(adjoint, diffrax.AbstractAdjoint):
+        raise UserInputError(f"adjoint = {adjoint!r}: must be a diffrax adjoint "
+                             "(e.g. diffrax.ForwardMode()) or None")
+    check_solve_inputs(bearing, op, duration=duration, **kwargs)
 
 
 def _save_functionals(t, y_scaled, args: SolveArgs):
@@ -211,7 +245,14 @@ def solve(
     (`num_saves = 0`: only the smooth functionals at t1, the cheapest form for gradients).
     `adjoint` selects how gradients flow through the solve (default: diffrax's checkpointed
     reverse mode; `diffrax.ForwardMode()` for `jax.jacfwd`).
+
+    Every argument is checked before anything is traced (`jaxbearing.io.check_solve_inputs`;
+    one-line `UserInputError`/`ConfigError`); under jit/vmap/grad traced values cannot be
+    checked and pass (`simulate` and the sweep check them concretely first).
     """
+    _check_solve(bearing, op, duration, num_saves=num_saves, rtol=rtol, atol=atol,
+                 max_steps=max_steps, progress=progress, perturbation=perturbation,
+                 functionals=functionals, adjoint=adjoint)
     y0 = initial_state(bearing, op, perturbation)
     scaling = Scaling(
         nominal=y0,
@@ -240,9 +281,7 @@ def solve(
         max_steps=max_steps,
         throw=False,
         adjoint=adjoint if adjoint is not None else diffrax.RecursiveCheckpointAdjoint(),
-        progress_meter=diffrax.TextProgressMeter(minimum_increase=0.05)
-        if progress
-        else diffrax.NoProgressMeter(),
+        progress_meter=SolveProgress() if progress else diffrax.NoProgressMeter(),
     )
     if num_saves:
         ys = dict(sol.ys)
@@ -253,7 +292,7 @@ def solve(
     return Solution(
         histories=hist,
         accumulators=acc,
-        result=jnp.asarray(sol.result._value, dtype=jnp.int32),
+        result=result_code(sol.result),
         num_steps=jnp.asarray(sol.stats["num_steps"]),
         num_rejected_steps=jnp.asarray(sol.stats["num_rejected_steps"]),
     )
@@ -309,9 +348,9 @@ def simulate(
 
     Compiles once per bearing structure (cached) and reports compile and run time separately.
     """
-    from ..io import validate_bearing
-
-    validate_bearing(bearing, op)
+    _check_solve(bearing, op, duration, num_saves=num_saves, rtol=rtol, atol=atol,
+                 max_steps=max_steps, progress=progress, perturbation=perturbation,
+                 functionals=functionals, rules={"num_saves": SIMULATE_NUM_SAVES})
     dyn = (bearing, op, jnp.asarray(duration, float), jnp.asarray(rtol, float), jnp.asarray(atol, float))
     static = (int(num_saves), int(max_steps), bool(progress), perturbation, functionals)
     start = time.perf_counter()
@@ -325,13 +364,8 @@ def simulate(
 
 
 def _result_message(code: int) -> str:
-    for name, text in (
-        ("max_steps_reached", "the step limit max_steps was reached"),
-        ("dt_min_reached", "the step size collapsed below dtmin (non-finite or unresolvable dynamics)"),
-    ):
-        if hasattr(diffrax.RESULTS, name) and code == getattr(diffrax.RESULTS, name)._value:
-            return text
-    return f"the solver did not succeed (diffrax result code {code})"
+    name = RESULT_NAMES[code] if 0 <= code < len(RESULT_NAMES) else "other"
+    return _RESULT_TEXT.get(name, f"the solver did not succeed ({name}, result code {code})")
 
 
 def simulation_result(sol: Solution, bearing, op, functionals, duration, wall, compile_time) -> SimulationResult:

@@ -11,10 +11,10 @@ from typing import Any
 import numpy as np
 
 from .._errors import UserInputError
-from ..io import KEY_BY_PATH, optional_import
+from ..io import KEY_BY_PATH, atomic_write, optional_import
 from ._batch import _ZONE_FIELDS, case_inputs, variable_names
 from ._spec import SweepSpec
-from ._storage import atomic_write, batch_path, load_spec_from_dir, read_batch
+from ._storage import batch_path, load_spec_from_dir, read_batch
 
 
 # -- the dataset ---------------------------------------------------------------------------------
@@ -53,8 +53,8 @@ def assemble(out_dir: str | os.PathLike, spec: SweepSpec | None = None):
     for b in range(spec.num_batches):
         data = read_batch(out_dir, spec, b)
         if data is None:
-            raise UserInputError(f"{out_dir}: {batch_path(out_dir, b).name} is missing; run "
-                                 "the sweep command again to compute it")
+            raise UserInputError(f"{out_dir}: {batch_path(out_dir, b).name} is missing or "
+                                 "damaged; run the sweep command again to compute it")
         batches.append(data)
     cols = {k: np.concatenate([d[k] for d in batches]) for k in batches[0]
             if k not in ("spec_hash", "batch")}

@@ -11,10 +11,18 @@ from collections.abc import Sequence
 import numpy as np
 
 from .._errors import UserInputError
+from ..io import acquire_lock, check_arguments, count, remove_stale_temporaries
 from ._batch import solve_batch
 from ._dataset import assemble
 from ._spec import SweepSpec
-from ._storage import append_log, batch_path, prepare_dir, read_batch, write_batch
+from ._storage import (
+    append_log,
+    batch_path,
+    prepare_dir,
+    read_batch,
+    set_aside_damaged,
+    write_batch,
+)
 
 
 # -- progress ------------------------------------------------------------------------------------
@@ -61,6 +69,7 @@ def run_sweep(
     assemble_results: bool = True,
     wait_timeout_s: float = 24 * 3600.0,
     devices: Sequence | None = None,
+    lock_wait_s: float = 0.0,
 ):
     """Run (or finish) the sweep `spec` into `out_dir`; returns the assembled dataset (process 0)
     or None (other processes, or `assemble_results=False`).
@@ -68,10 +77,58 @@ def run_sweep(
     This process computes its batches (k % num_processes == process_id) that have no valid batch
     file (all of them with `resume=False`), writing each as it finishes. Process 0 then waits up
     to `wait_timeout_s` for every other batch file and assembles DIR/results.nc.
+
+    Reliability: the process locks DIR (DIR/sweep.<process_id>.lock; another running sweep
+    there raises `DirectoryInUse` at once, or after waiting `lock_wait_s` seconds), deletes
+    temporary files left by killed writers, and moves batch files that do not load to
+    DIR/batches/damaged/ and computes them again (`recover`).
     """
     out_dir = pathlib.Path(out_dir)
+    check_run_arguments(process_id, num_processes, wait_timeout_s, lock_wait_s)
+    with acquire_lock(out_dir, f"sweep.{process_id}.lock", wait_s=lock_wait_s, what="sweep") as lock:
+        if lock.took_over:
+            _say(progress, f"sweep: {out_dir} was left locked by a run that ended "
+                 f"(pid {lock.took_over.get('pid')} on {lock.took_over.get('host')}); resuming")
+        return _run_locked(spec, out_dir, resume, process_id, num_processes, progress,
+                           assemble_results, wait_timeout_s, devices)
+
+
+def check_run_arguments(process_id, num_processes, wait_timeout_s, lock_wait_s) -> None:
+    """The process layout and the waiting times, before anything is locked or computed."""
+    check_arguments({"num_processes": num_processes}, {"num_processes": count(1)})
+    check_arguments({"process_id": process_id},
+                    {"process_id": count(0, num_processes - 1, note="0..num_processes-1")})
+    for name, value in (("wait_timeout_s", wait_timeout_s), ("lock_wait_s", lock_wait_s)):
+        if not (isinstance(value, (int, float)) and not isinstance(value, bool) and value >= 0):
+            raise UserInputError(f"{name} = {value!r}: must be >= 0 s (inf: no limit)")
+
+
+def _say(enabled: bool, text: str) -> None:
+    if enabled:
+        print(text, file=sys.stderr, flush=True)
+
+
+def recover(out_dir: pathlib.Path, mine: list[int], process_id: int, num_processes: int) -> list[int]:
+    """Clean up after a killed or damaged run: delete temporary files whose writer is gone, and
+    move this process's batch files that do not load to DIR/batches/damaged/ (logged and
+    reported on stderr); they are then computed again. Returns the batches moved aside."""
+    for directory in (out_dir, out_dir / "batches"):
+        if directory.is_dir():
+            remove_stale_temporaries(directory, all_hosts=num_processes == 1)
+    moved = set_aside_damaged(out_dir, mine)
+    for b, reason, target in moved:
+        print(f"sweep: {batch_path(out_dir, b).name} is damaged ({reason}); moved to "
+              f"{target.relative_to(out_dir)}; computing it again", file=sys.stderr, flush=True)
+        append_log(out_dir, {"event": "damaged", "batch": b, "process": process_id,
+                             "reason": reason, "moved_to": str(target.relative_to(out_dir))})
+    return [b for b, _, _ in moved]
+
+
+def _run_locked(spec, out_dir, resume, process_id, num_processes, progress, assemble_results,
+                wait_timeout_s, devices):
     prepare_dir(out_dir, spec, resume, process_id)
     mine = assigned_batches(spec, process_id, num_processes)
+    recover(out_dir, mine, process_id, num_processes)
     todo = [b for b in mine if not resume or read_batch(out_dir, spec, b) is None]
     n_mine = sum(len(spec.batch_cases(b)) for b in mine)
     n_todo = sum(len(spec.batch_cases(b)) for b in todo)

@@ -1,13 +1,16 @@
-"""Sweep output directory: atomic batch files, the spec, the log, what is already computed."""
+"""Sweep output directory: atomic batch files, the spec, the log, what is already computed, and
+damaged batch files (moved aside to DIR/batches/damaged/ and computed again)."""
 
 from __future__ import annotations
 
 import json
 import os
 import pathlib
+import time
 
 import numpy as np
 
+from ..io import atomic_write
 from ._spec import SweepSpec, SweepSpecError
 
 
@@ -16,15 +19,9 @@ def batch_path(out_dir: pathlib.Path, batch: int) -> pathlib.Path:
     return pathlib.Path(out_dir) / "batches" / f"batch_{batch:05d}.npz"
 
 
-def atomic_write(path: pathlib.Path, write) -> None:
-    """Write through `write(file)` to a temporary file next to `path`, fsync, os.replace."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
-    with open(tmp, "wb") as f:
-        write(f)
-        f.flush()
-        os.fsync(f.fileno())
-    os.replace(tmp, path)
+def damaged_dir(out_dir: pathlib.Path) -> pathlib.Path:
+    """DIR/batches/damaged: where batch files that fail to load are moved."""
+    return pathlib.Path(out_dir) / "batches" / "damaged"
 
 
 def write_batch(out_dir: pathlib.Path, spec: SweepSpec, batch: int, data: dict) -> pathlib.Path:
@@ -34,20 +31,54 @@ def write_batch(out_dir: pathlib.Path, spec: SweepSpec, batch: int, data: dict) 
     return path
 
 
-def read_batch(out_dir: pathlib.Path, spec: SweepSpec, batch: int) -> dict | None:
-    """The contents of a finished batch file, or None if it is missing, unreadable, of another
-    spec or of other cases."""
-    path = batch_path(out_dir, batch)
+def load_batch_file(path: pathlib.Path) -> dict:
+    """Every array of a batch file; raises `DamagedBatch` (with the reason) when it does not
+    load (truncated by a full disk or power loss: zipfile.BadZipFile, EOFError, zlib.error...)
+    and FileNotFoundError when there is none."""
     try:
         with np.load(path, allow_pickle=False) as z:
-            data = {k: z[k] for k in z.files}
-    except (OSError, ValueError, EOFError, KeyError):
+            return {k: z[k] for k in z.files}
+    except FileNotFoundError:
+        raise
+    except Exception as exc:  # noqa: BLE001 (any failure to load means a damaged file)
+        raise DamagedBatch(f"{type(exc).__name__}: {exc}") from exc
+
+
+class DamagedBatch(Exception):
+    """A batch file exists but does not load."""
+
+
+def read_batch(out_dir: pathlib.Path, spec: SweepSpec, batch: int) -> dict | None:
+    """The contents of a finished batch file, or None if it is missing, damaged (does not
+    load), of another spec or of other cases. Never raises."""
+    path = batch_path(out_dir, batch)
+    try:
+        data = load_batch_file(path)
+    except (OSError, DamagedBatch):
         return None
     if str(data.get("spec_hash")) != spec.hash:
         return None
     if not np.array_equal(data.get("case_index"), spec.batch_cases(batch)):
         return None
     return data
+
+
+def set_aside_damaged(out_dir: pathlib.Path, batches) -> list[tuple[int, str, pathlib.Path]]:
+    """Move every batch file of `batches` that does not load to DIR/batches/damaged/ (named
+    with the time, so nothing is overwritten); returns (batch, reason, new path) of each."""
+    moved = []
+    for b in batches:
+        path = batch_path(out_dir, b)
+        try:
+            load_batch_file(path)
+        except FileNotFoundError:
+            continue
+        except (OSError, DamagedBatch) as exc:
+            target = damaged_dir(out_dir) / f"{path.name}.{time.strftime('%Y%m%dT%H%M%S')}.{os.getpid()}"
+            target.parent.mkdir(parents=True, exist_ok=True)
+            os.replace(path, target)
+            moved.append((b, str(exc), target))
+    return moved
 
 
 def append_log(out_dir: pathlib.Path, record: dict) -> None:
