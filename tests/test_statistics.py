@@ -69,7 +69,7 @@ def _history(edges, period_samples, z=2):
             radius[i0:i0 + 5, 0, 0] = 3.5e-3
     zeros = np.zeros(shape)
     return dict(
-        t=t, flange_force=force, flange_pressure=force * 1e7, flange_sliding_speed=zeros + 2.0,
+        t=t, flange_force=force, flange_pressure=force * 1e7, flange_sliding_speed=zeros + 2.0, flange_roller_surface_speed=zeros + 3.0,
         flange_pv=force * 2e7, contact_height=zeros + 1e-3, contact_radius=radius,
         on_arc=(radius < 3.2e-3).astype(float),
         cage_speed=np.where(t < edges[1], 100.0, 110.0), roller_skew=np.full((n, z), -1e-4),
