@@ -7,7 +7,8 @@ at, below and above zero penetration and at zero sliding (MODEL.md section 4).
 - Point contact (Hamrock & Brewe 1983): `effective_modulus`, `point_contact_stiffness`,
   `point_contact_ellipse`, `point_contact_peak_pressure`, `point_contact_deflection`,
   `hamrock_brewe_parameters`.
-- Line contact (ISO/TS 16281, MODEL.md 4.2): `line_contact_stiffness`, `line_slice_loads`.
+- Line contact (ISO/TS 16281, MODEL.md 4.2): `line_contact_stiffness`, `line_slice_loads`,
+  `line_power` (the slice law's power with a hand-written tangent).
 - Smoothing: `smooth_penetration`, `smooth_power`, `hertz_force`, `safe_norm`,
   `smooth_direction`.
 - Traction and friction: `traction_coefficient`, `traction_force`, `friction_force`.
@@ -31,6 +32,7 @@ from ._line import (
     STEEL_ELASTIC_MODULUS,
     STEEL_POISSON_RATIO,
     line_contact_stiffness,
+    line_power,
     line_slice_loads,
 )
 from ._smooth import (
@@ -61,6 +63,7 @@ __all__ = [
     "hamrock_brewe_parameters",
     "hertz_force",
     "line_contact_stiffness",
+    "line_power",
     "line_slice_loads",
     "log_smooth_penetration",
     "point_contact_deflection",

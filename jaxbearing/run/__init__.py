@@ -7,11 +7,15 @@
 - statistics: `contact_events`, `summarise`;
 - design metrics through the dynamics: `design_metrics`, `design_jacobian`, `DesignMetrics`,
   `seated_perturbation`, `forward_jacobian`;
-- `plot_run`: the figures of one run.
+- `plot_run`: the figures of one run;
+- speed: `raceway_normal_norm` (the error norm of `solve`), `enable_compilation_cache` (JAX's
+  persistent cache in a user directory, `$JAXBEARING_CACHE_DIR`; on at import),
+  `parallel_map` / `simulate_ensemble` (independent cases, one process per core).
 
 May import: `jaxbearing._errors`, `contact`, `geometry`, `io`, `flange`, `forces`, `dynamics`.
 """
 
+from ._compile_cache import CACHE_ENV, enable_compilation_cache
 from ._design import (
     GRADIENT_ATOL,
     GRADIENT_HORIZON,
@@ -23,6 +27,7 @@ from ._design import (
     forward_jacobian,
     seated_perturbation,
 )
+from ._ensemble import parallel_map, simulate_ensemble
 from ._plots import plot_run
 from ._simulate import (
     Perturbation,
@@ -37,9 +42,17 @@ from ._simulate import (
     smooth_functionals,
     solve,
 )
+from ._step_control import RACEWAY_NORMAL_LOOSEN, RacewayNormalNorm, raceway_normal_norm
 from ._summary import contact_events, summarise
 
 __all__ = [
+    "CACHE_ENV",
+    "RACEWAY_NORMAL_LOOSEN",
+    "RacewayNormalNorm",
+    "enable_compilation_cache",
+    "parallel_map",
+    "raceway_normal_norm",
+    "simulate_ensemble",
     "GRADIENT_ATOL",
     "GRADIENT_HORIZON",
     "GRADIENT_MODE_NOTE",

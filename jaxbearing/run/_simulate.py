@@ -17,6 +17,7 @@
 from __future__ import annotations
 
 import dataclasses
+import functools
 import time
 
 import diffrax
@@ -24,7 +25,6 @@ import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
-import optimistix as optx
 from jaxtyping import Array
 
 from ..dynamics import (
@@ -43,6 +43,8 @@ from ..dynamics import (
     tangential_unit,
 )
 from ..geometry import Bearing, OperatingPoint, kinematic_cage_speed
+from ._compile_cache import checks_without_host_callbacks
+from ._step_control import RACEWAY_NORMAL_LOOSEN, raceway_normal_norm
 
 
 @dataclasses.dataclass(frozen=True)
@@ -190,43 +192,9 @@ def _save_functionals(t, y_scaled, args: SolveArgs):
     return args.scaling.unscale(t, y_scaled).accumulators
 
 
-def solve(
-    bearing: Bearing,
-    op: OperatingPoint,
-    duration,
-    *,
-    num_saves: int = 4000,
-    rtol=1e-3,
-    atol=1e-6,
-    max_steps: int = 2_000_000,
-    progress: bool = False,
-    perturbation: Perturbation | None = Perturbation(),
-    functionals: Functionals = Functionals(),
-    adjoint: diffrax.AbstractAdjoint | None = None,
-) -> Solution:
-    """Pure, jit-able and vmappable solve of the whole bearing over [0, duration].
-
-    `num_saves` (static) samples of the flange-contact quantities, cage and rings are kept
-    (`num_saves = 0`: only the smooth functionals at t1, the cheapest form for gradients).
-    `adjoint` selects how gradients flow through the solve (default: diffrax's checkpointed
-    reverse mode; `diffrax.ForwardMode()` for `jax.jacfwd`).
-    """
-    y0 = initial_state(bearing, op, perturbation)
-    scaling = Scaling(
-        nominal=y0,
-        scale=state_scales(bearing.num_rollers, bearing.pitch_diameter / 2),
-        orbit_speed=kinematic_cage_speed(bearing, op),
-    )
-    args = SolveArgs(params=Params(bearing=bearing, operating=op, functionals=functionals), scaling=scaling)
-    y0_scaled = scaling.scale_state(0.0, y0)
-    if num_saves:
-        saveat = diffrax.SaveAt(ts=jnp.linspace(0.0, duration, num_saves), fn=_save, t1=True)
-    else:
-        saveat = diffrax.SaveAt(t1=True, fn=_save_functionals)
-    controller = diffrax.PIDController(
-        rtol=rtol, atol=atol, pcoeff=0.3, icoeff=0.4, norm=optx.max_norm, dtmin=1e-13
-    )
-    sol = diffrax.diffeqsolve(
+def _diffeqsolve(y0_scaled, args, duration, saveat, controller, max_steps, adjoint, progress):
+    """diffrax Tsit5 over [0, duration] from the scaled state; failures land in `result`."""
+    return diffrax.diffeqsolve(
         diffrax.ODETerm(scaled_field),
         diffrax.Tsit5(),
         t0=0.0,
@@ -243,6 +211,52 @@ def solve(
         if progress
         else diffrax.NoProgressMeter(),
     )
+
+
+def solve(
+    bearing: Bearing,
+    op: OperatingPoint,
+    duration,
+    *,
+    num_saves: int = 4000,
+    rtol=1e-3,
+    atol=1e-6,
+    max_steps: int = 2_000_000,
+    progress: bool = False,
+    perturbation: Perturbation | None = Perturbation(),
+    functionals: Functionals = Functionals(),
+    adjoint: diffrax.AbstractAdjoint | None = None,
+    raceway_loosen=RACEWAY_NORMAL_LOOSEN,
+    error_norm=None,
+) -> Solution:
+    """Pure, jit-able and vmappable solve of the whole bearing over [0, duration].
+
+    `num_saves` (static) samples of the flange-contact quantities, cage and rings are kept
+    (`num_saves = 0`: only the smooth functionals at t1, the cheapest form for gradients).
+    `adjoint` selects how gradients flow through the solve (default: diffrax's checkpointed
+    reverse mode; `diffrax.ForwardMode()` for `jax.jacfwd`).
+    Error control (`_step_control`): the max norm over the scaled state with the raceway-normal
+    coordinates' tolerances `raceway_loosen` times looser (a float, may be traced; 1 = plain max
+    norm); `error_norm` (a function pytree -> scalar, e.g. `optimistix.rms_norm`) replaces it.
+    """
+    y0 = initial_state(bearing, op, perturbation)
+    scaling = Scaling(
+        nominal=y0,
+        scale=state_scales(bearing.num_rollers, bearing.pitch_diameter / 2),
+        orbit_speed=kinematic_cage_speed(bearing, op),
+    )
+    args = SolveArgs(params=Params(bearing=bearing, operating=op, functionals=functionals), scaling=scaling)
+    y0_scaled = scaling.scale_state(0.0, y0)
+    if num_saves:
+        saveat = diffrax.SaveAt(ts=jnp.linspace(0.0, duration, num_saves), fn=_save, t1=True)
+    else:
+        saveat = diffrax.SaveAt(t1=True, fn=_save_functionals)
+    norm = error_norm if error_norm is not None else raceway_normal_norm(y0_scaled, raceway_loosen)
+    controller = diffrax.PIDController(
+        rtol=rtol, atol=atol, pcoeff=0.3, icoeff=0.4, norm=norm, dtmin=1e-13
+    )
+    with checks_without_host_callbacks():  # cacheable program (`_compile_cache`)
+        sol = _diffeqsolve(y0_scaled, args, duration, saveat, controller, max_steps, adjoint, progress)
     if num_saves:
         ys = dict(sol.ys)
         acc = jax.tree_util.tree_map(lambda a: a[-1], ys.pop("accumulators"))
@@ -276,19 +290,25 @@ _COMPILED: dict = {}
 
 def _compiled_solve(bearing, op, duration, rtol, atol, static: tuple):
     """Ahead-of-time compiled `solve`, cached on the pytree structure, shapes and static
-    arguments, so arc and corner ends, other speeds, loads and tolerances reuse one compilation."""
-    dyn = (bearing, op, duration, rtol, atol)
+    arguments, so arc and corner ends, other speeds, loads, tolerances and seeds of the initial
+    scatter reuse one compilation (the scatter's seed and amplitudes are traced)."""
+    num_saves, max_steps, progress, perturbation, functionals = static
+    scatter = None if perturbation is None else (
+        jnp.asarray(perturbation.seed, jnp.int32), jnp.asarray(perturbation.axial, float),
+        jnp.asarray(perturbation.skew, float))
+    dyn = (bearing, op, duration, rtol, atol, scatter)
+    static = (num_saves, max_steps, progress, perturbation is None, functionals)
     leaves, treedef = jax.tree_util.tree_flatten(dyn)
     key = (treedef, tuple((jnp.shape(x), jnp.result_type(x)) for x in leaves), static)
     if key not in _COMPILED:
-        num_saves, max_steps, progress, perturbation, functionals = static
 
-        def run(b, o, d, r, a):
+        def run(b, o, d, r, a, sc):
+            pert = None if sc is None else Perturbation(seed=sc[0], axial=sc[1], skew=sc[2])
             return solve(b, o, d, num_saves=num_saves, rtol=r, atol=a, max_steps=max_steps,
-                         progress=progress, perturbation=perturbation, functionals=functionals)
+                         progress=progress, perturbation=pert, functionals=functionals)
 
         _COMPILED[key] = jax.jit(run).lower(*dyn).compile()
-    return _COMPILED[key]
+    return functools.partial(_COMPILED[key], *dyn)
 
 
 def simulate(
@@ -317,7 +337,7 @@ def simulate(
     compiled = _compiled_solve(*dyn, static)
     compile_time = time.perf_counter() - start
     start = time.perf_counter()
-    sol = compiled(*dyn)
+    sol = compiled()
     jax.block_until_ready(sol)
     wall = time.perf_counter() - start
     return simulation_result(sol, bearing, op, functionals, duration, wall, compile_time)
