@@ -5,13 +5,16 @@ Why processes and not `vmap`: an adaptive solve is a while loop whose step count
 case, so a vmapped batch runs every case as long as its slowest and pays for the masked lanes;
 on a 2-core CPU a batch of 32 ran at 0.74x the per-case throughput of one case at a time
 (benchmarks/results/throughput.json), and one case at a time used only about 1.1 of the 2 cores.
-Separate processes, each with one XLA thread, keep every core on a case of its own.
+Separate processes keep every core on a case of its own.
 
 `parallel_map(function, items)` maps a picklable top-level function over picklable items in a
 pool of `workers` processes (default: the CPUs this process may use), started with `spawn`
-(JAX is not fork-safe), each limited to `threads_per_worker` XLA threads. Results come back in
-the order of `items`. The workers share the persistent compilation cache (`_compile_cache`), so
-a program compiled by one is loaded, not recompiled, by the next. `workers=1` runs in this
+(JAX is not fork-safe). Results come back in the order of `items`. The workers share the
+persistent compilation cache (`_compile_cache`), so a program compiled by this process or by one
+worker is loaded, not recompiled, by the others. `threads_per_worker=1` limits each worker to
+one XLA thread; the default keeps this process's XLA flags, because the flags are part of the
+cache key (with other flags every worker compiles its program again: measured 2 min 13 s per
+worker against 16 s for a cache load, benchmarks/bench_ensemble.py). `workers=1` runs in this
 process (no pool).
 
 `simulate_ensemble(bearing, op, seeds, ...)` runs `simulate` once per seed of the initial roller
@@ -58,7 +61,7 @@ def parallel_map(
     items: Iterable[Any],
     *,
     workers: int | None = None,
-    threads_per_worker: int = 1,
+    threads_per_worker: int | None = None,
 ) -> list:
     """[function(item) for item in items], one process per worker (module docstring)."""
     items = list(items)
