@@ -69,6 +69,28 @@ VARIANTS = (
 QUICK_VARIANTS = (0, 3, 5, 8, 9)
 
 
+def tsit5_stability_limit(eigenvalue: complex, h_max: float = 1e-4) -> float:
+    """Largest step h [s] with |R(h lambda)| <= 1 on (0, h] for diffrax's Tsit5 tableau, where
+    R(z) = 1 + z b^T (I - z A)^-1 1 is the stability function (bisection on a fine grid)."""
+    import diffrax
+    import numpy as np
+
+    tab = diffrax.Tsit5().tableau
+    n = len(tab.b_sol)
+    a = np.zeros((n, n))
+    for i, row in enumerate(tab.a_lower):
+        a[i + 1, : i + 1] = np.asarray(row)
+    b = np.asarray(tab.b_sol)
+
+    def stable(h):
+        z = h * eigenvalue
+        return abs(1 + z * b @ np.linalg.solve(np.eye(n) - z * a, np.ones(n))) <= 1.0
+
+    hs = np.linspace(h_max / 1e5, h_max, 100_000)
+    ok = np.array([stable(h) for h in hs])
+    return float(hs[np.argmin(ok) - 1]) if not ok.all() else h_max
+
+
 # -- statistics --------------------------------------------------------------------------------
 def window_statistics(hist: dict, t_start: float, omega_kin: float) -> dict:
     """Flange statistics over the samples with t >= t_start (module docstring)."""
