@@ -210,7 +210,7 @@ class FlatField:
 
     `jaxbearing.run.solve` integrates the *scaled deviation* state
     Y = (y - nominal(t)) / scale (`jaxbearing.dynamics.Scaling`) with the field
-    `jaxbearing.run._field(t, Y, args)`. This object builds exactly the same `args` and
+    `jaxbearing.run.scaled_field(t, Y, args)`. This object builds exactly the same `args` and
     initial Y as `solve` does, ravels Y with `jax.flatten_util.ravel_pytree`, and ravels the
     arguments too, so that one compiled call takes three arrays (t, Y_flat, args_flat):
     the cheapest dispatch for an external integrator (`scipy.integrate.solve_ivp`).
@@ -222,7 +222,7 @@ class FlatField:
 
         from jaxbearing.dynamics import Functionals, Params, Scaling, state_scales
         from jaxbearing.geometry import kinematic_cage_speed
-        from jaxbearing.run import Perturbation, _Args, initial_state
+        from jaxbearing.run import Perturbation, SolveArgs, initial_state
 
         if perturbation == "default":
             perturbation = Perturbation()  # the default of `solve`
@@ -233,7 +233,7 @@ class FlatField:
             scale=state_scales(bearing.num_rollers, bearing.pitch_diameter / 2),
             orbit_speed=kinematic_cage_speed(bearing, op),
         )
-        self.args = _Args(params=Params(bearing=bearing, operating=op, functionals=functionals),
+        self.args = SolveArgs(params=Params(bearing=bearing, operating=op, functionals=functionals),
                           scaling=scaling)
         self.functionals = functionals
         y0_scaled = scaling.scale_state(0.0, y0)
@@ -246,9 +246,9 @@ class FlatField:
         """Flat scaled rate dY/dt (pure; jit this)."""
         from jax.flatten_util import ravel_pytree
 
-        from jaxbearing.run import _field
+        from jaxbearing.run import scaled_field
 
-        rate = _field(t, self._unravel_state(y_flat), self._unravel_args(args_flat))
+        rate = scaled_field(t, self._unravel_state(y_flat), self._unravel_args(args_flat))
         return ravel_pytree(rate)[0]
 
     def compile(self):

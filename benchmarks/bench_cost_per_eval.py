@@ -3,7 +3,7 @@
 
 Measured on the reference bearing at 20,000 rpm and 1000 N:
 
-* ``t_call``: one compiled call of the field diffrax integrates (`jaxbearing.run._field`
+* ``t_call``: one compiled call of the field diffrax integrates (`jaxbearing.run.scaled_field`
   on the scaled deviation state, raveled to flat vectors, `_common.FlatField`): median of many
   calls, each waited for with `block_until_ready`. This includes the dispatch of one XLA call
   (microseconds to tens of microseconds).

@@ -4,7 +4,7 @@ The source study integrates its bearing model with an explicit adaptive Runge-Ku
 rtol 1e-3, atol 1e-6 (MATLAB ode45 style). Its stand-in here is SciPy's `solve_ivp(RK45)`
 (Dormand-Prince 5(4), the ode45 pair) at those tolerances, driving *our* vector field: the very
 scaled-deviation state and field that `jaxbearing.solve` hands to diffrax
-(`jaxbearing.run._field`, `_Args`, `jaxbearing.dynamics.Scaling`), raveled to one flat
+(`jaxbearing.run.scaled_field`, `SolveArgs`, `jaxbearing.dynamics.Scaling`), raveled to one flat
 float64 vector and jit-compiled once. Both integrators therefore evaluate the same compiled
 physics from the same initial state; what differs is the integration loop (Python/NumPy in
 SciPy, one XLA while-loop in diffrax), the Runge-Kutta pair (Dormand-Prince vs Tsitouras) and
@@ -66,12 +66,13 @@ def _compile_solve(bearing, op, duration):
 
 @contextlib.contextmanager
 def _counting_field():
-    """Temporarily instrument `jaxbearing.run._field` to count its executions."""
+    """Temporarily instrument the field `jaxbearing.solve` integrates (`scaled_field` in
+    `jaxbearing.run._simulate`, where `solve` looks it up) to count its executions."""
     import jax
 
-    import jaxbearing.run as sim
+    import jaxbearing.run._simulate as sim
 
-    original = sim._field
+    original = sim.scaled_field
     counter = {"calls": 0}
 
     def bump():
@@ -81,11 +82,11 @@ def _counting_field():
         jax.debug.callback(bump)
         return original(t, y, args)
 
-    sim._field = counted
+    sim.scaled_field = counted
     try:
         yield counter
     finally:
-        sim._field = original
+        sim.scaled_field = original
 
 
 def verify_evaluation_count(bearing, op, duration) -> dict:

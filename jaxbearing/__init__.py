@@ -64,6 +64,7 @@ from .run import (  # noqa: E402
     contact_events,
     design_jacobian,
     design_metrics,
+    enable_compilation_cache,
     flange_functionals,
     seated_perturbation,
     simulate,
@@ -142,4 +143,10 @@ __all__ = [
     "design_metrics",
     "seated_perturbation",
     "zone_margins",
+    # speed
+    "enable_compilation_cache",
 ]
+
+#: the persistent compilation cache (`run._compile_cache`): `$JAXBEARING_CACHE_DIR`, or
+#: ~/.cache/jaxbearing/xla; JAXBEARING_CACHE_DIR=off switches it off
+COMPILATION_CACHE_DIR = enable_compilation_cache()

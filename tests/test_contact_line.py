@@ -154,3 +154,35 @@ def test_slice_load_monotone(d1, d2, length):
     q = line_slice_loads(jnp.array([lo, hi]), k_c, 2, W)
     assert float(q[0]) <= float(q[1])
     assert float(q[0]) >= 0.0
+
+
+def test_line_power_custom_jvp_matches_finite_differences_and_smooth_power():
+    """The hand-written tangent of the slice law (`line_power`) against central finite
+    differences in delta and in the softplus width, across the contact edge (x = delta/eps from
+    -60, the far branch, to +3000), and its value against `smooth_power`."""
+    from jaxbearing.contact import LINE_EXPONENT, line_power, smooth_power
+
+    eps = 1e-9
+    delta = jnp.array([-60e-9, -31e-9, -29e-9, -3e-9, 0.0, 0.7e-9, 4e-9, 50e-9, 3e-6])
+    width = jnp.full_like(delta, eps)
+    np.testing.assert_allclose(line_power(delta, width), smooth_power(delta, LINE_EXPONENT, eps), rtol=1e-13)
+
+    def fd(f, x, h):
+        return (f(x + h) - f(x - h)) / (2 * h)
+
+    d_delta = jax.jvp(lambda d: line_power(d, width), (delta,), (jnp.ones_like(delta),))[1]
+    h = 1e-6 * jnp.maximum(jnp.abs(delta), eps)
+    fd_delta = fd(lambda d: line_power(d, width), delta, h)
+    np.testing.assert_allclose(d_delta, fd_delta, rtol=1e-6, atol=1e-300)
+
+    # in the width: where |x| <= 60 (beyond, the exact derivative is below the differences' rounding)
+    d_width = jax.jvp(lambda w: line_power(delta, w), (width,), (jnp.ones_like(width),))[1]
+    fd_width = fd(lambda w: line_power(delta, w), width, 1e-6 * eps)
+    near = slice(0, 7)
+    np.testing.assert_allclose(d_width[near], fd_width[near], rtol=1e-6, atol=1e-300)
+    # and against automatic differentiation of smooth_power everywhere
+    ad_width = jax.vmap(jax.grad(lambda d, w: smooth_power(d, LINE_EXPONENT, w), argnums=1))(delta, width)
+    np.testing.assert_allclose(d_width, ad_width, rtol=1e-9, atol=1e-12 * float(jnp.max(jnp.abs(ad_width))))
+    # reverse mode and second derivatives run through the rule and stay finite
+    g2 = jax.vmap(jax.grad(jax.grad(lambda d: line_power(d, jnp.asarray(eps)))))(delta)
+    assert np.all(np.isfinite(np.asarray(g2)))

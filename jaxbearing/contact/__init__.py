@@ -9,7 +9,8 @@ at, below and above zero penetration and at zero sliding (MODEL.md section 4).
   `point_contact_deflection`, `point_contact_ellipticity`, `point_contact_parameters`,
   `complete_elliptic_integrals`; the Hamrock & Brewe (1983) fit for comparison:
   `hamrock_brewe_parameters`.
-- Line contact (ISO/TS 16281, MODEL.md 4.2): `line_contact_stiffness`, `line_slice_loads`.
+- Line contact (ISO/TS 16281, MODEL.md 4.2): `line_contact_stiffness`, `line_slice_loads`,
+  `line_power` (the slice law's power with a hand-written tangent).
 - Smoothing: `smooth_penetration`, `smooth_power`, `hertz_force`, `safe_norm`,
   `smooth_direction`.
 - Traction and friction: `traction_coefficient`, `traction_force`, `friction_force`.
@@ -65,6 +66,7 @@ from ._line import (
     STEEL_ELASTIC_MODULUS,
     STEEL_POISSON_RATIO,
     line_contact_stiffness,
+    line_power,
     line_slice_loads,
 )
 from ._smooth import (
@@ -110,6 +112,7 @@ __all__ = [
     "hunt_crossley_factor",
     "hunt_crossley_force",
     "line_contact_stiffness",
+    "line_power",
     "line_slice_loads",
     "log_smooth_penetration",
     "minimum_film_thickness",

@@ -12,11 +12,15 @@
   seeds), `summarise_steady`, `solve_from` (continue from any state), `check_steady_options`;
 - design metrics through the dynamics: `design_metrics`, `design_jacobian`, `DesignMetrics`,
   `seated_perturbation`, `forward_jacobian`;
-- `plot_run`: the figures of one run.
+- `plot_run`: the figures of one run;
+- speed: `raceway_normal_norm` (the error norm of `solve`), `enable_compilation_cache` (JAX's
+  persistent cache in a user directory, `$JAXBEARING_CACHE_DIR`; on at import),
+  `parallel_map` / `simulate_ensemble` (independent cases, one process per core).
 
 May import: `jaxbearing._errors`, `contact`, `geometry`, `io`, `flange`, `forces`, `dynamics`.
 """
 
+from ._compile_cache import CACHE_ENV, enable_compilation_cache
 from ._design import (
     GRADIENT_ATOL,
     GRADIENT_HORIZON,
@@ -28,6 +32,7 @@ from ._design import (
     forward_jacobian,
     seated_perturbation,
 )
+from ._ensemble import parallel_map, simulate_ensemble
 from ._plots import plot_run
 from ._progress import SolveProgress
 from ._settle import (
@@ -62,10 +67,18 @@ from ._statistics import (
     steady_statistics,
     student_t_interval,
 )
+from ._step_control import RACEWAY_NORMAL_LOOSEN, RacewayNormalNorm, raceway_normal_norm
 from ._summary import contact_events
 
 __all__ = [
     "RESULT_NAMES",
+    "CACHE_ENV",
+    "RACEWAY_NORMAL_LOOSEN",
+    "RacewayNormalNorm",
+    "enable_compilation_cache",
+    "parallel_map",
+    "raceway_normal_norm",
+    "simulate_ensemble",
     "GRADIENT_ATOL",
     "GRADIENT_HORIZON",
     "GRADIENT_MODE_NOTE",

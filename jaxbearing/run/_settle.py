@@ -3,7 +3,7 @@ measure over a window of whole revolutions (issue 11; docs/model.md 16).
 
 * `solve_from` continues the integration from any physical state (one call per revolution); it
   returns the saved histories and the final state. Its integrator settings are those of `solve`
-  (Tsit5, PID controller on the scaled state under the max norm); the scaling's nominal orbit
+  (Tsit5, PID controller on the scaled state under `solve`'s error norm); the scaling's nominal orbit
   restarts at every chunk from the chunk's own start state and cage speed, so the scaled
   azimuths never accumulate the cage slip over a long run.
 * Settling (`settle="auto"`): chunks of one cage revolution (2 pi / the previous revolution's
@@ -27,14 +27,15 @@ import diffrax
 import jax
 import jax.numpy as jnp
 import numpy as np
-import optimistix as optx
 
 from ..dynamics import Functionals, Params, Scaling, State, state_scales
 from ..geometry import Bearing, OperatingPoint, kinematic_cage_speed, rad_s_to_rpm
 from ..io import require
-from ._simulate import Perturbation, SolveArgs, _save, initial_state, scaled_field
+from ._compile_cache import checks_without_host_callbacks
+from ._simulate import Perturbation, SolveArgs, _diffeqsolve, _save, initial_state, result_code
 from ._simulate import simulate as _simulate_fixed
 from ._statistics import steady_statistics
+from ._step_control import raceway_normal_norm
 from ._summary import summarise as _summarise_fixed
 
 #: defaults of the settled run
@@ -55,16 +56,14 @@ def solve_from(params: Params, start: State, duration, *, num_saves: int, rtol, 
     args = SolveArgs(params=params, scaling=scaling)
     saveat = diffrax.SaveAt(subs=[diffrax.SubSaveAt(ts=jnp.linspace(0.0, duration, num_saves + 1)[:-1], fn=_save),
                                   diffrax.SubSaveAt(t1=True)])
-    controller = diffrax.PIDController(rtol=rtol, atol=atol, pcoeff=0.3, icoeff=0.4, norm=optx.max_norm,
-                                       dtmin=1e-13)
-    sol = diffrax.diffeqsolve(
-        diffrax.ODETerm(scaled_field), diffrax.Tsit5(), t0=0.0, t1=duration, dt0=1e-7,
-        y0=scaling.scale_state(0.0, start), args=args, saveat=saveat, stepsize_controller=controller,
-        max_steps=max_steps, throw=False,
-    )
+    y0_scaled = scaling.scale_state(0.0, start)
+    controller = diffrax.PIDController(rtol=rtol, atol=atol, pcoeff=0.3, icoeff=0.4,
+                                       norm=raceway_normal_norm(y0_scaled), dtmin=1e-13)
+    with checks_without_host_callbacks():  # the same integrator and error norm as `solve`
+        sol = _diffeqsolve(y0_scaled, args, duration, saveat, controller, max_steps, None, False)
     hist, final = sol.ys
     final = scaling.unscale(duration, jax.tree_util.tree_map(lambda a: a[-1], final))
-    return hist, final, jnp.asarray(sol.result._value, jnp.int32), jnp.asarray(sol.stats["num_steps"])
+    return hist, final, result_code(sol.result), jnp.asarray(sol.stats["num_steps"])
 
 
 _COMPILED: dict = {}

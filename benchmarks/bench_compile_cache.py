@@ -1,0 +1,141 @@
+"""Compile once (issue 12, item 5): compile time of a first and a second process with the
+persistent compilation cache (`jaxbearing.enable_compilation_cache`, on at import).
+
+Each program is compiled in two fresh Python processes, one after the other, sharing a new,
+empty cache directory (`JAXBEARING_CACHE_DIR`): the first compiles and writes the cache, the
+second should load it. Reported: each process's compile time (the `jax.jit(...).lower().compile()`
+of the program, or `SimulationResult.compile_time_s`), the ratio second / first (target <= 0.30),
+and the number of cache files written. Programs: `simulate` (reference bearing, 0.05 ms,
+4000 samples) and, in full mode, the forward-mode value + 3 design gradients of the smooth peak
+PV (`bench_gradients`' program) and one sweep batch (`jaxbearing.sweep.batch_runner`, 2 cases).
+
+    python benchmarks/bench_compile_cache.py [--quick]
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import _common  # noqa: E402
+
+NAME = "bench_compile_cache"
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _program_simulate() -> float:
+    import jaxbearing as jb
+
+    res = jb.simulate(jb.reference_bearing(), jb.reference_operating_point(), duration=0.05e-3)
+    assert res.ok, res.status
+    return res.compile_time_s
+
+
+def _program_gradient() -> float:
+    import diffrax
+    import jax
+    import jax.numpy as jnp
+
+    import jaxbearing as jb
+    from jaxbearing.flange import DesignVariables
+    from jaxbearing.run import (
+        GRADIENT_ATOL,
+        GRADIENT_HORIZON,
+        GRADIENT_RTOL,
+        flange_functionals,
+        seated_perturbation,
+    )
+
+    bearing, op = jb.reference_bearing(), jb.reference_operating_point()
+    x0 = DesignVariables.of(bearing).as_array()
+
+    def pv(x):
+        b = DesignVariables.from_array(x).apply(bearing)
+        return flange_functionals(b, op, GRADIENT_HORIZON, perturbation=seated_perturbation(b),
+                                  adjoint=diffrax.ForwardMode(), rtol=GRADIENT_RTOL, atol=GRADIENT_ATOL,
+                                  max_steps=100_000)[0]
+
+    def fwd(x):
+        return jax.vmap(lambda e: jax.jvp(pv, (x,), (e,)), out_axes=(None, 0))(jnp.eye(3))
+
+    start = time.perf_counter()
+    jax.jit(fwd).lower(x0).compile()
+    return time.perf_counter() - start
+
+
+def _program_sweep() -> float:
+    import jax
+    import numpy as np
+
+    import jaxbearing as jb
+    from jaxbearing.sweep import batch_runner
+
+    b, op = jb.reference_bearing(), jb.reference_operating_point()
+    cases = [(b, op, 0.05e-3, 1e-3, 1e-6)] * 2
+    inputs = jax.tree_util.tree_map(lambda *xs: np.stack([np.asarray(x, float) for x in xs]), *cases)
+    runner = batch_runner(50, 100_000, tuple(jax.local_devices()))
+    start = time.perf_counter()
+    runner.lower(*inputs).compile()
+    return time.perf_counter() - start
+
+
+PROGRAMS = {"simulate": _program_simulate, "forward_gradient": _program_gradient, "sweep_batch": _program_sweep}
+
+
+def _child(program: str) -> None:
+    seconds = PROGRAMS[program]()
+    print(json.dumps({"compile_s": seconds}))
+
+
+def _run_process(program: str, cache_dir: str) -> float:
+    env = dict(os.environ, JAXBEARING_CACHE_DIR=cache_dir, PYTHONPATH=str(ROOT))
+    out = subprocess.run([sys.executable, __file__, "--child", program], env=env, capture_output=True,
+                         text=True, check=True)
+    return json.loads(out.stdout.strip().splitlines()[-1])["compile_s"]
+
+
+def main(quick: bool = False) -> dict:
+    started = time.perf_counter()
+    programs = ["simulate"] if quick else list(PROGRAMS)
+    rows = {}
+    for program in programs:
+        with tempfile.TemporaryDirectory(prefix="jaxbearing-cache-") as cache:
+            _common.log(f"{NAME}: {program}: first process (empty cache)")
+            first = _run_process(program, cache)
+            files = sum(1 for _ in Path(cache).rglob("*") if _.is_file())
+            _common.log(f"{NAME}: {program}: second process")
+            second = _run_process(program, cache)
+        rows[program] = {"first_process_compile_s": first, "second_process_compile_s": second,
+                         "ratio": second / first, "cache_files": files}
+    worst = max(r["ratio"] for r in rows.values())
+    result = {
+        "benchmark": NAME,
+        "quick": quick,
+        "programs": rows,
+        "targets": {"second_process_compile": _common.target(
+            "a second process compiles in <= 30 % of the first (persistent cache)", worst, 0.30,
+            higher_is_better=False)},
+        "benchmark_wall_s": time.perf_counter() - started,
+    }
+    result["table"] = _common.format_table(
+        "Compile once: first vs second process, shared persistent cache",
+        ["program", "first s", "second s", "second/first", "cache files"],
+        [[k, r["first_process_compile_s"], r["second_process_compile_s"], r["ratio"], r["cache_files"]]
+         for k, r in rows.items()])
+    print(result["table"])
+    _common.write_json(NAME, result)
+    return result
+
+
+if __name__ == "__main__":
+    if "--child" in sys.argv:
+        _child(sys.argv[sys.argv.index("--child") + 1])
+    else:
+        main(quick="--quick" in sys.argv)

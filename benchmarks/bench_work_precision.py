@@ -1,0 +1,364 @@
+"""Work-precision of the dynamic solve (issue 12, item 1): error of flange statistics against a
+tight reference solution, versus field evaluations and wall time.
+
+Case: the reference bearing at 20,000 rpm and 1000 N, seeded initial scatter
+(`jaxbearing.Perturbation(seed=s)`, the same seeds for every integrator).
+
+Window. Settling detection is not used here (it is being built elsewhere): every run is
+integrated over [0, T0 + W] from the quasi-static start and the statistics are taken over the
+fixed window [T0, T0 + W] (full: T0 = 2 ms, W = 6 ms, seeds 0 and 1; quick: T0 = W = 1 ms,
+seed 0), from samples every `SAMPLE_DT` = 2 us (the same instants for every integrator). The
+window is short because the reference costs about 40x the default solve; the statistics are
+therefore those of the early running, not of settled running, and their confidence intervals
+(below) describe the scatter inside that window. What is compared is how far each integrator's
+statistics are from the reference's over the same window and seed.
+
+Statistics (flange samples with normal force > 1 N, every roller and flange): mean and 95th
+percentile of PV, mean sliding speed; cage slip 1 - mean(omega_c) / omega_c,kin over the window.
+Confidence interval of each (95 %): batch means over 8 contiguous blocks of the window
+(t-distribution, 7 degrees of freedom), of the reference run.
+
+Reference: `jaxbearing.solve` with Tsit5, max norm, rtol 1e-7, atol 1e-10.
+
+Integrators (all on the same compiled field and initial state):
+* `jaxbearing.solve` with the max norm (`raceway_loosen = 1`): the old default, at several rtol;
+* `jaxbearing.solve` with the raceway-normal tolerances loosened (`raceway_loosen` = 10, 100,
+  1000; `jaxbearing.run._step_control`);
+* `jaxbearing.solve` with `optimistix.rms_norm` (SciPy's norm inside diffrax);
+* SciPy `solve_ivp(RK45)` at rtol 1e-3, atol 1e-6 (RMS norm) driving the compiled flat field
+  (`_common.FlatField`), from Python.
+
+Reported per integrator and seed: step attempts, rejected steps, field evaluations (Tsit5:
+6 attempts + 1, `_common.fsal_rk_evaluations`; SciPy: nfev), evaluations per simulated ms, wall
+time (compile excluded; single runs, on a shared machine: read the evaluation counts first),
+every statistic, its relative error and its error in units of the reference's CI half-width.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import _common  # noqa: E402
+
+NAME = "bench_work_precision"
+SAMPLE_DT = 2e-6  # [s] spacing of the saved samples
+CONTACT_THRESHOLD = 1.0  # [N] a flange sample counts as in contact above this force
+NUM_BLOCKS = 8  # batch means for the confidence intervals
+T_975_7DOF = 2.364624  # Student t quantile 0.975, 7 degrees of freedom
+REF_RTOL, REF_ATOL = 1e-7, 1e-10
+STATS = ("mean_pv", "p95_pv", "mean_sliding_speed", "cage_slip")
+
+#: (label, kind, rtol, atol, raceway_loosen); kind: "solve" (max norm weighted by
+#: raceway_loosen), "rms" (solve with optimistix.rms_norm), "scipy" (solve_ivp RK45)
+VARIANTS = (
+    ("old default: Tsit5, max norm, rtol 1e-3", "solve", 1e-3, 1e-6, 1.0),
+    ("Tsit5, max norm, rtol 1e-2", "solve", 1e-2, 1e-6, 1.0),
+    ("Tsit5, raceway-normal tol x10, rtol 1e-3", "solve", 1e-3, 1e-6, 10.0),
+    ("Tsit5, raceway-normal tol x100, rtol 1e-3", "solve", 1e-3, 1e-6, 100.0),
+    ("Tsit5, raceway-normal tol x1000, rtol 1e-3", "solve", 1e-3, 1e-6, 1000.0),
+    ("Tsit5, raceway-normal tol x1e4, rtol 1e-3", "solve", 1e-3, 1e-6, 1e4),
+    ("Tsit5, raceway-normal tol x100, rtol 1e-2", "solve", 1e-2, 1e-6, 100.0),
+    ("Tsit5, raceway-normal tol x1e4, rtol 1e-2", "solve", 1e-2, 1e-6, 1e4),
+    ("Tsit5, RMS norm, rtol 1e-3", "rms", 1e-3, 1e-6, 1.0),
+    ("SciPy RK45 (same field, RMS), rtol 1e-3", "scipy", 1e-3, 1e-6, 1.0),
+)
+QUICK_VARIANTS = (0, 3, 5, 8, 9)
+
+
+def tsit5_stability_limit(eigenvalue: complex, h_max: float = 1e-4) -> float:
+    """Largest step h [s] with |R(h lambda)| <= 1 on (0, h] for diffrax's Tsit5 tableau, where
+    R(z) = 1 + z b^T (I - z A)^-1 1 is the stability function (bisection on a fine grid)."""
+    import diffrax
+    import numpy as np
+
+    tab = diffrax.Tsit5().tableau
+    n = len(tab.b_sol)
+    a = np.zeros((n, n))
+    for i, row in enumerate(tab.a_lower):
+        a[i + 1, : i + 1] = np.asarray(row)
+    b = np.asarray(tab.b_sol)
+
+    def stable(h):
+        z = h * eigenvalue
+        return abs(1 + z * b @ np.linalg.solve(np.eye(n) - z * a, np.ones(n))) <= 1.0
+
+    hs = np.linspace(h_max / 1e5, h_max, 100_000)
+    ok = np.array([stable(h) for h in hs])
+    return float(hs[np.argmin(ok) - 1]) if not ok.all() else h_max
+
+
+# -- statistics --------------------------------------------------------------------------------
+def window_statistics(hist: dict, t_start: float, omega_kin: float) -> dict:
+    """Flange statistics over the samples with t >= t_start (module docstring)."""
+    import numpy as np
+
+    t = np.asarray(hist["t"])
+    m = t >= t_start - 1e-12
+    q = np.asarray(hist["flange_force"])[m]
+    pv = np.asarray(hist["flange_pv"])[m]
+    u = np.asarray(hist["flange_sliding_speed"])[m]
+    cage = np.asarray(hist["cage_speed"])[m]
+    c = q > CONTACT_THRESHOLD
+    nan = float("nan")
+    return {
+        "mean_pv": float(pv[c].mean()) if c.any() else nan,
+        "p95_pv": float(np.percentile(pv[c], 95)) if c.any() else nan,
+        "mean_sliding_speed": float(u[c].mean()) if c.any() else nan,
+        "cage_slip": float(1.0 - cage.mean() / omega_kin),
+        "contact_samples": int(c.sum()),
+    }
+
+
+def confidence_halfwidths(hist: dict, t_start: float, omega_kin: float) -> dict:
+    """95 % half-widths of every statistic from `NUM_BLOCKS` batch means over the window."""
+    import numpy as np
+
+    t = np.asarray(hist["t"])
+    idx = np.flatnonzero(t >= t_start - 1e-12)
+    blocks = np.array_split(idx, NUM_BLOCKS)
+    per_block = [window_statistics({k: np.asarray(v)[b] for k, v in hist.items()}, t_start, omega_kin)
+                 for b in blocks]
+    out = {}
+    for s in STATS:
+        vals = np.array([b[s] for b in per_block], float)
+        vals = vals[np.isfinite(vals)]
+        out[s] = float(T_975_7DOF * vals.std(ddof=1) / np.sqrt(len(vals))) if len(vals) > 1 else float("nan")
+    return out
+
+
+def errors(stats: dict, ref: dict, ci: dict) -> dict:
+    """Relative error (cage slip: absolute, in slip units) and error in CI half-widths."""
+    rel, in_ci = {}, {}
+    for s in STATS:
+        d = abs(stats[s] - ref[s])
+        rel[s] = d if s == "cage_slip" else d / abs(ref[s])
+        in_ci[s] = d / ci[s] if ci[s] > 0 else float("inf")
+    return {"relative": rel, "in_ci_halfwidths": in_ci, "max_in_ci": max(in_ci.values()),
+            "max_relative_pv_speed": max(rel[s] for s in STATS if s != "cage_slip")}
+
+
+# -- integrators -----------------------------------------------------------------------------
+def compile_solve(bearing, op, num_saves: int, kind: str):
+    """Compiled (bearing, op, duration, rtol, atol, loosen, seed) -> Solution; seed is traced, so
+    one program serves every seed, tolerance and loosening."""
+    import jax.numpy as jnp
+    import optimistix as optx
+
+    import jaxbearing as jb
+
+    def run(b, o, d, r, a, loosen, seed):
+        norm = optx.rms_norm if kind == "rms" else None
+        return jb.solve(b, o, d, num_saves=num_saves, rtol=r, atol=a, raceway_loosen=loosen,
+                        error_norm=norm, perturbation=jb.Perturbation(seed=seed))
+
+    f = jnp.asarray
+    return _common.compile_jit(run, bearing, op, f(1e-3), f(1e-3), f(1e-6), f(1.0), jnp.asarray(0, jnp.int32))
+
+
+def run_solve(compiled, bearing, op, duration, rtol, atol, loosen, seed) -> dict:
+    import jax
+    import jax.numpy as jnp
+    import numpy as np
+
+    f = jnp.asarray
+    wall, sol = _common.time_once(lambda: compiled(bearing, op, f(duration), f(rtol), f(atol), f(loosen),
+                                                   jnp.asarray(seed, jnp.int32)))
+    hist = jax.tree_util.tree_map(np.asarray, sol.histories)
+    steps = int(sol.num_steps)
+    return {"ok": int(sol.result) == 0, "wall_s": wall, "step_attempts": steps,
+            "rejected_steps": int(sol.num_rejected_steps),
+            "evaluations": _common.fsal_rk_evaluations(steps), "hist": hist}
+
+
+class ScipyRunner:
+    """SciPy RK45 on the compiled flat field; histories from the same contact functions."""
+
+    def __init__(self, bearing, op):
+        import jax
+
+        import jaxbearing as jb
+
+        self.bearing, self.op = bearing, op
+        self.field0 = _common.FlatField(bearing, op, perturbation=jb.Perturbation(seed=0))
+        self.compiled_field, self.compile_s = self.field0.compile()
+        field0 = self.field0
+
+        def samples(ts, ys, args_flat):
+            from jaxbearing.dynamics import contact_loads
+
+            args = field0._unravel_args(args_flat)
+
+            def one(t, y):
+                state = args.scaling.unscale(t, field0._unravel_state(y))
+                fl = contact_loads(state, args.params).flange
+                return {"t": t, "flange_force": fl.normal_force, "flange_pv": fl.pv,
+                        "flange_sliding_speed": fl.sliding_speed, "cage_speed": state.cage.speed}
+
+            return jax.vmap(one)(ts, ys)
+
+        self.samples = jax.jit(samples)
+
+    def run(self, duration, num_saves, rtol, atol, seed) -> dict:
+        import jax
+        import numpy as np
+
+        import jaxbearing as jb
+
+        field = _common.FlatField(self.bearing, self.op, perturbation=jb.Perturbation(seed=seed))
+        args_flat = field.args_flat
+        ts = np.linspace(0.0, duration, num_saves)
+
+        def fun(t, y):
+            return np.asarray(self.compiled_field(t, y, args_flat))
+
+        from scipy.integrate import solve_ivp
+
+        counted = _common.count_calls(fun)
+        start = time.perf_counter()
+        sol = solve_ivp(counted, (0.0, duration), np.asarray(field.y0), method="RK45", rtol=rtol, atol=atol,
+                        t_eval=ts)
+        wall = time.perf_counter() - start
+        hist = jax.tree_util.tree_map(np.asarray, self.samples(sol.t, sol.y.T, args_flat))
+        attempts = _common.rk45_attempts(sol.nfev)
+        return {"ok": sol.status == 0, "wall_s": wall, "step_attempts": attempts,
+                "rejected_steps": None,  # t_eval given: sol.t does not list the accepted steps
+                "evaluations": int(sol.nfev), "hist": hist}
+
+
+# -- the benchmark -----------------------------------------------------------------------------
+def main(quick: bool = False) -> dict:
+    import numpy as np
+
+    import jaxbearing as jb
+
+    started = time.perf_counter()
+    t0, window = (1e-3, 1e-3) if quick else (2e-3, 6e-3)
+    seeds = (0,) if quick else (0, 1)
+    duration = t0 + window
+    num_saves = int(round(duration / SAMPLE_DT)) + 1
+    bearing, op = jb.reference_bearing(), jb.reference_operating_point()
+    jb.validate_bearing(bearing, op)
+    omega_kin = float(jb.kinematic_cage_speed(bearing, op))
+    variants = [VARIANTS[i] for i in QUICK_VARIANTS] if quick else list(VARIANTS)
+
+    _common.log(f"{NAME}: compiling solve (max/weighted norm), {num_saves} samples over {duration * 1e3:g} ms")
+    programs = {"solve": compile_solve(bearing, op, num_saves, "solve")}
+    if any(v[1] == "rms" for v in variants):
+        programs["rms"] = compile_solve(bearing, op, num_saves, "rms")
+    scipy_runner = ScipyRunner(bearing, op) if any(v[1] == "scipy" for v in variants) else None
+    compile_s = {k: v[1] for k, v in programs.items()}
+    if scipy_runner is not None:
+        compile_s["scipy_field"] = scipy_runner.compile_s
+
+    def run(kind, rtol, atol, loosen, seed):
+        if kind == "scipy":
+            return scipy_runner.run(duration, num_saves, rtol, atol, seed)
+        return run_solve(programs[kind][0], bearing, op, duration, rtol, atol, loosen, seed)
+
+    reference = {}
+    for seed in seeds:
+        _common.log(f"{NAME}: reference (rtol {REF_RTOL:g}), seed {seed}")
+        r = run("solve", REF_RTOL, REF_ATOL, 1.0, seed)
+        if not r["ok"]:
+            raise RuntimeError(f"the reference solve failed (seed {seed})")
+        hist = r.pop("hist")
+        r["statistics"] = window_statistics(hist, t0, omega_kin)
+        r["ci_halfwidth"] = confidence_halfwidths(hist, t0, omega_kin)
+        r["evaluations_per_ms"] = r["evaluations"] / (duration * 1e3)
+        reference[str(seed)] = r
+
+    rows = []
+    for label, kind, rtol, atol, loosen in variants:
+        per_seed = {}
+        for seed in seeds:
+            _common.log(f"{NAME}: {label}, seed {seed}")
+            r = run(kind, rtol, atol, loosen, seed)
+            hist = r.pop("hist")
+            ref = reference[str(seed)]
+            r["statistics"] = window_statistics(hist, t0, omega_kin)
+            r["errors"] = errors(r["statistics"], ref["statistics"], ref["ci_halfwidth"])
+            r["evaluations_per_ms"] = r["evaluations"] / (duration * 1e3)
+            per_seed[str(seed)] = r
+        rows.append({
+            "label": label, "kind": kind, "rtol": rtol, "atol": atol, "raceway_loosen": loosen,
+            "seeds": per_seed,
+            "all_ok": all(s["ok"] for s in per_seed.values()),
+            "evaluations_per_ms": float(np.mean([s["evaluations_per_ms"] for s in per_seed.values()])),
+            "wall_s_per_ms": float(np.mean([s["wall_s"] for s in per_seed.values()])) / (duration * 1e3),
+            "max_error_in_ci": max(s["errors"]["max_in_ci"] for s in per_seed.values()),
+            "max_relative_error_pv_speed": max(s["errors"]["max_relative_pv_speed"] for s in per_seed.values()),
+            "max_cage_slip_error": max(s["errors"]["relative"]["cage_slip"] for s in per_seed.values()),
+        })
+    base = rows[0]
+    for row in rows:
+        row["evaluation_ratio_vs_old_default"] = base["evaluations_per_ms"] / row["evaluations_per_ms"]
+        row["wall_ratio_vs_old_default"] = base["wall_s_per_ms"] / row["wall_s_per_ms"]
+    result = {
+        "benchmark": NAME,
+        "quick": quick,
+        "case": {
+            "bearing": "reference_bearing() (26 rollers, 31 slices, arc ends)",
+            "inner_speed_rpm": float(jb.rad_s_to_rpm(op.inner_speed)),
+            "radial_load_N": float(op.radial_load),
+            "startup_s": t0, "window_s": window, "seeds": list(seeds), "sample_dt_s": SAMPLE_DT,
+            "reference": {"rtol": REF_RTOL, "atol": REF_ATOL, "method": "Tsit5, max norm"},
+            "note": "fixed start-up time then a fixed window (no settling detection); CI from 8 batch "
+                    "means of the reference over the window; errors of cage slip are absolute",
+        },
+        "compile_s": compile_s,
+        "reference": reference,
+        "variants": rows,
+        "benchmark_wall_s": time.perf_counter() - started,
+    }
+    result["table"] = _table(result)
+    print(result["table"])
+    _common.write_json(NAME, result)
+    return result
+
+
+def _table(r: dict) -> str:
+    c = r["case"]
+    rows = []
+    for ref_seed, ref in r["reference"].items():
+        st = ref["statistics"]
+        rows.append([f"reference rtol {c['reference']['rtol']:g} (seed {ref_seed})", ref["evaluations_per_ms"], None,
+                     ref["wall_s"] / ((c["startup_s"] + c["window_s"]) * 1e3), None, st["mean_pv"] / 1e6,
+                     st["p95_pv"] / 1e6, st["mean_sliding_speed"], 100 * st["cage_slip"], None, None, None])
+    for v in r["variants"]:
+        s0 = next(iter(v["seeds"].values()))["statistics"]
+        rows.append([v["label"], v["evaluations_per_ms"], v["evaluation_ratio_vs_old_default"], v["wall_s_per_ms"],
+                     v["wall_ratio_vs_old_default"], s0["mean_pv"] / 1e6, s0["p95_pv"] / 1e6,
+                     s0["mean_sliding_speed"], 100 * s0["cage_slip"], v["max_relative_error_pv_speed"],
+                     100 * v["max_cage_slip_error"], v["max_error_in_ci"]])
+    return _common.format_table(
+        f"Work-precision: reference bearing {c['inner_speed_rpm']:.0f} rpm, {c['radial_load_N']:.0f} N; statistics over "
+        f"[{c['startup_s'] * 1e3:g}, {(c['startup_s'] + c['window_s']) * 1e3:g}] ms, seeds {c['seeds']} "
+        f"(statistics columns: first seed; errors: worst seed)",
+        ["integrator", "evals/ms", "x fewer", "wall s/ms", "x faster", "mean PV MPa m/s", "p95 PV", "mean u m/s",
+         "slip %", "max rel err PV,u", "slip err %pt", "err / CI"],
+        rows,
+    )
+
+
+def self_check() -> None:
+    """Cheap checks of the statistics (no model compile)."""
+    import numpy as np
+
+    t = np.linspace(0.0, 1.0, 81)
+    q = np.zeros((81, 2, 4))
+    q[:, 0, 0] = 10.0
+    hist = {"t": t, "flange_force": q, "flange_pv": q * 2.0, "flange_sliding_speed": q * 0.1,
+            "cage_speed": np.full(81, 99.0)}
+    s = window_statistics(hist, 0.5, 100.0)
+    assert abs(s["mean_pv"] - 20.0) < 1e-12 and abs(s["p95_pv"] - 20.0) < 1e-12
+    assert abs(s["cage_slip"] - 0.01) < 1e-12 and s["contact_samples"] == 41
+    ci = confidence_halfwidths(hist, 0.5, 100.0)
+    assert all(v == 0.0 for v in ci.values())
+
+
+if __name__ == "__main__":
+    main(quick="--quick" in sys.argv)

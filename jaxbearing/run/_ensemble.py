@@ -1,0 +1,107 @@
+"""Both cores: independent cases (seeds of an ensemble, sweep points, a batch of designs) run one
+process per core.
+
+Why processes and not `vmap`: an adaptive solve is a while loop whose step count depends on the
+case, so a vmapped batch runs every case as long as its slowest and pays for the masked lanes;
+on a 2-core CPU a batch of 32 ran at 0.74x the per-case throughput of one case at a time
+(benchmarks/results/throughput.json), and one case at a time used only about 1.1 of the 2 cores.
+Separate processes keep every core on a case of its own.
+
+`parallel_map(function, items)` maps a picklable top-level function over picklable items in a
+pool of `workers` processes (default: the CPUs this process may use), started with `spawn`
+(JAX is not fork-safe). Results come back in the order of `items`. The workers share the
+persistent compilation cache (`_compile_cache`), so a program compiled by this process or by one
+worker is loaded, not recompiled, by the others. `threads_per_worker=1` limits each worker to
+one XLA thread; the default keeps this process's XLA flags, because the flags are part of the
+cache key (with other flags every worker compiles its program again: measured 2 min 13 s per
+worker against 16 s for a cache load, benchmarks/bench_ensemble.py). `workers=1` runs in this
+process (no pool).
+
+`simulate_ensemble(bearing, op, seeds, ...)` runs `simulate` once per seed of the initial roller
+scatter (`Perturbation(seed=s)`) through `parallel_map`.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import multiprocessing
+import os
+from collections.abc import Callable, Iterable, Sequence
+from typing import Any
+
+#: XLA flags of a worker with one thread
+_ONE_THREAD_FLAGS = "--xla_cpu_multi_thread_eigen=false intra_op_parallelism_threads=1"
+
+
+def available_cpus() -> int:
+    """CPUs this process may run on."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # pragma: no cover - not Linux
+        return os.cpu_count() or 1
+
+
+@contextlib.contextmanager
+def _environment(**values: str):
+    old = {k: os.environ.get(k) for k in values}
+    os.environ.update(values)
+    try:
+        yield
+    finally:
+        for k, v in old.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
+
+
+def parallel_map(
+    function: Callable[[Any], Any],
+    items: Iterable[Any],
+    *,
+    workers: int | None = None,
+    threads_per_worker: int | None = None,
+) -> list:
+    """[function(item) for item in items], one process per worker (module docstring)."""
+    items = list(items)
+    if workers is None:
+        workers = available_cpus()
+    workers = max(1, min(int(workers), len(items)))
+    if workers == 1:
+        return [function(item) for item in items]
+    flags = os.environ.get("XLA_FLAGS", "")
+    if threads_per_worker == 1:
+        flags = f"{flags} {_ONE_THREAD_FLAGS}".strip()
+    ctx = multiprocessing.get_context("spawn")
+    with _environment(XLA_FLAGS=flags), ctx.Pool(workers) as pool:
+        return pool.map(function, items, chunksize=1)
+
+
+@dataclasses.dataclass(frozen=True)
+class _SimulateSeed:
+    """Picklable `simulate` of one seed (the keyword arguments travel with it)."""
+
+    bearing: Any
+    op: Any
+    kwargs: dict
+
+    def __call__(self, seed: int):
+        from ._simulate import Perturbation, simulate
+
+        base = self.kwargs.get("perturbation") or Perturbation()
+        kwargs = dict(self.kwargs, perturbation=dataclasses.replace(base, seed=int(seed)))
+        return simulate(self.bearing, self.op, **kwargs)
+
+
+def simulate_ensemble(
+    bearing,
+    op,
+    seeds: Sequence[int],
+    *,
+    workers: int | None = None,
+    **simulate_kwargs,
+) -> list:
+    """`simulate(bearing, op, perturbation=Perturbation(seed=s), **simulate_kwargs)` for every seed,
+    one process per core; a list of `SimulationResult` in the order of `seeds`."""
+    return parallel_map(_SimulateSeed(bearing, op, dict(simulate_kwargs)), list(seeds), workers=workers)

@@ -1,0 +1,82 @@
+"""Speed machinery of issue 12: the error norm of `solve`, the cacheable solve program (no host
+callbacks; that failures still reach `status` is tests/test_dynamics.py's forced-failure test),
+the compilation-cache switch and the process pool. The speed itself is measured by
+benchmarks/ (bench_work_precision, bench_compile_cache, bench_ensemble), not here."""
+
+from __future__ import annotations
+
+import operator
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+import optimistix as optx
+
+import jaxbearing as jb
+from jaxbearing.run import (
+    CACHE_ENV,
+    RacewayNormalNorm,
+    parallel_map,
+    raceway_normal_norm,
+)
+from jaxbearing.run._compile_cache import cache_dir_from_environment, default_cache_dir
+
+
+def _random_state(z=5):
+    from jaxbearing.dynamics import state_scales
+
+    template = state_scales(z, 0.05)
+    leaves, treedef = jax.tree_util.tree_flatten(template)
+    keys = jax.random.split(jax.random.PRNGKey(0), len(leaves))
+    return jax.tree_util.tree_unflatten(
+        treedef, [jax.random.normal(k, x.shape) for k, x in zip(keys, leaves)])
+
+
+def test_raceway_normal_norm_is_the_max_norm_with_radial_tolerances_loosened():
+    x = _random_state()
+    assert float(raceway_normal_norm(x, 1.0)(x)) == float(optx.max_norm(x))
+    norm = raceway_normal_norm(x, 100.0)
+    assert isinstance(norm, RacewayNormalNorm)
+    # a huge radial-velocity error of one roller counts 1/100
+    big = jax.tree_util.tree_map(jnp.zeros_like, x)
+    big = eqx.tree_at(lambda s: s.rollers.radial_velocity, big, jnp.zeros(5).at[2].set(50.0))
+    np.testing.assert_allclose(float(norm(big)), 0.5)
+    # an axial (flange-side) error counts in full
+    big = eqx.tree_at(lambda s: s.rollers.axial, big, jnp.zeros(5).at[0].set(3.0))
+    np.testing.assert_allclose(float(norm(big)), 3.0)
+
+
+def test_solve_program_has_no_host_callback():
+    """JAX's persistent cache refuses programs with host callbacks; `solve` must contain none
+    (equinox's checks are traced as NaN, `_compile_cache.checks_without_host_callbacks`)."""
+    b, op = jb.reference_bearing(), jb.reference_operating_point()
+
+    def run(d):
+        return jb.solve(b, op, d, num_saves=3, max_steps=10)
+
+    text = jax.jit(run).lower(1e-5).as_text()
+    assert "callback" not in text
+    # ... while diffrax itself puts its checks there under the default EQX_ON_ERROR
+    import diffrax
+
+    def plain(d):
+        return diffrax.diffeqsolve(diffrax.ODETerm(lambda t, y, a: -y), diffrax.Tsit5(), 0.0, d, 1e-3, 1.0,
+                                   saveat=diffrax.SaveAt(ts=jnp.linspace(0.0, d, 3)), throw=False).ys
+
+    assert "callback" in jax.jit(plain).lower(1.0).as_text()
+
+
+def test_cache_directory_from_environment(monkeypatch, tmp_path):
+    monkeypatch.delenv(CACHE_ENV, raising=False)
+    assert cache_dir_from_environment() == default_cache_dir()
+    for off in ("off", "0", "", "False"):
+        monkeypatch.setenv(CACHE_ENV, off)
+        assert cache_dir_from_environment() is None
+    monkeypatch.setenv(CACHE_ENV, str(tmp_path / "c"))
+    assert cache_dir_from_environment() == tmp_path / "c"
+
+
+def test_parallel_map_keeps_order_in_two_processes():
+    assert parallel_map(operator.neg, [3, 1, 2], workers=2) == [-3, -1, -2]
+    assert parallel_map(operator.neg, [4], workers=2) == [-4]  # one item: no pool
