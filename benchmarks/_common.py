@@ -233,8 +233,9 @@ class FlatField:
             scale=state_scales(bearing.num_rollers, bearing.pitch_diameter / 2),
             orbit_speed=kinematic_cage_speed(bearing, op),
         )
-        self.args = SolveArgs(params=Params(bearing=bearing, operating=op, functionals=functionals),
-                          scaling=scaling)
+        self.args = SolveArgs(
+            params=Params(bearing=bearing, operating=op, functionals=functionals), scaling=scaling
+        )
         self.functionals = functionals
         y0_scaled = scaling.scale_state(0.0, y0)
         self.y0, self._unravel_state = ravel_pytree(y0_scaled)

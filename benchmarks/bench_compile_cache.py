@@ -58,9 +58,16 @@ def _program_gradient() -> float:
 
     def pv(x):
         b = DesignVariables.from_array(x).apply(bearing)
-        return flange_functionals(b, op, GRADIENT_HORIZON, perturbation=seated_perturbation(b),
-                                  adjoint=diffrax.ForwardMode(), rtol=GRADIENT_RTOL, atol=GRADIENT_ATOL,
-                                  max_steps=100_000)[0]
+        return flange_functionals(
+            b,
+            op,
+            GRADIENT_HORIZON,
+            perturbation=seated_perturbation(b),
+            adjoint=diffrax.ForwardMode(),
+            rtol=GRADIENT_RTOL,
+            atol=GRADIENT_ATOL,
+            max_steps=100_000,
+        )[0]
 
     def fwd(x):
         return jax.vmap(lambda e: jax.jvp(pv, (x,), (e,)), out_axes=(None, 0))(jnp.eye(3))
@@ -86,7 +93,11 @@ def _program_sweep() -> float:
     return time.perf_counter() - start
 
 
-PROGRAMS = {"simulate": _program_simulate, "forward_gradient": _program_gradient, "sweep_batch": _program_sweep}
+PROGRAMS = {
+    "simulate": _program_simulate,
+    "forward_gradient": _program_gradient,
+    "sweep_batch": _program_sweep,
+}
 
 
 def _child(program: str) -> None:
@@ -96,8 +107,9 @@ def _child(program: str) -> None:
 
 def _run_process(program: str, cache_dir: str) -> float:
     env = dict(os.environ, JAXBEARING_CACHE_DIR=cache_dir, PYTHONPATH=str(ROOT))
-    out = subprocess.run([sys.executable, __file__, "--child", program], env=env, capture_output=True,
-                         text=True, check=True)
+    out = subprocess.run(
+        [sys.executable, __file__, "--child", program], env=env, capture_output=True, text=True, check=True
+    )
     return json.loads(out.stdout.strip().splitlines()[-1])["compile_s"]
 
 
@@ -112,23 +124,35 @@ def main(quick: bool = False) -> dict:
             files = sum(1 for _ in Path(cache).rglob("*") if _.is_file())
             _common.log(f"{NAME}: {program}: second process")
             second = _run_process(program, cache)
-        rows[program] = {"first_process_compile_s": first, "second_process_compile_s": second,
-                         "ratio": second / first, "cache_files": files}
+        rows[program] = {
+            "first_process_compile_s": first,
+            "second_process_compile_s": second,
+            "ratio": second / first,
+            "cache_files": files,
+        }
     worst = max(r["ratio"] for r in rows.values())
     result = {
         "benchmark": NAME,
         "quick": quick,
         "programs": rows,
-        "targets": {"second_process_compile": _common.target(
-            "a second process compiles in <= 30 % of the first (persistent cache)", worst, 0.30,
-            higher_is_better=False)},
+        "targets": {
+            "second_process_compile": _common.target(
+                "a second process compiles in <= 30 % of the first (persistent cache)",
+                worst,
+                0.30,
+                higher_is_better=False,
+            )
+        },
         "benchmark_wall_s": time.perf_counter() - started,
     }
     result["table"] = _common.format_table(
         "Compile once: first vs second process, shared persistent cache",
         ["program", "first s", "second s", "second/first", "cache files"],
-        [[k, r["first_process_compile_s"], r["second_process_compile_s"], r["ratio"], r["cache_files"]]
-         for k, r in rows.items()])
+        [
+            [k, r["first_process_compile_s"], r["second_process_compile_s"], r["ratio"], r["cache_files"]]
+            for k, r in rows.items()
+        ],
+    )
     print(result["table"])
     _common.write_json(NAME, result)
     return result

@@ -98,9 +98,12 @@ def main(quick: bool = False) -> dict:
     t1 = jnp.asarray(1e-6)
 
     call_times = _common.time_repeats(lambda: compiled_field(t1, y0, args_flat), num_calls, warmup=10)
-    loop_times = [t / num_loop for t in _common.time_repeats(lambda: compiled_loop(y0, args_flat), repeats, warmup=1)]
-    nohoist_times = [t / num_loop for t in
-                     _common.time_repeats(lambda: compiled_nohoist(y0, args_flat), repeats, warmup=1)]
+    loop_times = [
+        t / num_loop for t in _common.time_repeats(lambda: compiled_loop(y0, args_flat), repeats, warmup=1)
+    ]
+    nohoist_times = [
+        t / num_loop for t in _common.time_repeats(lambda: compiled_nohoist(y0, args_flat), repeats, warmup=1)
+    ]
     t_call = float(np.median(call_times))
     t_loop = float(np.median(loop_times))
     t_nohoist = float(np.median(nohoist_times))
@@ -163,7 +166,10 @@ def main(quick: bool = False) -> dict:
         "targets": {
             "integration_loop_overhead": _common.target(
                 "integration-loop overhead (solve wall / (evaluations x one compiled field call) - 1) < 30 %",
-                main_solve["overhead_vs_call"], 0.30, higher_is_better=False),
+                main_solve["overhead_vs_call"],
+                0.30,
+                higher_is_better=False,
+            ),
         },
         "benchmark_wall_s": time.perf_counter() - started,
     }
@@ -179,32 +185,71 @@ def _table(r: dict) -> str:
         f"Part 2 - cost of one vector-field evaluation (reference bearing, state of {c['state_size']} floats)",
         ["measurement", "median us", "min us", "repeats", "compile s"],
         [
-            ["one compiled call (with dispatch)", f["t_call_median_s"] * 1e6, f["single_call_s"]["min_s"] * 1e6,
-             f["single_call_s"]["repeats"], f["compile_s"]],
-            [f"inside a compiled loop of {f['in_loop_evaluations']}", f["t_loop_median_s"] * 1e6,
-             f["in_loop_per_evaluation_s"]["min_s"] * 1e6, f["in_loop_per_evaluation_s"]["repeats"],
-             f["in_loop_compile_s"]],
-            ["inside a compiled loop, nothing hoisted", f["t_loop_nohoist_median_s"] * 1e6,
-             f["in_loop_nohoist_per_evaluation_s"]["min_s"] * 1e6,
-             f["in_loop_nohoist_per_evaluation_s"]["repeats"], f["in_loop_nohoist_compile_s"]],
+            [
+                "one compiled call (with dispatch)",
+                f["t_call_median_s"] * 1e6,
+                f["single_call_s"]["min_s"] * 1e6,
+                f["single_call_s"]["repeats"],
+                f["compile_s"],
+            ],
+            [
+                f"inside a compiled loop of {f['in_loop_evaluations']}",
+                f["t_loop_median_s"] * 1e6,
+                f["in_loop_per_evaluation_s"]["min_s"] * 1e6,
+                f["in_loop_per_evaluation_s"]["repeats"],
+                f["in_loop_compile_s"],
+            ],
+            [
+                "inside a compiled loop, nothing hoisted",
+                f["t_loop_nohoist_median_s"] * 1e6,
+                f["in_loop_nohoist_per_evaluation_s"]["min_s"] * 1e6,
+                f["in_loop_nohoist_per_evaluation_s"]["repeats"],
+                f["in_loop_nohoist_compile_s"],
+            ],
         ],
     )
     rows = []
     for s in r["solves"].values():
-        rows.append([s["num_saves"], s["wall_s"], s["step_attempts"], s["rejected_steps"], s["evaluations"],
-                     s["wall_per_evaluation_s"] * 1e6, 100 * s["overhead_vs_call"],
-                     100 * s["overhead_vs_loop_nohoist"], 100 * s["overhead_vs_loop"], s["compile_s"]])
+        rows.append(
+            [
+                s["num_saves"],
+                s["wall_s"],
+                s["step_attempts"],
+                s["rejected_steps"],
+                s["evaluations"],
+                s["wall_per_evaluation_s"] * 1e6,
+                100 * s["overhead_vs_call"],
+                100 * s["overhead_vs_loop_nohoist"],
+                100 * s["overhead_vs_loop"],
+                s["compile_s"],
+            ]
+        )
     t2 = _common.format_table(
         f"Integration-loop overhead of jaxbearing.solve over {c['simulated_time_s'] * 1e3:g} ms "
         f"(overhead = wall / (evals x t_eval) - 1)",
-        ["num_saves", "wall s", "attempts", "rejected", "evals", "us/eval", "ovh vs call %", "vs no-hoist %",
-         "vs loop %",
-         "compile s"],
+        [
+            "num_saves",
+            "wall s",
+            "attempts",
+            "rejected",
+            "evals",
+            "us/eval",
+            "ovh vs call %",
+            "vs no-hoist %",
+            "vs loop %",
+            "compile s",
+        ],
         rows,
     )
     t = r["targets"]["integration_loop_overhead"]
-    return "\n".join([t1, t2, f"target: {t['target']}: {100 * t['measured']:.0f} % -> "
-                                f"{'reached' if t['reached'] else 'NOT reached'}"])
+    return "\n".join(
+        [
+            t1,
+            t2,
+            f"target: {t['target']}: {100 * t['measured']:.0f} % -> "
+            f"{'reached' if t['reached'] else 'NOT reached'}",
+        ]
+    )
 
 
 def self_check() -> None:

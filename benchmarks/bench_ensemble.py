@@ -45,8 +45,9 @@ def main(quick: bool = False) -> dict:
     bearing, op = jb.reference_bearing(), jb.reference_operating_point()
     kw = dict(duration=duration, num_saves=200)
     # the worker processes import jaxbearing from this checkout
-    os.environ["PYTHONPATH"] = os.pathsep.join([str(Path(__file__).resolve().parents[1]),
-                                                os.environ.get("PYTHONPATH", "")]).rstrip(os.pathsep)
+    os.environ["PYTHONPATH"] = os.pathsep.join(
+        [str(Path(__file__).resolve().parents[1]), os.environ.get("PYTHONPATH", "")]
+    ).rstrip(os.pathsep)
     _common.log(f"{NAME}: compiling simulate (cache dir {jb.COMPILATION_CACHE_DIR})")
     first = jb.simulate(bearing, op, perturbation=jb.Perturbation(seed=0), **kw)
     serial, pooled, run_serial, run_pooled = [], [], [], []
@@ -71,8 +72,12 @@ def main(quick: bool = False) -> dict:
     result = {
         "benchmark": NAME,
         "quick": quick,
-        "case": {"seeds": seeds, "simulated_time_s": duration, "num_saves": 200,
-                 "bearing": "reference_bearing(), 20,000 rpm, 1000 N"},
+        "case": {
+            "seeds": seeds,
+            "simulated_time_s": duration,
+            "num_saves": 200,
+            "bearing": "reference_bearing(), 20,000 rpm, 1000 N",
+        },
         "compile_s_first": first.compile_time_s,
         "one_at_a_time_wall_s": serial,
         "two_processes_wall_s": pooled,
@@ -85,17 +90,24 @@ def main(quick: bool = False) -> dict:
         "ratio_run_phase": ratio,
         "step_attempts": steps,
         "load_average_at_end": list(os.getloadavg()),
-        "targets": {"two_core_ensemble": _common.target(
-            "ensemble of seeds on 2 cores >= 1.5x the throughput of one case at a time (run phase)", ratio, 1.5,
-            higher_is_better=True)},
+        "targets": {
+            "two_core_ensemble": _common.target(
+                "ensemble of seeds on 2 cores >= 1.5x the throughput of one case at a time (run phase)",
+                ratio,
+                1.5,
+                higher_is_better=True,
+            )
+        },
         "benchmark_wall_s": time.perf_counter() - started,
     }
     result["table"] = _common.format_table(
         f"Both cores: {len(seeds)} seeds x {duration * 1e3:g} ms (best of {rounds})",
         ["mode", "wall s (end to end)", "cases/s", "ratio end to end", "run s per case", "ratio run phase"],
-        [["one at a time (one process)", t1, len(seeds) / t1, 1.0, min(run_serial), 1.0],
-         ["simulate_ensemble, 2 processes", t2, len(seeds) / t2, end_to_end, min(run_pooled),
-          ratio]])
+        [
+            ["one at a time (one process)", t1, len(seeds) / t1, 1.0, min(run_serial), 1.0],
+            ["simulate_ensemble, 2 processes", t2, len(seeds) / t2, end_to_end, min(run_pooled), ratio],
+        ],
+    )
     print(result["table"])
     _common.write_json(NAME, result)
     return result

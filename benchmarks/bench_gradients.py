@@ -79,8 +79,9 @@ def main(quick: bool = True) -> dict:
 
     def pv(x, adjoint=None):
         b = DesignVariables.from_array(x).apply(bearing)
-        return flange_functionals(b, op, GRADIENT_HORIZON, perturbation=seated_perturbation(b),
-                                  adjoint=adjoint, **kw)[0]
+        return flange_functionals(
+            b, op, GRADIENT_HORIZON, perturbation=seated_perturbation(b), adjoint=adjoint, **kw
+        )[0]
 
     forward = jax.jit(pv)
 
@@ -108,12 +109,12 @@ def main(quick: bool = True) -> dict:
         return float(forward(x)), np.asarray(g)
 
     _, g_fd = central_fd(x0)
-    t = _interleaved({"forward": forward, "fwd_mode": fwd_mode, "rev_mode": rev_mode,
-                      "fd": central_fd}, x0, repeats)
+    t = _interleaved(
+        {"forward": forward, "fwd_mode": fwd_mode, "rev_mode": rev_mode, "fd": central_fd}, x0, repeats
+    )
     # minimum over repeats: the least-disturbed call on a shared machine (timeit convention)
     t_fwd, t_jf, t_rv, t_fd = (t[k][0] for k in ("forward", "fwd_mode", "rev_mode", "fd"))
-    c_fwd, c_jf, c_rv = (max(0.0, a - b) for a, b in ((first_fwd, t_fwd), (first_jf, t_jf),
-                                                      (first_rv, t_rv)))
+    c_fwd, c_jf, c_rv = (max(0.0, a - b) for a, b in ((first_fwd, t_fwd), (first_jf, t_jf), (first_rv, t_rv)))
     g_fd = np.asarray(g_fd)
     g_f, g_r = np.asarray(g_f), np.asarray(g_r)
     scale = np.abs(g_fd).max()
@@ -140,12 +141,24 @@ def main(quick: bool = True) -> dict:
         "times_min_median_s": t,
         "repeats": repeats,
         "methods": {
-            "forward_mode": {"time_s": t_jf, "relative_to_forward_solve": t_jf / t_fwd,
-                             "compile_s": c_jf, "max_rel_diff_to_fd": agree(g_f)},
-            "reverse_mode_checkpointed": {"time_s": t_rv, "relative_to_forward_solve": t_rv / t_fwd,
-                                          "compile_s": c_rv, "max_rel_diff_to_fd": agree(g_r)},
-            "central_fd": {"time_s": t_fd, "relative_to_forward_solve": t_fd / t_fwd,
-                           "compile_s": c_fwd, "max_rel_diff_to_fd": 0.0},
+            "forward_mode": {
+                "time_s": t_jf,
+                "relative_to_forward_solve": t_jf / t_fwd,
+                "compile_s": c_jf,
+                "max_rel_diff_to_fd": agree(g_f),
+            },
+            "reverse_mode_checkpointed": {
+                "time_s": t_rv,
+                "relative_to_forward_solve": t_rv / t_fwd,
+                "compile_s": c_rv,
+                "max_rel_diff_to_fd": agree(g_r),
+            },
+            "central_fd": {
+                "time_s": t_fd,
+                "relative_to_forward_solve": t_fd / t_fwd,
+                "compile_s": c_fwd,
+                "max_rel_diff_to_fd": 0.0,
+            },
         },
         "forward_solve_compile_s": c_fwd,
         "faster_ad_mode": faster,
@@ -155,13 +168,19 @@ def main(quick: bool = True) -> dict:
     }
     RESULTS.mkdir(parents=True, exist_ok=True)
     (RESULTS / "gradients.json").write_text(json.dumps(out, indent=2))
-    print(f"value + gradient of smooth peak PV in (R_end, theta_f, Delta_bf); horizon "
-          f"{GRADIENT_HORIZON * 1e3:g} ms, rtol {GRADIENT_RTOL:g}, atol {GRADIENT_ATOL:g}")
-    print(f"one forward solve: {t_fwd:.3f} s (compile {c_fwd:.1f} s); peak PV {float(value) / 1e9:.4g} GPa m/s")
+    print(
+        f"value + gradient of smooth peak PV in (R_end, theta_f, Delta_bf); horizon "
+        f"{GRADIENT_HORIZON * 1e3:g} ms, rtol {GRADIENT_RTOL:g}, atol {GRADIENT_ATOL:g}"
+    )
+    print(
+        f"one forward solve: {t_fwd:.3f} s (compile {c_fwd:.1f} s); peak PV {float(value) / 1e9:.4g} GPa m/s"
+    )
     print(f"{'method':<28}{'time [s]':>10}{'x forward':>11}{'compile [s]':>13}{'max rel diff to FD':>20}")
     for name, m in out["methods"].items():
-        print(f"{name:<28}{m['time_s']:>10.3f}{m['relative_to_forward_solve']:>11.2f}"
-              f"{m['compile_s']:>13.1f}{m['max_rel_diff_to_fd']:>20.2e}")
+        print(
+            f"{name:<28}{m['time_s']:>10.3f}{m['relative_to_forward_solve']:>11.2f}"
+            f"{m['compile_s']:>13.1f}{m['max_rel_diff_to_fd']:>20.2e}"
+        )
     print(f"faster AD mode: {faster}, by {ratio:.2f}x")
     return out
 

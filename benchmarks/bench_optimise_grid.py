@@ -57,11 +57,15 @@ def main(quick: bool = True) -> dict:
     grid = opt.grid_search(problem, n_grid, n_grid, CLEARANCE_MM * 1e-3)
 
     def design(x):
-        return None if x is None else {
-            "end_radius_mm": float(x[0]) * 1e3,
-            "layback_angle_deg": math.degrees(float(x[1])),
-            "axial_clearance_mm": float(x[2]) * 1e3,
-        }
+        return (
+            None
+            if x is None
+            else {
+                "end_radius_mm": float(x[0]) * 1e3,
+                "layback_angle_deg": math.degrees(float(x[1])),
+                "axial_clearance_mm": float(x[2]) * 1e3,
+            }
+        )
 
     out = {
         "bearing": "reference (jaxbearing.reference_bearing), 20,000 rpm, 1000 N, gravity on",
@@ -92,9 +96,7 @@ def main(quick: bool = True) -> dict:
             "model_evaluation_kind": "solve (value only)",
             "wall_time_s": grid["wall_time_s"],
         },
-        "search_no_worse_than_grid": bool(
-            res.feasible and res.objective <= grid["best_objective"] + 1e-3
-        ),
+        "search_no_worse_than_grid": bool(res.feasible and res.objective <= grid["best_objective"] + 1e-3),
         "no_worse_tolerance_GPa_m_s": 1e-3,
         "quick": quick,
         "machine": machine_info(),
@@ -102,12 +104,18 @@ def main(quick: bool = True) -> dict:
     RESULTS.mkdir(parents=True, exist_ok=True)
     (RESULTS / "optimise_vs_grid.json").write_text(json.dumps(out, indent=2))
     s, g = out["search"], out["grid"]
-    print(f"optimiser vs {n_grid} x {n_grid} grid, Delta_bf {CLEARANCE_MM} mm, {duration * 1e3:g} ms per evaluation")
-    print(f"{'':<10}{'PV [GPa m/s]':>14}{'R_end [mm]':>12}{'theta_f [deg]':>15}{'evaluations':>13}{'wall [s]':>10}")
+    print(
+        f"optimiser vs {n_grid} x {n_grid} grid, Delta_bf {CLEARANCE_MM} mm, {duration * 1e3:g} ms per evaluation"
+    )
+    print(
+        f"{'':<10}{'PV [GPa m/s]':>14}{'R_end [mm]':>12}{'theta_f [deg]':>15}{'evaluations':>13}{'wall [s]':>10}"
+    )
     for name, r in (("search", s), ("grid", g)):
         d = r["design"] or {"end_radius_mm": float("nan"), "layback_angle_deg": float("nan")}
-        print(f"{name:<10}{r['objective_GPa_m_s']:>14.4f}{d['end_radius_mm']:>12.2f}"
-              f"{d['layback_angle_deg']:>15.3f}{r['model_evaluations']:>13d}{r['wall_time_s']:>10.1f}")
+        print(
+            f"{name:<10}{r['objective_GPa_m_s']:>14.4f}{d['end_radius_mm']:>12.2f}"
+            f"{d['layback_angle_deg']:>15.3f}{r['model_evaluations']:>13d}{r['wall_time_s']:>10.1f}"
+        )
     print(f"search no worse than grid: {out['search_no_worse_than_grid']}")
     return out
 

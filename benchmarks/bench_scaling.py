@@ -119,7 +119,8 @@ def run_point(num_rollers: int, duration: float) -> dict:
         "peak_rss_bytes": end,
         "rss_after_compile_bytes": after_compile,
         "run_peak_rss_bytes": run_peak,
-        "run_peak_above_post_compile_bytes": None if run_peak is None or after_compile is None
+        "run_peak_above_post_compile_bytes": None
+        if run_peak is None or after_compile is None
         else run_peak - after_compile,
     }
 
@@ -129,15 +130,27 @@ def measure_point(num_rollers: int, duration: float, timeout: float = POINT_TIME
     spec = json.dumps({"num_rollers": num_rollers, "duration": duration})
     start = time.perf_counter()
     try:
-        proc = subprocess.run([sys.executable, str(Path(__file__).resolve()), "--point", spec],
-                              capture_output=True, text=True, timeout=timeout)
+        proc = subprocess.run(
+            [sys.executable, str(Path(__file__).resolve()), "--point", spec],
+            capture_output=True,
+            text=True,
+            timeout=timeout,
+        )
     except subprocess.TimeoutExpired:
-        return {"num_rollers": num_rollers, "duration_s": duration, "ok": False,
-                "status": f"failed: the point ran past {timeout:g} s"}
+        return {
+            "num_rollers": num_rollers,
+            "duration_s": duration,
+            "ok": False,
+            "status": f"failed: the point ran past {timeout:g} s",
+        }
     if proc.returncode != 0:
         tail = (proc.stderr or proc.stdout).strip().splitlines()[-1:] or ["(no output)"]
-        return {"num_rollers": num_rollers, "duration_s": duration, "ok": False,
-                "status": f"failed: exit {proc.returncode}: {tail[0]}"}
+        return {
+            "num_rollers": num_rollers,
+            "duration_s": duration,
+            "ok": False,
+            "status": f"failed: exit {proc.returncode}: {tail[0]}",
+        }
     out = json.loads(proc.stdout.strip().splitlines()[-1])
     out["process_wall_s"] = time.perf_counter() - start
     return out
@@ -173,7 +186,7 @@ def main(quick: bool = False) -> dict:
             "operating_point": "reference_operating_point() (20,000 rpm, 1000 N, gravity on)",
             "solver": "jaxbearing.simulate defaults: Tsit5, rtol 1e-3, atol 1e-6, 4000 saved samples",
             "memory": "fresh process per point; peak_rss = ru_maxrss of the whole process (compiler "
-                      "included); run_peak_rss = VmHWM during the timed run (reset after compiling)",
+            "included); run_peak_rss = VmHWM during the timed run (reset after compiling)",
             "largest_roller_count_that_fits": z_max,
         },
         "versus_duration": by_duration,
@@ -185,7 +198,9 @@ def main(quick: bool = False) -> dict:
     print(result["table"])
     _common.write_json(NAME, result)
     if failed:
-        raise RuntimeError(f"{len(failed)} scaling point(s) failed: " + "; ".join(p["status"] for p in failed))
+        raise RuntimeError(
+            f"{len(failed)} scaling point(s) failed: " + "; ".join(p["status"] for p in failed)
+        )
     return result
 
 
@@ -197,22 +212,53 @@ def _rows(points):
             rows.append([p["num_rollers"], p["duration_s"] * 1e3, p["status"]] + [None] * 8)
             continue
         run_peak = p.get("run_peak_rss_bytes")
-        rows.append([p["num_rollers"], p["duration_s"] * 1e3, "ok", p["wall_s"], p["compile_s"],
-                     p["step_attempts"], p["wall_per_step_s"] * 1e6, p["rss_baseline_bytes"] / mib,
-                     p["peak_rss_bytes"] / mib, None if run_peak is None else run_peak / mib,
-                     None if run_peak is None else p["run_peak_above_post_compile_bytes"] / mib])
+        rows.append(
+            [
+                p["num_rollers"],
+                p["duration_s"] * 1e3,
+                "ok",
+                p["wall_s"],
+                p["compile_s"],
+                p["step_attempts"],
+                p["wall_per_step_s"] * 1e6,
+                p["rss_baseline_bytes"] / mib,
+                p["peak_rss_bytes"] / mib,
+                None if run_peak is None else run_peak / mib,
+                None if run_peak is None else p["run_peak_above_post_compile_bytes"] / mib,
+            ]
+        )
     return rows
 
 
 def _table(r: dict) -> str:
-    header = ["rollers", "sim ms", "status", "wall s", "compile s", "attempts", "us/step",
-              "import MiB", "peak MiB", "run peak MiB", "run extra MiB"]
-    return "\n".join([
-        _common.format_table("Part 5 - scaling with simulated duration (reference bearing, 26 rollers; "
-                             "fresh process per point)", header, _rows(r["versus_duration"])),
-        _common.format_table("Part 5 - scaling with roller count (reference geometry)", header,
-                             _rows(r["versus_roller_count"])),
-    ])
+    header = [
+        "rollers",
+        "sim ms",
+        "status",
+        "wall s",
+        "compile s",
+        "attempts",
+        "us/step",
+        "import MiB",
+        "peak MiB",
+        "run peak MiB",
+        "run extra MiB",
+    ]
+    return "\n".join(
+        [
+            _common.format_table(
+                "Part 5 - scaling with simulated duration (reference bearing, 26 rollers; "
+                "fresh process per point)",
+                header,
+                _rows(r["versus_duration"]),
+            ),
+            _common.format_table(
+                "Part 5 - scaling with roller count (reference geometry)",
+                header,
+                _rows(r["versus_roller_count"]),
+            ),
+        ]
+    )
 
 
 def self_check() -> None:

@@ -141,8 +141,16 @@ def _compile_dopri5_rms(field: _common.FlatField, duration):
             args=args_flat,
             saveat=diffrax.SaveAt(t1=True),
             stepsize_controller=diffrax.PIDController(
-                rtol=RTOL, atol=ATOL, pcoeff=0.0, icoeff=1.0, dcoeff=0.0, safety=0.9,
-                factormin=0.2, factormax=10.0, norm=optx.rms_norm),
+                rtol=RTOL,
+                atol=ATOL,
+                pcoeff=0.0,
+                icoeff=1.0,
+                dcoeff=0.0,
+                safety=0.9,
+                factormin=0.2,
+                factormax=10.0,
+                norm=optx.rms_norm,
+            ),
             max_steps=1_000_000,
             throw=False,
         )
@@ -227,7 +235,9 @@ def main(quick: bool = False) -> dict:
         return np.asarray(compiled_field(t, y, args_flat))
 
     _common.run_solve_ivp(lambda t, y: -y, (0.0, 1.0), np.ones(1), rtol=RTOL, atol=ATOL)  # import/warm SciPy
-    eval_times = _common.time_repeats(lambda: compiled_field(0.0, y0, args_flat), 50 if quick else 200, warmup=5)
+    eval_times = _common.time_repeats(
+        lambda: compiled_field(0.0, y0, args_flat), 50 if quick else 200, warmup=5
+    )
     t_eval = float(np.median(eval_times))
 
     # -- timed runs, interleaved so that machine load hits all three alike -------------------
@@ -293,8 +303,12 @@ def main(quick: bool = False) -> dict:
     rows["scipy"]["time_outside_field_share"] = 1.0 - rows["scipy"]["evaluations"] * t_eval / wall["scipy"]
 
     agreement = {
-        "diffrax_vs_scipy": _agreement(rows["diffrax"]["final_state"], rows["scipy"]["final_state"], omega_kin),
-        "dopri5_rms_vs_scipy": _agreement(rows["dopri5_rms"]["final_state"], rows["scipy"]["final_state"], omega_kin),
+        "diffrax_vs_scipy": _agreement(
+            rows["diffrax"]["final_state"], rows["scipy"]["final_state"], omega_kin
+        ),
+        "dopri5_rms_vs_scipy": _agreement(
+            rows["dopri5_rms"]["final_state"], rows["scipy"]["final_state"], omega_kin
+        ),
     }
     if not quick:
         _common.log(f"{NAME}: counting the field's executions in an instrumented solve")
@@ -314,22 +328,26 @@ def main(quick: bool = False) -> dict:
             "state_size": field.size,
             "repeats": repeats,
             "note": "all three integrate the scaled deviation state of jaxbearing.solve with the same "
-                    "compiled field; SciPy's error norm is RMS, jaxbearing.solve's the max norm "
-                    "(stricter at equal tolerances, so it takes more steps); the Dopri5/RMS row runs "
-                    "SciPy's own algorithm inside diffrax",
+            "compiled field; SciPy's error norm is RMS, jaxbearing.solve's the max norm "
+            "(stricter at equal tolerances, so it takes more steps); the Dopri5/RMS row runs "
+            "SciPy's own algorithm inside diffrax",
         },
         **rows,
         "speedup_diffrax_over_scipy": speedup,
         "speedup_dopri5_rms_over_scipy": wall["scipy"] / wall["dopri5_rms"],
         "evaluation_ratio_scipy_over_diffrax": rows["scipy"]["evaluations"] / rows["diffrax"]["evaluations"],
-        "per_evaluation_speedup_diffrax_over_scipy":
-            rows["scipy"]["wall_per_evaluation_s"] / rows["diffrax"]["wall_per_evaluation_s"],
+        "per_evaluation_speedup_diffrax_over_scipy": rows["scipy"]["wall_per_evaluation_s"]
+        / rows["diffrax"]["wall_per_evaluation_s"],
         "final_state_agreement": agreement,
         "evaluation_count_check": count_check,
         "targets": {
             "diffrax_vs_scipy": _common.target(
                 "one diffrax solve (jaxbearing.solve) >= 2x faster than SciPy RK45 driving the same "
-                "compiled field", speedup, 2.0, higher_is_better=True),
+                "compiled field",
+                speedup,
+                2.0,
+                higher_is_better=True,
+            ),
         },
         "benchmark_wall_s": time.perf_counter() - started,
     }
@@ -341,42 +359,70 @@ def main(quick: bool = False) -> dict:
 
 def _table(r: dict) -> str:
     c = r["case"]
-    labels = {"diffrax": "jaxbearing.solve (diffrax Tsit5, max norm)",
-              "dopri5_rms": "diffrax Dopri5, RMS norm (SciPy's method)",
-              "scipy": "SciPy solve_ivp RK45 (same field)"}
+    labels = {
+        "diffrax": "jaxbearing.solve (diffrax Tsit5, max norm)",
+        "dopri5_rms": "diffrax Dopri5, RMS norm (SciPy's method)",
+        "scipy": "SciPy solve_ivp RK45 (same field)",
+    }
     rows = []
     for key, label in labels.items():
         x = r[key]
-        rows.append([label, x["wall_s"], x["compile_s"], x["accepted_steps"], x["rejected_steps"],
-                     x["evaluations"], x["wall_per_evaluation_s"] * 1e6,
-                     r["scipy"]["wall_s"] / x["wall_s"], x["final_state"]["cage_speed_rad_s"],
-                     x["final_state"]["smooth_peak_pv_Pa_m_s"]])
+        rows.append(
+            [
+                label,
+                x["wall_s"],
+                x["compile_s"],
+                x["accepted_steps"],
+                x["rejected_steps"],
+                x["evaluations"],
+                x["wall_per_evaluation_s"] * 1e6,
+                r["scipy"]["wall_s"] / x["wall_s"],
+                x["final_state"]["cage_speed_rad_s"],
+                x["final_state"]["smooth_peak_pv_Pa_m_s"],
+            ]
+        )
     table = _common.format_table(
         f"Part 1 - diffrax vs SciPy RK45 on the same compiled field: reference bearing, "
         f"{c['inner_speed_rpm']:.0f} rpm, {c['radial_load_N']:.0f} N, {c['simulated_time_s'] * 1e3:g} ms "
         f"simulated, rtol {c['rtol']:g}, atol {c['atol']:g} (median of {c['repeats']})",
-        ["integrator", "wall s", "compile s", "accepted", "rejected", "evals", "us/eval",
-         "SciPy/this", "cage rad/s", "peak PV Pa m/s"],
+        [
+            "integrator",
+            "wall s",
+            "compile s",
+            "accepted",
+            "rejected",
+            "evals",
+            "us/eval",
+            "SciPy/this",
+            "cage rad/s",
+            "peak PV Pa m/s",
+        ],
         rows,
     )
     lines = [table]
     s = r["scipy"]
-    lines.append(f"one compiled field call (median): {s['single_evaluation_median_s'] * 1e6:.1f} us; "
-                 f"SciPy's time outside the field: {100 * s['time_outside_field_share']:.0f} %")
+    lines.append(
+        f"one compiled field call (median): {s['single_evaluation_median_s'] * 1e6:.1f} us; "
+        f"SciPy's time outside the field: {100 * s['time_outside_field_share']:.0f} %"
+    )
     for key, a in r["final_state_agreement"].items():
         lines.append(
             f"final state {key.replace('_vs_', ' vs ')}: agree = {a['agree']} (cage speed "
             f"{100 * a['cage_speed_difference_rel_kinematic']:.2g} % of kinematic <= {100 * CAGE_SPEED_TOL:g} %, "
             f"ring centre {a['inner_ring_centre_difference_m'] * 1e6:.2g} um <= {RING_CENTRE_TOL * 1e6:g} um, "
-            f"smooth peak PV {100 * a['smooth_peak_pv_difference_rel']:.2g} % <= {100 * PEAK_PV_TOL:g} %)")
+            f"smooth peak PV {100 * a['smooth_peak_pv_difference_rel']:.2g} % <= {100 * PEAK_PV_TOL:g} %)"
+        )
     ck = r["evaluation_count_check"]
     if ck is not None:
         lines.append(
             f"Tsit5 evaluations, counted in an instrumented solve: {ck['counted_evaluations']}; formula "
             f"6 x {ck['step_attempts']} attempts + 1 = {ck['formula_evaluations']} "
-            f"({'holds' if ck['formula_holds'] else 'DOES NOT HOLD'})")
+            f"({'holds' if ck['formula_holds'] else 'DOES NOT HOLD'})"
+        )
     t = r["targets"]["diffrax_vs_scipy"]
-    lines.append(f"target: {t['target']}: {t['measured']:.2f}x -> {'reached' if t['reached'] else 'NOT reached'}")
+    lines.append(
+        f"target: {t['target']}: {t['measured']:.2f}x -> {'reached' if t['reached'] else 'NOT reached'}"
+    )
     return "\n".join(lines)
 
 
@@ -391,7 +437,12 @@ def self_check() -> None:
     assert run["attempts"] >= run["accepted_steps"] > 0
     np.testing.assert_allclose(run["y1"], np.exp(-1.0) * np.array([1.0, 2.0]), rtol=1e-6)
     assert _common.fsal_rk_evaluations(12) == 73
-    a = {"t1": 1.0, "cage_speed_rad_s": 100.0, "inner_ring_centre_m": [0.0, 1e-6], "smooth_peak_pv_Pa_m_s": 1e6}
+    a = {
+        "t1": 1.0,
+        "cage_speed_rad_s": 100.0,
+        "inner_ring_centre_m": [0.0, 1e-6],
+        "smooth_peak_pv_Pa_m_s": 1e6,
+    }
     assert _agreement(a, a, 100.0)["agree"]
     b = dict(a, cage_speed_rad_s=101.0)
     assert not _agreement(a, b, 100.0)["agree"]

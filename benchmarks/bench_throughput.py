@@ -34,13 +34,22 @@ def _inputs(batch: int, duration: float):
     b = reference_bearing()
     op = reference_operating_point()
     speeds = np.linspace(15000.0, 25000.0, batch) if batch > 1 else np.array([20000.0])
-    cases = [(b, OperatingPoint(inner_speed=rpm_to_rad_s(s), radial_load=op.radial_load,
-                                gravity=op.gravity), duration, 1e-3, 1e-6) for s in speeds]
+    cases = [
+        (
+            b,
+            OperatingPoint(inner_speed=rpm_to_rad_s(s), radial_load=op.radial_load, gravity=op.gravity),
+            duration,
+            1e-3,
+            1e-6,
+        )
+        for s in speeds
+    ]
     return jax.tree_util.tree_map(lambda *xs: np.stack([np.asarray(x, float) for x in xs]), *cases)
 
 
-def measure(batch: int, duration: float, num_saves: int = 50, max_steps: int = 100_000,
-            repeats: int = 1) -> dict:
+def measure(
+    batch: int, duration: float, num_saves: int = 50, max_steps: int = 100_000, repeats: int = 1
+) -> dict:
     """Compile time, best wall time and cases/s of one vmapped, sharded batch of `batch`."""
     import jax
     import numpy as np
@@ -85,8 +94,11 @@ def main(quick: bool = True) -> dict:
     for n in sizes:
         row = measure(n, duration, repeats=1 if quick else 2)
         rows.append(row)
-        print(f"  batch {n:>4}: {row['cases_per_s']:.3f} cases/s (compile {row['compile_s']:.1f} s)",
-              file=sys.stderr, flush=True)
+        print(
+            f"  batch {n:>4}: {row['cases_per_s']:.3f} cases/s (compile {row['compile_s']:.1f} s)",
+            file=sys.stderr,
+            flush=True,
+        )
     result = {
         "benchmark": "sweep throughput (vmapped batches of the reference bearing)",
         "quick": quick,
@@ -101,13 +113,17 @@ def main(quick: bool = True) -> dict:
 
 
 def format_table(result: dict) -> str:
-    head = (f"{'batch':>6}{'devices':>9}{'sim ms':>8}{'compile s':>11}{'wall s':>9}"
-            f"{'cases/s':>10}{'steps':>8}{'ok':>5}")
+    head = (
+        f"{'batch':>6}{'devices':>9}{'sim ms':>8}{'compile s':>11}{'wall s':>9}"
+        f"{'cases/s':>10}{'steps':>8}{'ok':>5}"
+    )
     lines = [f"sweep throughput on {result['device']}", head, "-" * len(head)]
     for r in result["rows"]:
-        lines.append(f"{r['batch_size']:>6}{r['devices']:>9}{r['simulated_time_ms']:>8.2f}"
-                     f"{r['compile_s']:>11.1f}{r['wall_s']:>9.2f}{r['cases_per_s']:>10.3f}"
-                     f"{r['max_steps_taken']:>8}{r['cases_ok']:>5}")
+        lines.append(
+            f"{r['batch_size']:>6}{r['devices']:>9}{r['simulated_time_ms']:>8.2f}"
+            f"{r['compile_s']:>11.1f}{r['wall_s']:>9.2f}{r['cases_per_s']:>10.3f}"
+            f"{r['max_steps_taken']:>8}{r['cases_ok']:>5}"
+        )
     return "\n".join(lines)
 
 

@@ -120,8 +120,9 @@ def confidence_halfwidths(hist: dict, t_start: float, omega_kin: float) -> dict:
     t = np.asarray(hist["t"])
     idx = np.flatnonzero(t >= t_start - 1e-12)
     blocks = np.array_split(idx, NUM_BLOCKS)
-    per_block = [window_statistics({k: np.asarray(v)[b] for k, v in hist.items()}, t_start, omega_kin)
-                 for b in blocks]
+    per_block = [
+        window_statistics({k: np.asarray(v)[b] for k, v in hist.items()}, t_start, omega_kin) for b in blocks
+    ]
     out = {}
     for s in STATS:
         vals = np.array([b[s] for b in per_block], float)
@@ -137,8 +138,12 @@ def errors(stats: dict, ref: dict, ci: dict) -> dict:
         d = abs(stats[s] - ref[s])
         rel[s] = d if s == "cage_slip" else d / abs(ref[s])
         in_ci[s] = d / ci[s] if ci[s] > 0 else float("inf")
-    return {"relative": rel, "in_ci_halfwidths": in_ci, "max_in_ci": max(in_ci.values()),
-            "max_relative_pv_speed": max(rel[s] for s in STATS if s != "cage_slip")}
+    return {
+        "relative": rel,
+        "in_ci_halfwidths": in_ci,
+        "max_in_ci": max(in_ci.values()),
+        "max_relative_pv_speed": max(rel[s] for s in STATS if s != "cage_slip"),
+    }
 
 
 # -- integrators -----------------------------------------------------------------------------
@@ -152,8 +157,17 @@ def compile_solve(bearing, op, num_saves: int, kind: str):
 
     def run(b, o, d, r, a, loosen, seed):
         norm = optx.rms_norm if kind == "rms" else None
-        return jb.solve(b, o, d, num_saves=num_saves, rtol=r, atol=a, raceway_loosen=loosen,
-                        error_norm=norm, perturbation=jb.Perturbation(seed=seed))
+        return jb.solve(
+            b,
+            o,
+            d,
+            num_saves=num_saves,
+            rtol=r,
+            atol=a,
+            raceway_loosen=loosen,
+            error_norm=norm,
+            perturbation=jb.Perturbation(seed=seed),
+        )
 
     f = jnp.asarray
     return _common.compile_jit(run, bearing, op, f(1e-3), f(1e-3), f(1e-6), f(1.0), jnp.asarray(0, jnp.int32))
@@ -165,13 +179,19 @@ def run_solve(compiled, bearing, op, duration, rtol, atol, loosen, seed) -> dict
     import numpy as np
 
     f = jnp.asarray
-    wall, sol = _common.time_once(lambda: compiled(bearing, op, f(duration), f(rtol), f(atol), f(loosen),
-                                                   jnp.asarray(seed, jnp.int32)))
+    wall, sol = _common.time_once(
+        lambda: compiled(bearing, op, f(duration), f(rtol), f(atol), f(loosen), jnp.asarray(seed, jnp.int32))
+    )
     hist = jax.tree_util.tree_map(np.asarray, sol.histories)
     steps = int(sol.num_steps)
-    return {"ok": int(sol.result) == 0, "wall_s": wall, "step_attempts": steps,
-            "rejected_steps": int(sol.num_rejected_steps),
-            "evaluations": _common.fsal_rk_evaluations(steps), "hist": hist}
+    return {
+        "ok": int(sol.result) == 0,
+        "wall_s": wall,
+        "step_attempts": steps,
+        "rejected_steps": int(sol.num_rejected_steps),
+        "evaluations": _common.fsal_rk_evaluations(steps),
+        "hist": hist,
+    }
 
 
 class ScipyRunner:
@@ -195,8 +215,13 @@ class ScipyRunner:
             def one(t, y):
                 state = args.scaling.unscale(t, field0._unravel_state(y))
                 fl = contact_loads(state, args.params).flange
-                return {"t": t, "flange_force": fl.normal_force, "flange_pv": fl.pv,
-                        "flange_sliding_speed": fl.sliding_speed, "cage_speed": state.cage.speed}
+                return {
+                    "t": t,
+                    "flange_force": fl.normal_force,
+                    "flange_pv": fl.pv,
+                    "flange_sliding_speed": fl.sliding_speed,
+                    "cage_speed": state.cage.speed,
+                }
 
             return jax.vmap(one)(ts, ys)
 
@@ -219,14 +244,20 @@ class ScipyRunner:
 
         counted = _common.count_calls(fun)
         start = time.perf_counter()
-        sol = solve_ivp(counted, (0.0, duration), np.asarray(field.y0), method="RK45", rtol=rtol, atol=atol,
-                        t_eval=ts)
+        sol = solve_ivp(
+            counted, (0.0, duration), np.asarray(field.y0), method="RK45", rtol=rtol, atol=atol, t_eval=ts
+        )
         wall = time.perf_counter() - start
         hist = jax.tree_util.tree_map(np.asarray, self.samples(sol.t, sol.y.T, args_flat))
         attempts = _common.rk45_attempts(sol.nfev)
-        return {"ok": sol.status == 0, "wall_s": wall, "step_attempts": attempts,
-                "rejected_steps": None,  # t_eval given: sol.t does not list the accepted steps
-                "evaluations": int(sol.nfev), "hist": hist}
+        return {
+            "ok": sol.status == 0,
+            "wall_s": wall,
+            "step_attempts": attempts,
+            "rejected_steps": None,  # t_eval given: sol.t does not list the accepted steps
+            "evaluations": int(sol.nfev),
+            "hist": hist,
+        }
 
 
 # -- the benchmark -----------------------------------------------------------------------------
@@ -245,7 +276,9 @@ def main(quick: bool = False) -> dict:
     omega_kin = float(jb.kinematic_cage_speed(bearing, op))
     variants = [VARIANTS[i] for i in QUICK_VARIANTS] if quick else list(VARIANTS)
 
-    _common.log(f"{NAME}: compiling solve (max/weighted norm), {num_saves} samples over {duration * 1e3:g} ms")
+    _common.log(
+        f"{NAME}: compiling solve (max/weighted norm), {num_saves} samples over {duration * 1e3:g} ms"
+    )
     programs = {"solve": compile_solve(bearing, op, num_saves, "solve")}
     if any(v[1] == "rms" for v in variants):
         programs["rms"] = compile_solve(bearing, op, num_saves, "rms")
@@ -283,16 +316,24 @@ def main(quick: bool = False) -> dict:
             r["errors"] = errors(r["statistics"], ref["statistics"], ref["ci_halfwidth"])
             r["evaluations_per_ms"] = r["evaluations"] / (duration * 1e3)
             per_seed[str(seed)] = r
-        rows.append({
-            "label": label, "kind": kind, "rtol": rtol, "atol": atol, "raceway_loosen": loosen,
-            "seeds": per_seed,
-            "all_ok": all(s["ok"] for s in per_seed.values()),
-            "evaluations_per_ms": float(np.mean([s["evaluations_per_ms"] for s in per_seed.values()])),
-            "wall_s_per_ms": float(np.mean([s["wall_s"] for s in per_seed.values()])) / (duration * 1e3),
-            "max_error_in_ci": max(s["errors"]["max_in_ci"] for s in per_seed.values()),
-            "max_relative_error_pv_speed": max(s["errors"]["max_relative_pv_speed"] for s in per_seed.values()),
-            "max_cage_slip_error": max(s["errors"]["relative"]["cage_slip"] for s in per_seed.values()),
-        })
+        rows.append(
+            {
+                "label": label,
+                "kind": kind,
+                "rtol": rtol,
+                "atol": atol,
+                "raceway_loosen": loosen,
+                "seeds": per_seed,
+                "all_ok": all(s["ok"] for s in per_seed.values()),
+                "evaluations_per_ms": float(np.mean([s["evaluations_per_ms"] for s in per_seed.values()])),
+                "wall_s_per_ms": float(np.mean([s["wall_s"] for s in per_seed.values()])) / (duration * 1e3),
+                "max_error_in_ci": max(s["errors"]["max_in_ci"] for s in per_seed.values()),
+                "max_relative_error_pv_speed": max(
+                    s["errors"]["max_relative_pv_speed"] for s in per_seed.values()
+                ),
+                "max_cage_slip_error": max(s["errors"]["relative"]["cage_slip"] for s in per_seed.values()),
+            }
+        )
     base = rows[0]
     for row in rows:
         row["evaluation_ratio_vs_old_default"] = base["evaluations_per_ms"] / row["evaluations_per_ms"]
@@ -304,10 +345,13 @@ def main(quick: bool = False) -> dict:
             "bearing": "reference_bearing() (26 rollers, 31 slices, arc ends)",
             "inner_speed_rpm": float(jb.rad_s_to_rpm(op.inner_speed)),
             "radial_load_N": float(op.radial_load),
-            "startup_s": t0, "window_s": window, "seeds": list(seeds), "sample_dt_s": SAMPLE_DT,
+            "startup_s": t0,
+            "window_s": window,
+            "seeds": list(seeds),
+            "sample_dt_s": SAMPLE_DT,
             "reference": {"rtol": REF_RTOL, "atol": REF_ATOL, "method": "Tsit5, max norm"},
             "note": "fixed start-up time then a fixed window (no settling detection); CI from 8 batch "
-                    "means of the reference over the window; errors of cage slip are absolute",
+            "means of the reference over the window; errors of cage slip are absolute",
         },
         "compile_s": compile_s,
         "reference": reference,
@@ -325,21 +369,58 @@ def _table(r: dict) -> str:
     rows = []
     for ref_seed, ref in r["reference"].items():
         st = ref["statistics"]
-        rows.append([f"reference rtol {c['reference']['rtol']:g} (seed {ref_seed})", ref["evaluations_per_ms"], None,
-                     ref["wall_s"] / ((c["startup_s"] + c["window_s"]) * 1e3), None, st["mean_pv"] / 1e6,
-                     st["p95_pv"] / 1e6, st["mean_sliding_speed"], 100 * st["cage_slip"], None, None, None])
+        rows.append(
+            [
+                f"reference rtol {c['reference']['rtol']:g} (seed {ref_seed})",
+                ref["evaluations_per_ms"],
+                None,
+                ref["wall_s"] / ((c["startup_s"] + c["window_s"]) * 1e3),
+                None,
+                st["mean_pv"] / 1e6,
+                st["p95_pv"] / 1e6,
+                st["mean_sliding_speed"],
+                100 * st["cage_slip"],
+                None,
+                None,
+                None,
+            ]
+        )
     for v in r["variants"]:
         s0 = next(iter(v["seeds"].values()))["statistics"]
-        rows.append([v["label"], v["evaluations_per_ms"], v["evaluation_ratio_vs_old_default"], v["wall_s_per_ms"],
-                     v["wall_ratio_vs_old_default"], s0["mean_pv"] / 1e6, s0["p95_pv"] / 1e6,
-                     s0["mean_sliding_speed"], 100 * s0["cage_slip"], v["max_relative_error_pv_speed"],
-                     100 * v["max_cage_slip_error"], v["max_error_in_ci"]])
+        rows.append(
+            [
+                v["label"],
+                v["evaluations_per_ms"],
+                v["evaluation_ratio_vs_old_default"],
+                v["wall_s_per_ms"],
+                v["wall_ratio_vs_old_default"],
+                s0["mean_pv"] / 1e6,
+                s0["p95_pv"] / 1e6,
+                s0["mean_sliding_speed"],
+                100 * s0["cage_slip"],
+                v["max_relative_error_pv_speed"],
+                100 * v["max_cage_slip_error"],
+                v["max_error_in_ci"],
+            ]
+        )
     return _common.format_table(
         f"Work-precision: reference bearing {c['inner_speed_rpm']:.0f} rpm, {c['radial_load_N']:.0f} N; statistics over "
         f"[{c['startup_s'] * 1e3:g}, {(c['startup_s'] + c['window_s']) * 1e3:g}] ms, seeds {c['seeds']} "
         f"(statistics columns: first seed; errors: worst seed)",
-        ["integrator", "evals/ms", "x fewer", "wall s/ms", "x faster", "mean PV MPa m/s", "p95 PV", "mean u m/s",
-         "slip %", "max rel err PV,u", "slip err %pt", "err / CI"],
+        [
+            "integrator",
+            "evals/ms",
+            "x fewer",
+            "wall s/ms",
+            "x faster",
+            "mean PV MPa m/s",
+            "p95 PV",
+            "mean u m/s",
+            "slip %",
+            "max rel err PV,u",
+            "slip err %pt",
+            "err / CI",
+        ],
         rows,
     )
 
@@ -351,8 +432,13 @@ def self_check() -> None:
     t = np.linspace(0.0, 1.0, 81)
     q = np.zeros((81, 2, 4))
     q[:, 0, 0] = 10.0
-    hist = {"t": t, "flange_force": q, "flange_pv": q * 2.0, "flange_sliding_speed": q * 0.1,
-            "cage_speed": np.full(81, 99.0)}
+    hist = {
+        "t": t,
+        "flange_force": q,
+        "flange_pv": q * 2.0,
+        "flange_sliding_speed": q * 0.1,
+        "cage_speed": np.full(81, 99.0),
+    }
     s = window_statistics(hist, 0.5, 100.0)
     assert abs(s["mean_pv"] - 20.0) < 1e-12 and abs(s["p95_pv"] - 20.0) < 1e-12
     assert abs(s["cage_slip"] - 0.01) < 1e-12 and s["contact_samples"] == 41

@@ -57,8 +57,11 @@ def _child(name: str, quick: bool, status_file: str) -> int:
         result = module.main(quick=quick)
         if not isinstance(result, dict):
             raise TypeError(f"{name}.main returned {type(result).__name__}, expected a dict")
-        written = [p for p in Path(_common.RESULTS_DIR).glob("*.json")
-                   if p.name != "summary.json" and p.stat().st_mtime >= started_at]
+        written = [
+            p
+            for p in Path(_common.RESULTS_DIR).glob("*.json")
+            if p.name != "summary.json" and p.stat().st_mtime >= started_at
+        ]
         if not written:  # the benchmark wrote no JSON of its own: keep what it returned
             written = [_common.write_json(name, result)]
         status["json"] = sorted(str(p.name) for p in written)
@@ -83,13 +86,20 @@ def run_one(name: str, quick: bool, timeout: float) -> dict:
             proc = subprocess.run(cmd, timeout=timeout)
             code = proc.returncode
         except subprocess.TimeoutExpired:
-            return {"name": name, "ok": False, "wall_s": time.perf_counter() - start,
-                    "error": f"timed out after {timeout:g} s"}
+            return {
+                "name": name,
+                "ok": False,
+                "wall_s": time.perf_counter() - start,
+                "error": f"timed out after {timeout:g} s",
+            }
         if os.path.exists(status_file):
             status = json.loads(Path(status_file).read_text())
         else:
-            status = {"name": name, "ok": False, "error": f"the process exited with code {code} "
-                      "without reporting (crashed or killed)"}
+            status = {
+                "name": name,
+                "ok": False,
+                "error": f"the process exited with code {code} without reporting (crashed or killed)",
+            }
         status["process_wall_s"] = time.perf_counter() - start
         return status
 
@@ -97,7 +107,9 @@ def run_one(name: str, quick: bool, timeout: float) -> dict:
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="short simulated times, few repeats")
-    parser.add_argument("--only", default=None, help="comma-separated benchmark names (bench_ prefix optional)")
+    parser.add_argument(
+        "--only", default=None, help="comma-separated benchmark names (bench_ prefix optional)"
+    )
     parser.add_argument("--list", action="store_true", help="list the benchmarks and exit")
     parser.add_argument("--timeout", type=float, default=None, help="seconds per benchmark")
     parser.add_argument("--child", default=None, help=argparse.SUPPRESS)
@@ -114,24 +126,32 @@ def main(argv: list[str] | None = None) -> int:
         wanted = [w if w.startswith("bench_") else f"bench_{w}" for w in args.only.split(",") if w]
         unknown = [w for w in wanted if w not in names]
         if unknown:
-            print(f"error: --only: unknown benchmark(s) {', '.join(unknown)}; available: {', '.join(names)}",
-                  file=sys.stderr)
+            print(
+                f"error: --only: unknown benchmark(s) {', '.join(unknown)}; available: {', '.join(names)}",
+                file=sys.stderr,
+            )
             return 2
         names = wanted
     timeout = args.timeout if args.timeout is not None else DEFAULT_TIMEOUT_S[args.quick]
 
     machine = _common.machine_info()
     print(f"jaxbearing benchmarks ({'quick' if args.quick else 'full'}): {', '.join(names)}")
-    print(f"machine: {machine['cpu_count']} CPUs ({machine['cpu_model']}), load {machine['load_average_1_5_15min']}, "
-          f"jax {machine['jax']} on {machine['jax_backend']}, {machine['date_utc']}\n", flush=True)
+    print(
+        f"machine: {machine['cpu_count']} CPUs ({machine['cpu_model']}), load {machine['load_average_1_5_15min']}, "
+        f"jax {machine['jax']} on {machine['jax_backend']}, {machine['date_utc']}\n",
+        flush=True,
+    )
     start = time.perf_counter()
     statuses = []
     for name in names:
         print(f"=== {name} ===", flush=True)
         status = run_one(name, args.quick, timeout)
         statuses.append(status)
-        print(f"=== {name}: {'ok' if status['ok'] else 'FAILED: ' + status.get('error', '?')} "
-              f"({status.get('process_wall_s', 0.0):.1f} s) ===\n", flush=True)
+        print(
+            f"=== {name}: {'ok' if status['ok'] else 'FAILED: ' + status.get('error', '?')} "
+            f"({status.get('process_wall_s', 0.0):.1f} s) ===\n",
+            flush=True,
+        )
     total = time.perf_counter() - start
 
     summary = {
@@ -139,7 +159,9 @@ def main(argv: list[str] | None = None) -> int:
         "machine": machine,
         "load_average_at_end": list(os.getloadavg()),
         "total_wall_s": total,
-        "benchmarks": {s["name"]: {k: v for k, v in s.items() if k not in ("name", "table")} for s in statuses},
+        "benchmarks": {
+            s["name"]: {k: v for k, v in s.items() if k not in ("name", "table")} for s in statuses
+        },
         "targets": {f"{s['name']}.{k}": t for s in statuses for k, t in (s.get("targets") or {}).items()},
         "failed": [s["name"] for s in statuses if not s["ok"]],
     }
@@ -149,15 +171,30 @@ def main(argv: list[str] | None = None) -> int:
     for s in statuses:
         if s.get("table"):
             print(s["table"] + "\n")
-    rows = [[s["name"], "ok" if s["ok"] else "FAILED", s.get("process_wall_s"),
-             (s.get("error") or "")[:80]] for s in statuses]
-    print(_common.format_table(f"Benchmarks ({total:.0f} s in all)", ["benchmark", "status", "wall s", "error"], rows))
+    rows = [
+        [s["name"], "ok" if s["ok"] else "FAILED", s.get("process_wall_s"), (s.get("error") or "")[:80]]
+        for s in statuses
+    ]
+    print(
+        _common.format_table(
+            f"Benchmarks ({total:.0f} s in all)", ["benchmark", "status", "wall s", "error"], rows
+        )
+    )
     if summary["targets"]:
-        trows = [[k, t["target"], t["measured"], t["threshold"], t["reached"]] for k, t in summary["targets"].items()]
-        print(_common.format_table("Targets of issue 8", ["key", "target", "measured", "threshold", "reached"], trows))
+        trows = [
+            [k, t["target"], t["measured"], t["threshold"], t["reached"]]
+            for k, t in summary["targets"].items()
+        ]
+        print(
+            _common.format_table(
+                "Targets of issue 8", ["key", "target", "measured", "threshold", "reached"], trows
+            )
+        )
     print(f"results: {path.parent}/")
     if summary["failed"]:
-        print(f"{len(summary['failed'])} benchmark(s) failed: {', '.join(summary['failed'])}", file=sys.stderr)
+        print(
+            f"{len(summary['failed'])} benchmark(s) failed: {', '.join(summary['failed'])}", file=sys.stderr
+        )
         return 1
     return 0
 

@@ -48,7 +48,8 @@ def build_parser() -> argparse.ArgumentParser:
     from jaxbearing.cli import exit_codes_text
 
     r = sub.add_parser(
-        "run", help="run the multi-start projected augmented-Lagrangian search",
+        "run",
+        help="run the multi-start projected augmented-Lagrangian search",
         description="Search the roller-end/flange design (end radius R_end, layback angle "
         "theta_f, axial clearance Delta_bf) that minimises the smooth peak flange PV of short "
         "dynamic runs over an envelope of speeds and loads, inside the design zone (relief, "
@@ -56,29 +57,45 @@ def build_parser() -> argparse.ArgumentParser:
         "(projected augmented Lagrangian with Adam, forward-mode gradients through the solve). "
         "Writes DIR/result.json (strict JSON) and DIR/search_paths.png when the search ends; a "
         "killed run writes nothing and leaves earlier results as they were.",
-        epilog=exit_codes_text(), formatter_class=argparse.RawDescriptionHelpFormatter)
-    r.add_argument("--config", help="jaxbearing TOML configuration (bearing and operating point; "
-                   "default: the embedded reference bearing)")
-    r.add_argument("--bounds", dest="bounds_file", help="optimiser TOML file with [bounds], "
-                   "[constraints], [envelope], [search] sections (command-line options win)")
+        epilog=exit_codes_text(),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    r.add_argument(
+        "--config",
+        help="jaxbearing TOML configuration (bearing and operating point; "
+        "default: the embedded reference bearing)",
+    )
+    r.add_argument(
+        "--bounds",
+        dest="bounds_file",
+        help="optimiser TOML file with [bounds], "
+        "[constraints], [envelope], [search] sections (command-line options win)",
+    )
     r.add_argument("--end-radius-mm", help="R_end bounds LO,HI [mm] (default 60,120)")
     r.add_argument("--layback-deg", help="theta_f bounds LO,HI [deg] (default 1.0,2.0)")
     r.add_argument("--clearance-mm", help="Delta_bf bounds LO,HI [mm] (default 0.10,0.30)")
-    r.add_argument("--min-clearance-mm", type=float, help="required actual axial clearance "
-                   "Lambda_bf [mm] (default 0)")
-    r.add_argument("--flange-load-N", type=float, help="flange load of the relief margin's "
-                   "contact ellipse [N] (default 100)")
-    r.add_argument("--speeds-rpm", help="operating speeds, e.g. 5000,15000,30000 (default: the "
-                   "configuration's speed)")
+    r.add_argument(
+        "--min-clearance-mm", type=float, help="required actual axial clearance Lambda_bf [mm] (default 0)"
+    )
+    r.add_argument(
+        "--flange-load-N",
+        type=float,
+        help="flange load of the relief margin's contact ellipse [N] (default 100)",
+    )
+    r.add_argument(
+        "--speeds-rpm", help="operating speeds, e.g. 5000,15000,30000 (default: the configuration's speed)"
+    )
     r.add_argument("--loads-N", help="radial loads, e.g. 500,1000 (default: the configuration's)")
     r.add_argument("--weights", help="weights of the operating points (speeds x loads, speed-major)")
-    r.add_argument("--aggregate", choices=("max", "mean"), help="robust objective: smooth "
-                   "worst case (max, default) or weighted mean")
+    r.add_argument(
+        "--aggregate",
+        choices=("max", "mean"),
+        help="robust objective: smooth worst case (max, default) or weighted mean",
+    )
     r.add_argument("--starts", type=int, help="number of parallel starts (default 4)")
     r.add_argument("--iterations", type=int, help="iterations (default 20)")
     r.add_argument("--learning-rate", type=float, help="Adam step size in scaled units (default 0.08)")
-    r.add_argument("--duration-ms", type=float, help="simulated time per evaluation [ms] "
-                   "(default 0.3)")
+    r.add_argument("--duration-ms", type=float, help="simulated time per evaluation [ms] (default 0.3)")
     r.add_argument("--rtol", type=float, help="solver rtol (default 1e-3)")
     r.add_argument("--atol", type=float, help="solver atol (default 1e-6)")
     r.add_argument("--out", default="optimise_out", help="output directory (default optimise_out)")
@@ -133,7 +150,11 @@ def problem_from_settings(bearing, op, s: dict):
         s.get("end_radius_mm"), s.get("layback_angle_deg"), s.get("axial_clearance_mm")
     )
     problem = make_problem(
-        bearing, op, bounds=bounds, speeds_rpm=s.get("speeds_rpm"), loads_N=s.get("loads_N"),
+        bearing,
+        op,
+        bounds=bounds,
+        speeds_rpm=s.get("speeds_rpm"),
+        loads_N=s.get("loads_N"),
         weights=s.get("weights"),
         duration=_positive(s, "duration_ms", DEFAULT_DURATION * 1e3) * 1e-3,
         flange_load=_positive(s, "flange_load_N", 100.0),
@@ -187,22 +208,29 @@ def run(args) -> int:
         raise UserInputError(f"--out {args.out}: cannot create directory: {exc.strerror}") from None
 
     k = problem.num_operating_points
-    print(f"optimise: {options['num_starts']} starts x {k} operating point(s), "
-          f"{options['num_iterations']} iterations, {problem.duration * 1e3:g} ms per evaluation "
-          f"({problem.aggregate} over the envelope)")
+    print(
+        f"optimise: {options['num_starts']} starts x {k} operating point(s), "
+        f"{options['num_iterations']} iterations, {problem.duration * 1e3:g} ms per evaluation "
+        f"({problem.aggregate} over the envelope)"
+    )
 
     def progress(it, info):
         if args.quiet:
             return
         best = info["best"]
-        print(f"iter {it:3d}  best feasible {best:.4f} GPa m/s" if np.isfinite(best)
-              else f"iter {it:3d}  best feasible   none yet")
+        print(
+            f"iter {it:3d}  best feasible {best:.4f} GPa m/s"
+            if np.isfinite(best)
+            else f"iter {it:3d}  best feasible   none yet"
+        )
         for j in range(info["x"].shape[0]):
             m = info["margins"][j]
             w = int(np.argmin(m))
-            print(f"   start {j}: J {info['objective'][j]:8.4f} GPa m/s  "
-                  f"min margin {MARGIN_NAMES[w]} {m[w] * 1e3:+.4f} mm  {_design_text(info['x'][j])}"
-                  f"{'' if info['feasible'][j] else '  (infeasible)'}")
+            print(
+                f"   start {j}: J {info['objective'][j]:8.4f} GPa m/s  "
+                f"min margin {MARGIN_NAMES[w]} {m[w] * 1e3:+.4f} mm  {_design_text(info['x'][j])}"
+                f"{'' if info['feasible'][j] else '  (infeasible)'}"
+            )
         sys.stdout.flush()
 
     res = search(problem, callback=progress, **options)
@@ -214,24 +242,34 @@ def run(args) -> int:
     print(f"start design: {_design_text(res.start_design)}")
     print(f"  margins: {_margin_text(res.start_margins)}")
     if res.status == "no_feasible_design_in_bounds":
-        print("optimise: no feasible design exists within the bounds (every design-zone margin "
-              "cannot be satisfied at once); widen the bounds or relax --min-clearance-mm",
-              file=sys.stderr)
+        print(
+            "optimise: no feasible design exists within the bounds (every design-zone margin "
+            "cannot be satisfied at once); widen the bounds or relax --min-clearance-mm",
+            file=sys.stderr,
+        )
         print(f"wrote {out / 'result.json'} and {plot_path}")
         return EXIT_INFEASIBLE
     if res.status == "no_feasible_iterate":
-        print("optimise: no iterate reached the feasible design zone (it exists within the bounds);"
-              " try more --iterations or --starts", file=sys.stderr)
+        print(
+            "optimise: no iterate reached the feasible design zone (it exists within the bounds);"
+            " try more --iterations or --starts",
+            file=sys.stderr,
+        )
         print(f"wrote {out / 'result.json'} and {plot_path}")
         return EXIT_INFEASIBLE
-    print(f"final design: {_design_text(res.design)}  (start {res.best_start}, iteration "
-          f"{res.best_iteration})")
+    print(
+        f"final design: {_design_text(res.design)}  (start {res.best_start}, iteration {res.best_iteration})"
+    )
     print(f"  margins: {_margin_text(res.margins)}  -> feasible")
-    print(f"  smooth peak PV {res.objective:.4f} GPa m/s (start {res.start_objective:.4f}); "
-          f"improvement {100 * res.improvement:.1f}%"
-          + ("" if np.all(res.start_margins > 0) else " over an infeasible start"))
-    print(f"  {res.num_model_evaluations} model evaluations (value + forward-mode gradient), "
-          f"{res.wall_time_s:.1f} s (compile {res.compile_time_s:.1f} s)")
+    print(
+        f"  smooth peak PV {res.objective:.4f} GPa m/s (start {res.start_objective:.4f}); "
+        f"improvement {100 * res.improvement:.1f}%"
+        + ("" if np.all(res.start_margins > 0) else " over an infeasible start")
+    )
+    print(
+        f"  {res.num_model_evaluations} model evaluations (value + forward-mode gradient), "
+        f"{res.wall_time_s:.1f} s (compile {res.compile_time_s:.1f} s)"
+    )
     print(f"wrote {out / 'result.json'} and {plot_path}")
     return 0
 
@@ -244,8 +282,11 @@ def _result_json(problem, options, res) -> dict:
     def design(x):
         if x is None:
             return None
-        return {"end_radius_mm": float(x[0]) * 1e3, "layback_angle_deg": math.degrees(float(x[1])),
-                "axial_clearance_mm": float(x[2]) * 1e3}
+        return {
+            "end_radius_mm": float(x[0]) * 1e3,
+            "layback_angle_deg": math.degrees(float(x[1])),
+            "axial_clearance_mm": float(x[2]) * 1e3,
+        }
 
     def margins(m):
         return None if m is None else {f"{n}_margin_mm": float(v) * 1e3 for n, v in zip(MARGIN_NAMES, m)}

@@ -25,9 +25,12 @@ def plot_search(problem, result, path) -> pathlib.Path:
     fig, ax = plt.subplots(figsize=(7, 5))
     feas = np.asarray(z.feasible, dtype=float)
     ax.contourf(rr, tt, feas, levels=[-0.5, 0.5, 1.5], colors=["#f2f2f2", "#b7e1b0"])
-    styles = (("relief_margin", "tab:red", "relief"), ("height_margin", "tab:blue", "height limit"),
-              ("limited_circle_margin", "tab:purple", "limited circle"),
-              ("clearance_margin", "tab:orange", "axial clearance"))
+    styles = (
+        ("relief_margin", "tab:red", "relief"),
+        ("height_margin", "tab:blue", "height limit"),
+        ("limited_circle_margin", "tab:purple", "limited circle"),
+        ("clearance_margin", "tab:orange", "axial clearance"),
+    )
     for field, colour, label in styles:
         m = np.asarray(getattr(z, field))
         if m.min() < 0 < m.max():
@@ -37,16 +40,25 @@ def plot_search(problem, result, path) -> pathlib.Path:
     if h:
         xs = np.asarray(h["x"])  # (I, S, 3)
         for s in range(xs.shape[1]):
-            line, = ax.plot(xs[:, s, 0] * 1e3, np.degrees(xs[:, s, 1]), "-", lw=1, marker=".", ms=3)
+            (line,) = ax.plot(xs[:, s, 0] * 1e3, np.degrees(xs[:, s, 1]), "-", lw=1, marker=".", ms=3)
             ax.plot(xs[0, s, 0] * 1e3, math.degrees(xs[0, s, 1]), "o", color=line.get_color(), mfc="none")
     if result.design is not None:
-        ax.plot(result.design[0] * 1e3, math.degrees(result.design[1]), "*", color="k", ms=14,
-                label="final design")
+        ax.plot(
+            result.design[0] * 1e3,
+            math.degrees(result.design[1]),
+            "*",
+            color="k",
+            ms=14,
+            label="final design",
+        )
     ax.set_xlabel("end radius R_end [mm]")
     ax.set_ylabel("layback angle theta_f [deg]")
     free_clearance = problem.bounds.upper[2] > problem.bounds.lower[2]
-    ax.set_title(f"design zone at Delta_bf = {x_ref[2] * 1e3:.3f} mm (green: feasible) and search paths"
-                 + (" (projected: Delta_bf varies along them)" if free_clearance else ""), fontsize=9)
+    ax.set_title(
+        f"design zone at Delta_bf = {x_ref[2] * 1e3:.3f} mm (green: feasible) and search paths"
+        + (" (projected: Delta_bf varies along them)" if free_clearance else ""),
+        fontsize=9,
+    )
     if ax.get_legend_handles_labels()[0]:
         ax.legend(fontsize=7, loc="best")
     fig.tight_layout()

@@ -98,7 +98,9 @@ class Bounds:
             for which, v in (("lower", lo), ("upper", hi)):
                 require(f"bounds.{name}_{unit} {which} bound", v, lambda x: np.isfinite(x) & ok(x), valid)
             if lo > hi:
-                raise UserInputError(f"bounds.{name}_{unit} = [{lo:g}, {hi:g}]: lower bound above upper bound")
+                raise UserInputError(
+                    f"bounds.{name}_{unit} = [{lo:g}, {hi:g}]: lower bound above upper bound"
+                )
 
     def check(self, bearing: Bearing) -> None:
         """The end-radius bounds against the roller of `bearing`: R_end > D/2 (the end must be
@@ -107,8 +109,12 @@ class Bounds:
             return
         half_d = float(f"{float(np.max(np.asarray(bearing.roller.diameter))) / 2 / MM:.12g}")
         for which, v in zip(("lower", "upper"), self.end_radius):
-            require(f"bounds.end_radius_mm {which} bound", float(f"{float(v) / MM:.12g}"), lambda x: x > half_d,
-                    f"> D/2 = {half_d:g} mm (half the roller diameter of the bearing)")
+            require(
+                f"bounds.end_radius_mm {which} bound",
+                float(f"{float(v) / MM:.12g}"),
+                lambda x: x > half_d,
+                f"> D/2 = {half_d:g} mm (half the roller diameter of the bearing)",
+            )
 
     @property
     def lower(self) -> np.ndarray:
@@ -191,8 +197,7 @@ def load_optimise_toml(path: str) -> dict:
     for section, table in data.items():
         if section not in OPTIMISE_TOML_KEYS or not isinstance(table, dict):
             raise UserInputError(
-                f"optimise file {path}: unknown section [{section}] "
-                f"(valid: {', '.join(OPTIMISE_TOML_KEYS)})"
+                f"optimise file {path}: unknown section [{section}] (valid: {', '.join(OPTIMISE_TOML_KEYS)})"
             )
         for key, value in table.items():
             if key not in OPTIMISE_TOML_KEYS[section]:
@@ -258,10 +263,17 @@ class DesignProblem(eqx.Module):
         if self.aggregate not in ("max", "mean"):
             raise UserInputError(f"aggregate = {self.aggregate!r}: must be 'max' or 'mean'")
         require("temperature", self.temperature, lambda v: np.isfinite(v) & (v > 0), "> 0 GPa m/s and finite")
-        check_solver_arguments(duration=self.duration, rtol=self.rtol, atol=self.atol,
-                               max_steps=self.max_steps)
-        if self.perturbation is not None and isinstance(self.perturbation, str) and self.perturbation != "seated":
-            raise UserInputError(f"perturbation = {self.perturbation!r}: must be 'seated', a Perturbation or None")
+        check_solver_arguments(
+            duration=self.duration, rtol=self.rtol, atol=self.atol, max_steps=self.max_steps
+        )
+        if (
+            self.perturbation is not None
+            and isinstance(self.perturbation, str)
+            and self.perturbation != "seated"
+        ):
+            raise UserInputError(
+                f"perturbation = {self.perturbation!r}: must be 'seated', a Perturbation or None"
+            )
         require("flange_load", self.flange_load, lambda v: np.isfinite(v) & (v > 0), "> 0 N and finite")
         require("min_clearance", self.min_clearance, np.isfinite, "finite (m)")
         require("initial_skew", self.initial_skew, lambda v: np.isfinite(v) & (v >= 0), ">= 0 rad and finite")
@@ -289,9 +301,16 @@ class DesignProblem(eqx.Module):
 
         def one(op):
             m = design_metrics(
-                self.bearing, op, design, duration=self.duration, flange_load=self.flange_load,
-                min_clearance=self.min_clearance, rtol=self.rtol, atol=self.atol,
-                max_steps=self.max_steps, adjoint=diffrax.ForwardMode(),
+                self.bearing,
+                op,
+                design,
+                duration=self.duration,
+                flange_load=self.flange_load,
+                min_clearance=self.min_clearance,
+                rtol=self.rtol,
+                atol=self.atol,
+                max_steps=self.max_steps,
+                adjoint=diffrax.ForwardMode(),
                 perturbation=perturbation,
             )
             return m.peak_pv / PV_SCALE
@@ -315,7 +334,9 @@ class DesignProblem(eqx.Module):
     def margins(self, u: Float[Array, 3]) -> Float[Array, 4]:
         """Design-zone margins [m] (relief, height, limited circle, clearance)."""
         return zone_margins(
-            self.bearing, self.design(u), flange_load=self.flange_load,
+            self.bearing,
+            self.design(u),
+            flange_load=self.flange_load,
             min_clearance=self.min_clearance,
         )
 
@@ -360,7 +381,11 @@ def feasibility_map(problem: DesignProblem, axial_clearance: float, n: int = 81)
     r = np.linspace(lo[0], hi[0], n)
     t = np.linspace(lo[1], hi[1], n)
     z = design_zone_grid(
-        problem.bearing, r[:, None], t[None, :], axial_clearance, problem.flange_load,
+        problem.bearing,
+        r[:, None],
+        t[None, :],
+        axial_clearance,
+        problem.flange_load,
         problem.min_clearance,
     )
     return r, t, z

@@ -183,11 +183,20 @@ def search(
     found, _ = any_feasible(problem)
     if not found:
         return SearchResult(
-            status="no_feasible_design_in_bounds", feasible=False, design=None,
-            objective=float("nan"), peak_pv=None, margins=None, start_design=x_start,
-            start_objective=float("nan"), start_margins=start_margins, history={},
-            num_model_evaluations=0, num_iterations=0,
-            wall_time_s=time.perf_counter() - t_start, compile_time_s=0.0,
+            status="no_feasible_design_in_bounds",
+            feasible=False,
+            design=None,
+            objective=float("nan"),
+            peak_pv=None,
+            margins=None,
+            start_design=x_start,
+            start_objective=float("nan"),
+            start_margins=start_margins,
+            history={},
+            num_model_evaluations=0,
+            num_iterations=0,
+            wall_time_s=time.perf_counter() - t_start,
+            compile_time_s=0.0,
         )
 
     hyper = _Hyper(float(learning_rate), int(num_iterations), float(rho))
@@ -195,20 +204,36 @@ def search(
     # the first call compiles (unless cached): its excess over the later iterations
     compile_time = max(0.0, times[0] - float(np.median(times[1:]))) if len(times) > 1 else 0.0
     common = dict(
-        start_design=x_start, start_objective=float(history["objective"][0, 0]),
-        start_margins=start_margins, history=history,
+        start_design=x_start,
+        start_objective=float(history["objective"][0, 0]),
+        start_margins=start_margins,
+        history=history,
         num_model_evaluations=(num_iterations + 1) * num_starts * problem.num_operating_points,
-        num_iterations=num_iterations, wall_time_s=time.perf_counter() - t_start,
+        num_iterations=num_iterations,
+        wall_time_s=time.perf_counter() - t_start,
         compile_time_s=compile_time,
     )
     if best[1] < 0:
-        return SearchResult(status="no_feasible_iterate", feasible=False, design=None,
-                            objective=float("nan"), peak_pv=None, margins=None, **common)
+        return SearchResult(
+            status="no_feasible_iterate",
+            feasible=False,
+            design=None,
+            objective=float("nan"),
+            peak_pv=None,
+            margins=None,
+            **common,
+        )
     _, i, s = best
     return SearchResult(
-        status="ok", feasible=True, design=history["x"][i, s], objective=best[0],
-        peak_pv=history["peak_pv"][i, s], margins=history["margins"][i, s],
-        best_start=s, best_iteration=i, **common,
+        status="ok",
+        feasible=True,
+        design=history["x"][i, s],
+        objective=best[0],
+        peak_pv=history["peak_pv"][i, s],
+        margins=history["margins"][i, s],
+        best_start=s,
+        best_iteration=i,
+        **common,
     )
 
 
@@ -232,19 +257,27 @@ def _iterations(problem: DesignProblem, hyper: _Hyper, uj, callback):
         for s in np.where(feas)[0]:
             if val[s] < best[0]:
                 best = (float(val[s]), it, int(s))
-        for key, value in (("u", np.asarray(uj)), ("x", x), ("objective", val), ("margins", marg),
-                           ("multipliers", np.asarray(lam)), ("peak_pv", pv)):
+        for key, value in (
+            ("u", np.asarray(uj)),
+            ("x", x),
+            ("objective", val),
+            ("margins", marg),
+            ("multipliers", np.asarray(lam)),
+            ("peak_pv", pv),
+        ):
             hist[key].append(value)
         if callback is not None:
-            callback(it, dict(u=np.asarray(uj), x=x, objective=val, margins=marg, feasible=feas,
-                              best=best[0]))
+            callback(
+                it, dict(u=np.asarray(uj), x=x, objective=val, margins=marg, feasible=feas, best=best[0])
+            )
         if it < hyper.num_iterations:
             uj, opt_state, lam = u_new, opt_state_new, lam_new
     return {k_: np.stack(v) for k_, v in hist.items()}, best, times
 
 
-def grid_search(problem: DesignProblem, n_end_radius: int, n_layback: int, axial_clearance: float,
-                *, batch: int = 32) -> dict:
+def grid_search(
+    problem: DesignProblem, n_end_radius: int, n_layback: int, axial_clearance: float, *, batch: int = 32
+) -> dict:
     """Brute force over an n_end_radius x n_layback grid of (R_end, theta_f) inside the bounds at
     fixed Delta_bf, with the same model as `search` (value only, vmapped batches of `batch`
     designs). Infeasible points are not solved. Returns the grid, objective (nan where
@@ -267,9 +300,13 @@ def grid_search(problem: DesignProblem, n_end_radius: int, n_layback: int, axial
     ok = np.isfinite(obj)
     best = int(np.nanargmin(np.where(ok, obj, np.nan))) if ok.any() else -1
     return dict(
-        end_radius=r, layback_angle=t, axial_clearance=axial_clearance,
-        objective=obj.reshape(rr.shape), feasible=feas.reshape(rr.shape),
+        end_radius=r,
+        layback_angle=t,
+        axial_clearance=axial_clearance,
+        objective=obj.reshape(rr.shape),
+        feasible=feas.reshape(rr.shape),
         best_design=x[best] if best >= 0 else None,
         best_objective=float(obj[best]) if best >= 0 else float("nan"),
-        num_model_evaluations=int(len(idx)), wall_time_s=time.perf_counter() - t0,
+        num_model_evaluations=int(len(idx)),
+        wall_time_s=time.perf_counter() - t0,
     )

@@ -38,8 +38,11 @@ def test_module_imports_and_has_main(name):
 def test_write_json_is_strict_json_with_machine_info(tmp_path):
     import numpy as np
 
-    path = _common.write_json("demo", {"x": np.float64(1.5), "a": np.arange(3), "nan": math.nan,
-                                       "inf": math.inf}, results_dir=tmp_path)
+    path = _common.write_json(
+        "demo",
+        {"x": np.float64(1.5), "a": np.arange(3), "nan": math.nan, "inf": math.inf},
+        results_dir=tmp_path,
+    )
     data = json.loads(path.read_text())
     assert data["x"] == 1.5 and data["a"] == [0, 1, 2] and data["nan"] is None and data["inf"] == "inf"
     assert data["benchmark"] == "demo"
@@ -60,7 +63,8 @@ def test_runner_records_failure_and_continues(tmp_path, monkeypatch):
     (tmp_path / "bench_a_fails.py").write_text("def main(quick=False):\n    raise ValueError('boom')\n")
     (tmp_path / "bench_b_ok.py").write_text(
         "def main(quick=False):\n    return {'table': 'B', 'targets': {'t': {'target': 't', 'measured': 1.0,"
-        " 'threshold': 0.5, 'reached': True}}}\n")
+        " 'threshold': 0.5, 'reached': True}}}\n"
+    )
     results = tmp_path / "results"
     monkeypatch.setattr(_common, "RESULTS_DIR", results)
     monkeypatch.setattr(run_all, "discover", lambda bench_dir=tmp_path: ["bench_a_fails", "bench_b_ok"])

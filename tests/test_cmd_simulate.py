@@ -40,8 +40,16 @@ def test_both_ends_write_summary_histories_plots(both_run, capsys):
     for end in ("arc", "corner"):
         block = doc[end]
         assert block["status"] == "ok"
-        for key in ("cage_speed_rpm", "kinematic_cage_speed_rpm", "cage_slip", "flange_contact_events",
-                    "on_arc_fraction", "num_steps", "wall_time_s", "status"):
+        for key in (
+            "cage_speed_rpm",
+            "kinematic_cage_speed_rpm",
+            "cage_slip",
+            "flange_contact_events",
+            "on_arc_fraction",
+            "num_steps",
+            "wall_time_s",
+            "status",
+        ):
             assert key in block
         for key in SUMMARY_STATS:
             assert set(block[key]) == {"max", "mean", "median", "min"}
@@ -69,7 +77,7 @@ def test_invalid_override_one_line_exit_2(tmp_path, capsys):
 def test_forced_solver_failure_nonzero_exit(tmp_path, capsys):
     """A failed solve: exit 1, the progress meter says where it stopped (no jump to 100 %), the
     table marks the failed run's values, summary.json is strict JSON (issue 16)."""
-    cfg = _config(tmp_path, "[simulation]\nduration_ms = 0.6\nmax_steps = 30\nprogress = true\nend = \"arc\"\n")
+    cfg = _config(tmp_path, '[simulation]\nduration_ms = 0.6\nmax_steps = 30\nprogress = true\nend = "arc"\n')
     out = tmp_path / "out"
     assert main(["simulate", "--config", cfg, "--out", str(out)]) == 1
     printed = capsys.readouterr().out

@@ -36,20 +36,40 @@ def _module_fields(module) -> dict[str, object]:
 #: MODEL.md section 2 (the physics contract), in SI: the reference bearing is written down once,
 #: in the configuration schema; this table is the independent copy it is checked against.
 MODEL_MD_REFERENCE = {
-    "pitch_diameter": 85e-3, "radial_clearance": 20e-6, "inner_ring_mass": 0.5,
-    "flange_traction": 0.08, "pocket_friction": 0.10,
-    "roller.diameter": 7.5e-3, "roller.length": 8.0e-3, "roller.central_length": 4.5e-3,
-    "roller.crown_drop": 4e-6, "roller.corner_radius": 0.4e-3, "roller.end_radius": 80e-3,
-    "flange.height": 2.0e-3, "flange.relief_height": 0.3e-3, "flange.contact_height_limit": 1.8e-3,
-    "flange.layback_angle": np.radians(1.6), "flange.axial_clearance": 0.15e-3,
-    "cage.inner_diameter": 80e-3, "cage.outer_diameter": 90e-3, "cage.width": 14e-3,
-    "cage.pocket_clearance": 0.20e-3, "cage.guiding_clearance": 0.40e-3, "cage.land_width": 3e-3,
-    "ring_material.elastic_modulus": 203e9, "ring_material.poisson_ratio": 0.28,
-    "ring_material.density": 7830.0, "roller_material.elastic_modulus": 203e9,
-    "cage_material.elastic_modulus": 205e9, "cage_material.poisson_ratio": 0.29,
-    "cage_material.density": 7850.0, "lubricant.viscosity": 0.055,
-    "lubricant.pressure_viscosity": 1.85e-8, "lubricant.temperature_viscosity": 0.0315,
-    "lubricant.density": 960.0, "lubricant.oil_fraction": 0.05,
+    "pitch_diameter": 85e-3,
+    "radial_clearance": 20e-6,
+    "inner_ring_mass": 0.5,
+    "flange_traction": 0.08,
+    "pocket_friction": 0.10,
+    "roller.diameter": 7.5e-3,
+    "roller.length": 8.0e-3,
+    "roller.central_length": 4.5e-3,
+    "roller.crown_drop": 4e-6,
+    "roller.corner_radius": 0.4e-3,
+    "roller.end_radius": 80e-3,
+    "flange.height": 2.0e-3,
+    "flange.relief_height": 0.3e-3,
+    "flange.contact_height_limit": 1.8e-3,
+    "flange.layback_angle": np.radians(1.6),
+    "flange.axial_clearance": 0.15e-3,
+    "cage.inner_diameter": 80e-3,
+    "cage.outer_diameter": 90e-3,
+    "cage.width": 14e-3,
+    "cage.pocket_clearance": 0.20e-3,
+    "cage.guiding_clearance": 0.40e-3,
+    "cage.land_width": 3e-3,
+    "ring_material.elastic_modulus": 203e9,
+    "ring_material.poisson_ratio": 0.28,
+    "ring_material.density": 7830.0,
+    "roller_material.elastic_modulus": 203e9,
+    "cage_material.elastic_modulus": 205e9,
+    "cage_material.poisson_ratio": 0.29,
+    "cage_material.density": 7850.0,
+    "lubricant.viscosity": 0.055,
+    "lubricant.pressure_viscosity": 1.85e-8,
+    "lubricant.temperature_viscosity": 0.0315,
+    "lubricant.density": 960.0,
+    "lubricant.oil_fraction": 0.05,
 }
 
 
@@ -73,7 +93,13 @@ def test_reference_operating_point_and_simulation():
         assert np.asarray(got[name]).tobytes() == np.asarray(want[name]).tobytes(), name
     sim = cfg.simulation
     assert (sim.end, sim.duration_ms, sim.rtol, sim.atol, sim.max_steps, sim.progress) == (
-        "both", 20.0, 1e-3, 1e-6, 2_000_000, True)
+        "both",
+        20.0,
+        1e-3,
+        1e-6,
+        2_000_000,
+        True,
+    )
     assert sim.ends == ("arc", "corner") and sim.duration == pytest.approx(0.02)
     with pytest.raises(dataclasses.FrozenInstanceError):
         sim.rtol = 1.0  # type: ignore[misc]
@@ -182,8 +208,7 @@ FLOAT_KEYS = [k for k in KEYS if k.kind is float]
 
 
 @settings(max_examples=120, deadline=None)
-@given(changes=st.dictionaries(
-    st.sampled_from(FLOAT_KEYS), st.floats(0.98, 1.02), min_size=1, max_size=8))
+@given(changes=st.dictionaries(st.sampled_from(FLOAT_KEYS), st.floats(0.98, 1.02), min_size=1, max_size=8))
 def test_random_valid_configs_round_trip(changes):
     ref = jb.reference_config()
     dotted = {k.path: ref[k.path] * f for k, f in changes.items()}
@@ -196,8 +221,9 @@ def test_random_valid_configs_round_trip(changes):
     assert again == cfg
     assert again.to_toml() == text
     assert tomllib.loads(text) == cfg.to_dict()
-    same = jax.tree_util.tree_map(lambda x, y: np.asarray(x).tobytes() == np.asarray(y).tobytes(),
-                                  again.bearing(), cfg.bearing())
+    same = jax.tree_util.tree_map(
+        lambda x, y: np.asarray(x).tobytes() == np.asarray(y).tobytes(), again.bearing(), cfg.bearing()
+    )
     assert all(jax.tree_util.tree_leaves(same))
 
 
@@ -220,20 +246,31 @@ def test_replace_dotted_keys_revalidates():
 
 
 # -- unknown keys, types -----------------------------------------------------------------------
-@pytest.mark.parametrize("text, field, suggestion", [
-    ("[roller]\ndiamter_mm = 7.5\n", "roller.diamter_mm", "did you mean roller.diameter_mm?"),
-    ("[roler]\ndiameter_mm = 7.5\n", "roler", "did you mean [roller]?"),
-    ("[flange]\nlayback_angle = 1.6\n", "flange.layback_angle",
-     "did you mean flange.layback_angle_deg?"),
-    ("[operating]\nspeed_rmp = 1000\n", "operating.speed_rmp", "did you mean operating.speed_rpm?"),
-    ("[materials.rollers]\npoisson_ratio = 0.3\n", "materials.rollers",
-     "did you mean [materials.roller]?"),
-    ("[roller]\npitch_diameter_mm = 85\n", "roller.pitch_diameter_mm",
-     "did you mean bearing.pitch_diameter_mm (in [bearing])?"),
-    ("[cage]\ndensity_kg_m3 = 1320\n", "cage.density_kg_m3",
-     "did you mean materials.cage.density_kg_m3 (in [materials.cage])?"),
-    ("speed_rpm = 1000\n", "speed_rpm", "did you mean operating.speed_rpm (in [operating])?"),
-])
+@pytest.mark.parametrize(
+    "text, field, suggestion",
+    [
+        ("[roller]\ndiamter_mm = 7.5\n", "roller.diamter_mm", "did you mean roller.diameter_mm?"),
+        ("[roler]\ndiameter_mm = 7.5\n", "roler", "did you mean [roller]?"),
+        ("[flange]\nlayback_angle = 1.6\n", "flange.layback_angle", "did you mean flange.layback_angle_deg?"),
+        ("[operating]\nspeed_rmp = 1000\n", "operating.speed_rmp", "did you mean operating.speed_rpm?"),
+        (
+            "[materials.rollers]\npoisson_ratio = 0.3\n",
+            "materials.rollers",
+            "did you mean [materials.roller]?",
+        ),
+        (
+            "[roller]\npitch_diameter_mm = 85\n",
+            "roller.pitch_diameter_mm",
+            "did you mean bearing.pitch_diameter_mm (in [bearing])?",
+        ),
+        (
+            "[cage]\ndensity_kg_m3 = 1320\n",
+            "cage.density_kg_m3",
+            "did you mean materials.cage.density_kg_m3 (in [materials.cage])?",
+        ),
+        ("speed_rpm = 1000\n", "speed_rpm", "did you mean operating.speed_rpm (in [operating])?"),
+    ],
+)
 def test_did_you_mean(text, field, suggestion):
     with pytest.raises(ConfigError) as info:
         jb.loads_config(text)
@@ -246,19 +283,21 @@ def test_unknown_key_without_close_match_lists_valid_keys():
         jb.loads_config("[flange]\nzzzzz = 1\n")
 
 
-@pytest.mark.parametrize("text, field, fragment", [
-    ('[bearing]\npitch_diameter_mm = "85"\n', "bearing.pitch_diameter_mm", 'got string "85"'),
-    ("[roller]\ndiameter_mm = true\n", "roller.diameter_mm", "got boolean true"),
-    ("[bearing]\nnum_rollers = 26.0\n", "bearing.num_rollers", "got float 26.0"),
-    ("[bearing]\nnum_slices = true\n", "bearing.num_slices", "got boolean true"),
-    ("[operating]\ngravity = 1\n", "operating.gravity", "got integer 1"),
-    ("[roller]\nlength_mm = [8.0]\n", "roller.length_mm", "got array"),
-    ("[roller]\nlength_mm = 2025-01-01\n", "roller.length_mm", "expected a number"),
-    ("[simulation]\nend = 1\n", "simulation.end", "expected a string"),
-    ("roller = 7.5\n", "roller", "expected a table [roller]"),
-    ("[bearing]\npitch_diameter_mm = 1" + "0" * 400 + "\n", "bearing.pitch_diameter_mm",
-     "too large"),
-])
+@pytest.mark.parametrize(
+    "text, field, fragment",
+    [
+        ('[bearing]\npitch_diameter_mm = "85"\n', "bearing.pitch_diameter_mm", 'got string "85"'),
+        ("[roller]\ndiameter_mm = true\n", "roller.diameter_mm", "got boolean true"),
+        ("[bearing]\nnum_rollers = 26.0\n", "bearing.num_rollers", "got float 26.0"),
+        ("[bearing]\nnum_slices = true\n", "bearing.num_slices", "got boolean true"),
+        ("[operating]\ngravity = 1\n", "operating.gravity", "got integer 1"),
+        ("[roller]\nlength_mm = [8.0]\n", "roller.length_mm", "got array"),
+        ("[roller]\nlength_mm = 2025-01-01\n", "roller.length_mm", "expected a number"),
+        ("[simulation]\nend = 1\n", "simulation.end", "expected a string"),
+        ("roller = 7.5\n", "roller", "expected a table [roller]"),
+        ("[bearing]\npitch_diameter_mm = 1" + "0" * 400 + "\n", "bearing.pitch_diameter_mm", "too large"),
+    ],
+)
 def test_wrong_types(text, field, fragment):
     with pytest.raises(ConfigError) as info:
         jb.loads_config(text)
@@ -288,12 +327,15 @@ def test_config_show_prints_every_key_with_a_comment(capsys):
     assert tomllib.loads(out) == jb.reference_config().to_dict()
     lines = out.splitlines()
     for key in KEYS:
-        i = next(i for i, line in enumerate(lines) if line.startswith(f"{key.name} = ")
-                 and _section_of(lines, i) == key.section)
+        i = next(
+            i
+            for i, line in enumerate(lines)
+            if line.startswith(f"{key.name} = ") and _section_of(lines, i) == key.section
+        )
         comment = lines[i - 1]
         assert comment.startswith("# ") and len(comment) > 10, key.path
         if key.kind in (int, float):
-            assert ("in " in comment or ">" in comment), key.path  # the valid range
+            assert "in " in comment or ">" in comment, key.path  # the valid range
         if key.symbol:
             assert key.symbol in comment, key.path
 

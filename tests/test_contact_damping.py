@@ -34,8 +34,7 @@ WIDTH = 1e-14  # penetration softplus width for the impact runs [m], << the ~10 
 
 def _exact_restitution(v_in, c):
     f = lambda v: v / c - math.log1p(c * v) / c**2
-    v_out = brentq(lambda w: f(-w) - f(v_in), 0.0, min(v_in, (1 - 1e-12) / c), xtol=1e-15,
-                   rtol=1e-14)
+    v_out = brentq(lambda w: f(-w) - f(v_in), 0.0, min(v_in, (1 - 1e-12) / c), xtol=1e-15, rtol=1e-14)
     return v_out / v_in
 
 
@@ -53,9 +52,16 @@ def _simulate_restitution(mass, stiffness, exponent, alpha, v_in):
     separated.terminal = True
     separated.direction = -1
     t_scale = d_max / v_in
-    sol = solve_ivp(rhs, (0.0, 50 * t_scale), [0.0, v_in], method="DOP853", rtol=1e-12,
-                    atol=[1e-9 * d_max, 1e-12 * v_in], events=separated,
-                    first_step=1e-3 * t_scale)
+    sol = solve_ivp(
+        rhs,
+        (0.0, 50 * t_scale),
+        [0.0, v_in],
+        method="DOP853",
+        rtol=1e-12,
+        atol=[1e-9 * d_max, 1e-12 * v_in],
+        events=separated,
+        first_step=1e-3 * t_scale,
+    )
     assert sol.status == 1, "no separation"
     return -sol.y_events[0][0][1] / v_in
 
@@ -93,8 +99,7 @@ def test_factor_is_the_raceway_and_pocket_law():
     want = DAMPING_FACTOR_WIDTH * np.logaddexp(0.0, (1 + 1.5 * 0.3 * np.asarray(rates)) / 0.02)
     np.testing.assert_allclose(hunt_crossley_factor(rates), want, rtol=1e-14)
     # identity near 1, no pull when separating fast
-    np.testing.assert_allclose(hunt_crossley_factor(jnp.array([0.0, 0.5])), [1.0, 1.225],
-                               rtol=1e-15)
+    np.testing.assert_allclose(hunt_crossley_factor(jnp.array([0.0, 0.5])), [1.0, 1.225], rtol=1e-15)
     assert 0.0 <= float(hunt_crossley_factor(-10.0)) < 1e-40
 
 
@@ -106,8 +111,7 @@ def test_force_is_elastic_times_factor_and_vanishes_with_the_contact():
     assert float(hunt_crossley_force(k, -1e-6, 5.0)) == 0.0
 
 
-@pytest.mark.parametrize("d, v", [(0.0, 0.0), (-1e-9, 0.0), (1e-9, -1 / 0.45), (-1e-6, -3.0),
-                                  (2e-6, 0.2)])
+@pytest.mark.parametrize("d, v", [(0.0, 0.0), (-1e-9, 0.0), (1e-9, -1 / 0.45), (-1e-6, -3.0), (2e-6, 0.2)])
 def test_smooth_at_zero(d, v):
     # finite gradient and Hessian at first touch, at zero rate, at the factor's zero crossing
     # and far outside; the gradient matches central differences where the force is loaded

@@ -38,9 +38,17 @@ from jaxbearing.contact import (
 # alpha_p = 1.85e-8 1/Pa, beta_T = 0.0315 1/C)
 E_PRIME = float(effective_modulus(2.08e11, 0.3, 2.08e11, 0.3))
 ETA, ALPHA_P, BETA_T, T0 = 0.055, 1.85e-8, 0.0315, 80.0
-LUB = Lubricant(viscosity=ETA, pressure_viscosity=ALPHA_P, temperature_viscosity=BETA_T,
-                density=870.0, oil_fraction=0.05, traction_a=-0.04, traction_b=0.2528,
-                traction_c=2.926, traction_d=0.04)
+LUB = Lubricant(
+    viscosity=ETA,
+    pressure_viscosity=ALPHA_P,
+    temperature_viscosity=BETA_T,
+    density=870.0,
+    oil_fraction=0.05,
+    traction_a=-0.04,
+    traction_b=0.2528,
+    traction_c=2.926,
+    traction_d=0.04,
+)
 
 
 def _hand_film(load, rx, ry, u, kind):
@@ -74,26 +82,40 @@ def test_film_thickness_is_hamrock_dowson(load, rx, ry, u):
         got = float(fn(load, rx, ry, u, E_PRIME, ETA, ALPHA_P, 0.0))
         np.testing.assert_allclose(got, _hand_film(load, rx, ry, u, kind), rtol=1e-10)
     # the regularised speed and load change nothing measurable at these loads and speeds
-    np.testing.assert_allclose(_hmin(load, rx, ry, u, E_PRIME, ETA, ALPHA_P),
-                               _hand_film(load, rx, ry, u, "min"), rtol=1e-7)
+    np.testing.assert_allclose(
+        _hmin(load, rx, ry, u, E_PRIME, ETA, ALPHA_P), _hand_film(load, rx, ry, u, "min"), rtol=1e-7
+    )
 
 
 def test_ehl_parameters_and_ellipticity_orientation():
     u, g, w, k = ehl_parameters(1000.0, 5e-3, 50e-3, 10.0, E_PRIME, ETA, ALPHA_P, 0.0)
-    np.testing.assert_allclose([u, g, w], [ETA * 10 / (E_PRIME * 5e-3), ALPHA_P * E_PRIME,
-                                           1000 / (E_PRIME * 25e-6)], rtol=1e-14)
+    np.testing.assert_allclose(
+        [u, g, w], [ETA * 10 / (E_PRIME * 5e-3), ALPHA_P * E_PRIME, 1000 / (E_PRIME * 25e-6)], rtol=1e-14
+    )
     np.testing.assert_allclose(k, exact_hertz(1000.0, 50e-3, 5e-3, E_PRIME)["k"], rtol=1e-9)
     # rolling along the long axis: k < 1
     *_, k_long = ehl_parameters(1000.0, 50e-3, 5e-3, 10.0, E_PRIME, ETA, ALPHA_P, 0.0)
     np.testing.assert_allclose(k_long, 1 / k, rtol=1e-12)
 
 
-_log_hmin = jax.jit(jax.grad(
-    lambda x: jnp.log(minimum_film_thickness(jnp.exp(x[0]), 5e-3, 50e-3, jnp.exp(x[1]), E_PRIME,
-                                             jnp.exp(x[2]), jnp.exp(x[3]), 0.0))))
-_log_hc = jax.jit(jax.grad(
-    lambda x: jnp.log(central_film_thickness(jnp.exp(x[0]), 5e-3, 50e-3, jnp.exp(x[1]), E_PRIME,
-                                             jnp.exp(x[2]), jnp.exp(x[3]), 0.0))))
+_log_hmin = jax.jit(
+    jax.grad(
+        lambda x: jnp.log(
+            minimum_film_thickness(
+                jnp.exp(x[0]), 5e-3, 50e-3, jnp.exp(x[1]), E_PRIME, jnp.exp(x[2]), jnp.exp(x[3]), 0.0
+            )
+        )
+    )
+)
+_log_hc = jax.jit(
+    jax.grad(
+        lambda x: jnp.log(
+            central_film_thickness(
+                jnp.exp(x[0]), 5e-3, 50e-3, jnp.exp(x[1]), E_PRIME, jnp.exp(x[2]), jnp.exp(x[3]), 0.0
+            )
+        )
+    )
+)
 
 
 def test_exponents_of_the_film_formulas():
@@ -106,15 +128,18 @@ def test_exponents_of_the_film_formulas():
 def test_viscosity_at_temperature():
     np.testing.assert_allclose(viscosity_at_temperature(T0, ETA, BETA_T, T0), ETA, rtol=1e-15)
     # halves every ln(2)/beta_T = 22.0 C
-    np.testing.assert_allclose(viscosity_at_temperature(T0 + math.log(2) / BETA_T, ETA, BETA_T, T0),
-                               ETA / 2, rtol=1e-14)
-    np.testing.assert_allclose(viscosity_at_temperature(40.0, ETA, BETA_T, T0),
-                               ETA * math.exp(0.0315 * 40), rtol=1e-14)
+    np.testing.assert_allclose(
+        viscosity_at_temperature(T0 + math.log(2) / BETA_T, ETA, BETA_T, T0), ETA / 2, rtol=1e-14
+    )
+    np.testing.assert_allclose(
+        viscosity_at_temperature(40.0, ETA, BETA_T, T0), ETA * math.exp(0.0315 * 40), rtol=1e-14
+    )
 
 
 def test_entrainment_velocity_and_radii():
-    np.testing.assert_allclose(entrainment_velocity(jnp.array([3.0, 1.0]), jnp.array([1.0, -1.0])),
-                               [2.0, 0.0])
+    np.testing.assert_allclose(
+        entrainment_velocity(jnp.array([3.0, 1.0]), jnp.array([1.0, -1.0])), [2.0, 0.0]
+    )
     r1, r2 = 0.4e-3, 120e-3
     np.testing.assert_allclose(entrainment_radii(r1, r2, 1.0), (r1, r2), rtol=1e-15)
     np.testing.assert_allclose(entrainment_radii(r1, r2, 0.0), (r2, r1), rtol=1e-15)
@@ -132,8 +157,9 @@ def test_film_parameter():
 
 def test_asperity_load_fraction():
     f = jax.jit(asperity_load_fraction)
-    np.testing.assert_allclose(f(jnp.array([0.0, 1.0, 3.0, ASPERITY_MIDPOINT])),
-                               [1.0, 0.9, 1 / 82, 0.5], rtol=1e-14)
+    np.testing.assert_allclose(
+        f(jnp.array([0.0, 1.0, 3.0, ASPERITY_MIDPOINT])), [1.0, 0.9, 1 / 82, 0.5], rtol=1e-14
+    )
     lam = jnp.linspace(0.0, 10.0, 101)
     assert bool(jnp.all(jnp.diff(f(lam)) < 0))
     assert float(jax.grad(asperity_load_fraction)(0.0)) == 0.0
@@ -143,8 +169,9 @@ def test_mixed_traction_coefficient_limits_and_blend():
     mu_b, mu_f = 0.08, 0.04
     np.testing.assert_allclose(mixed_traction_coefficient(0.0, mu_b, mu_f), mu_b, rtol=1e-15)
     np.testing.assert_allclose(mixed_traction_coefficient(50.0, mu_b, mu_f), mu_f, rtol=1e-9)
-    np.testing.assert_allclose(mixed_traction_coefficient(1.0, mu_b, mu_f),
-                               0.9 * mu_b + 0.1 * mu_f, rtol=1e-14)
+    np.testing.assert_allclose(
+        mixed_traction_coefficient(1.0, mu_b, mu_f), 0.9 * mu_b + 0.1 * mu_f, rtol=1e-14
+    )
 
 
 def test_mixed_traction_force():
@@ -154,11 +181,13 @@ def test_mixed_traction_force():
     kappa = float(traction_coefficient(s, LUB))
     f_a = 1 / (1 + lam**6 / 9)  # Lambda_m^6 = 9
     mu = f_a * mu_b + (1 - f_a) * kappa
-    np.testing.assert_allclose(mixed_traction_force(u, q, lam, mu_b, LUB),
-                               -q * mu * np.asarray(u) / s, rtol=1e-13)
+    np.testing.assert_allclose(
+        mixed_traction_force(u, q, lam, mu_b, LUB), -q * mu * np.asarray(u) / s, rtol=1e-13
+    )
     # boundary limit is Coulomb friction with the flange coefficient
-    np.testing.assert_allclose(mixed_traction_force(u, q, 0.0, mu_b, LUB),
-                               -q * mu_b * np.asarray(u) / s, rtol=1e-14)
+    np.testing.assert_allclose(
+        mixed_traction_force(u, q, 0.0, mu_b, LUB), -q * mu_b * np.asarray(u) / s, rtol=1e-14
+    )
 
 
 def _lubricated(x):
@@ -175,8 +204,17 @@ _lub_d1 = jax.jit(jax.jacfwd(_lubricated))
 _lub_d2 = jax.jit(jax.hessian(_lubricated))
 
 
-@pytest.mark.parametrize("x", [(0.0, 0.0, 0.0), (0.0, 5.0, 5.0), (50.0, 0.0, 0.0),
-                               (50.0, 0.0, 1e-4), (-1.0, -3.0, 2.0), (50.0, 5.0, 5.0)])
+@pytest.mark.parametrize(
+    "x",
+    [
+        (0.0, 0.0, 0.0),
+        (0.0, 5.0, 5.0),
+        (50.0, 0.0, 0.0),
+        (50.0, 0.0, 1e-4),
+        (-1.0, -3.0, 2.0),
+        (50.0, 5.0, 5.0),
+    ],
+)
 def test_finite_and_smooth_at_zero_speed_and_load(x):
     x = jnp.asarray(x, dtype=float)
     out = _lub(x)

@@ -76,8 +76,16 @@ def exact_hertz(load, r_long, r_short, e_prime):
     a = k * b
     p0 = 3.0 * load / (2.0 * math.pi * a * b)
     delta = p0 * b * kk / e_star
-    return {"k": k, "first": kk, "second": ee, "a": a, "b": b, "delta": delta, "p0": p0,
-            "stiffness": load / delta**1.5}
+    return {
+        "k": k,
+        "first": kk,
+        "second": ee,
+        "a": a,
+        "b": b,
+        "delta": delta,
+        "p0": p0,
+        "stiffness": load / delta**1.5,
+    }
 
 
 def test_oracle_is_consistent():
@@ -111,8 +119,9 @@ def test_elliptic_integrals_closed_forms():
 
 
 def test_elliptic_integrals_against_scipy_including_negative_parameter():
-    m = np.concatenate([-np.geomspace(1e8, 1e-8, 33), [0.0], np.linspace(1e-6, 0.99, 25),
-                        1 - np.geomspace(1e-2, 1e-9, 15)])
+    m = np.concatenate(
+        [-np.geomspace(1e8, 1e-8, 33), [0.0], np.linspace(1e-6, 0.99, 25), 1 - np.geomspace(1e-2, 1e-9, 15)]
+    )
     kk, ee = _elliptic(jnp.asarray(m))
     np.testing.assert_allclose(kk, ellipk(m), rtol=1e-13)
     np.testing.assert_allclose(ee, ellipe(m), rtol=1e-13)
@@ -150,8 +159,15 @@ def test_exact_against_oracle(swap):
         ex = exact_hertz(LOAD, r_long, r_short, E_PRIME)
         ax, ay = map(float, _ellipse(LOAD, rx, ry, E_PRIME))
         a_long, a_short = (ay, ax) if swap else (ax, ay)
-        got = np.array([a_long, a_short, float(_defl(LOAD, rx, ry, E_PRIME)),
-                        float(_pmax(LOAD, rx, ry, E_PRIME)), float(_stiff(rx, ry, E_PRIME))])
+        got = np.array(
+            [
+                a_long,
+                a_short,
+                float(_defl(LOAD, rx, ry, E_PRIME)),
+                float(_pmax(LOAD, rx, ry, E_PRIME)),
+                float(_stiff(rx, ry, E_PRIME)),
+            ]
+        )
         want = np.array([ex["a"], ex["b"], ex["delta"], ex["p0"], ex["stiffness"]])
         err = np.max(np.abs(got / want - 1))
         worst = max(worst, err)
@@ -172,8 +188,7 @@ def test_fit_error_that_motivated_the_switch():
     k, e, f = map(float, _params(rx, ry))
     r = 1 / (1 / rx + 1 / ry)
     k_fit = math.pi * k * E_PRIME * math.sqrt(e * r / (4.5 * f**3))
-    p_fit = 3 * LOAD / (2 * math.pi * (6 * e * LOAD * r / (math.pi * E_PRIME)) ** (2 / 3)
-                        * k ** (1 / 3))
+    p_fit = 3 * LOAD / (2 * math.pi * (6 * e * LOAD * r / (math.pi * E_PRIME)) ** (2 / 3) * k ** (1 / 3))
     stiff_err = k_fit / float(_stiff(rx, ry, E_PRIME)) - 1
     p_err = p_fit / float(_pmax(LOAD, rx, ry, E_PRIME)) - 1
     assert 0.11 < stiff_err < 0.13
@@ -196,8 +211,10 @@ def test_hamrock_brewe_parameters_within_their_documented_error(swap):
     for alpha in [1.2, 17.0, 1000.0]:
         k, e, f = map(float, _params(1e-3, alpha * 1e-3))
         np.testing.assert_allclose(
-            [k, e, f], [1.0339 * alpha**0.6360, 1.0003 + 0.5968 / alpha,
-                        1.5277 + 0.6023 * math.log(alpha)], rtol=1e-9)  # saturation: 5e-11
+            [k, e, f],
+            [1.0339 * alpha**0.6360, 1.0003 + 0.5968 / alpha, 1.5277 + 0.6023 * math.log(alpha)],
+            rtol=1e-9,
+        )  # saturation: 5e-11
 
 
 @pytest.mark.parametrize("radius", [1e-3, 80e-3])
@@ -208,10 +225,12 @@ def test_sphere_on_plane(radius):
     ax, ay = _ellipse(LOAD, radius, radius, E_PRIME)
     np.testing.assert_allclose([ax, ay], [a, a], rtol=1e-14)
     np.testing.assert_allclose(_defl(LOAD, radius, radius, E_PRIME), a * a / radius, rtol=1e-14)
-    np.testing.assert_allclose(_pmax(LOAD, radius, radius, E_PRIME),
-                               3 * LOAD / (2 * math.pi * a * a), rtol=1e-14)
-    np.testing.assert_allclose(_stiff(radius, radius, E_PRIME),
-                               (2 / 3) * E_PRIME * math.sqrt(radius), rtol=1e-14)
+    np.testing.assert_allclose(
+        _pmax(LOAD, radius, radius, E_PRIME), 3 * LOAD / (2 * math.pi * a * a), rtol=1e-14
+    )
+    np.testing.assert_allclose(
+        _stiff(radius, radius, E_PRIME), (2 / 3) * E_PRIME * math.sqrt(radius), rtol=1e-14
+    )
 
 
 def test_near_circle_expansion():
@@ -242,9 +261,7 @@ def test_long_axis_along_larger_radius():
 
 
 @settings(max_examples=40, deadline=None)
-@given(
-    st.floats(1e-4, 1.0), st.floats(-9.0, 9.0), st.floats(1e-3, 1e4), st.floats(1e10, 5e11)
-)
+@given(st.floats(1e-4, 1.0), st.floats(-9.0, 9.0), st.floats(1e-3, 1e4), st.floats(1e10, 5e11))
 def test_symmetry_and_consistency(rx, log_ratio, load, e_prime):
     ry = rx * math.exp(log_ratio)
     k1, k2 = _stiff(rx, ry, e_prime), _stiff(ry, rx, e_prime)
@@ -253,8 +270,7 @@ def test_symmetry_and_consistency(rx, log_ratio, load, e_prime):
     bx, by = _ellipse(load, ry, rx, e_prime)
     np.testing.assert_allclose([ax, ay], [by, bx], rtol=1e-13)
     # p_max = 3 Q / (2 pi a b), Q = K delta^1.5
-    np.testing.assert_allclose(_pmax(load, rx, ry, e_prime) * 2 * math.pi * ax * ay / 3, load,
-                               rtol=1e-12)
+    np.testing.assert_allclose(_pmax(load, rx, ry, e_prime) * 2 * math.pi * ax * ay / 3, load, rtol=1e-12)
     np.testing.assert_allclose(k1 * _defl(load, rx, ry, e_prime) ** 1.5, load, rtol=1e-12)
     assert (ax >= ay) == (rx >= ry) or abs(log_ratio) < 1e-12
 
@@ -278,10 +294,16 @@ def test_smooth_and_continuous_through_equal_radii():
 def _log_outputs(x):
     """ln of (K_s, a_x, a_y, p_max, delta) at (ln Q, ln R_x, ln R_y)."""
     q, rx, ry = jnp.exp(x[0]), jnp.exp(x[1]), jnp.exp(x[2])
-    return jnp.log(jnp.stack([point_contact_stiffness(rx, ry, E_PRIME),
-                              *point_contact_ellipse(q, rx, ry, E_PRIME),
-                              point_contact_peak_pressure(q, rx, ry, E_PRIME),
-                              point_contact_deflection(q, rx, ry, E_PRIME)]))
+    return jnp.log(
+        jnp.stack(
+            [
+                point_contact_stiffness(rx, ry, E_PRIME),
+                *point_contact_ellipse(q, rx, ry, E_PRIME),
+                point_contact_peak_pressure(q, rx, ry, E_PRIME),
+                point_contact_deflection(q, rx, ry, E_PRIME),
+            ]
+        )
+    )
 
 
 _jac = jax.jit(jax.jacfwd(_log_outputs))
@@ -300,14 +322,17 @@ def test_gradients_and_hessians_against_finite_differences(ratio):
     jac = np.asarray(_jac(x))
     np.testing.assert_allclose(_jac_rev(x), jac, rtol=1e-12, atol=1e-14)
     h = 1e-5
-    fd = np.stack([(np.asarray(_log_out(x + h * e)) - np.asarray(_log_out(x - h * e))) / (2 * h)
-                   for e in np.eye(3)], axis=1)
+    fd = np.stack(
+        [(np.asarray(_log_out(x + h * e)) - np.asarray(_log_out(x - h * e))) / (2 * h) for e in np.eye(3)],
+        axis=1,
+    )
     np.testing.assert_allclose(jac, fd, rtol=0, atol=1e-8)
     np.testing.assert_allclose(jac[0, 1] + jac[0, 2], 0.5, rtol=1e-12)
     np.testing.assert_allclose(jac[1:, 0], [1 / 3, 1 / 3, 1 / 3, 2 / 3], rtol=1e-12)
     hess = np.asarray(_hess(x))
-    fd2 = np.stack([(np.asarray(_jac(x + h * e)) - np.asarray(_jac(x - h * e))) / (2 * h)
-                    for e in np.eye(3)], axis=2)
+    fd2 = np.stack(
+        [(np.asarray(_jac(x + h * e)) - np.asarray(_jac(x - h * e))) / (2 * h) for e in np.eye(3)], axis=2
+    )
     np.testing.assert_allclose(hess, fd2, rtol=0, atol=1e-7)
 
 
@@ -316,10 +341,14 @@ def _finite(tree):
 
 
 def _all_outputs(rx, ry, q):
-    return jnp.stack([point_contact_stiffness(rx, ry, E_PRIME),
-                      *point_contact_ellipse(q, rx, ry, E_PRIME),
-                      point_contact_peak_pressure(q, rx, ry, E_PRIME),
-                      point_contact_deflection(q, rx, ry, E_PRIME)])
+    return jnp.stack(
+        [
+            point_contact_stiffness(rx, ry, E_PRIME),
+            *point_contact_ellipse(q, rx, ry, E_PRIME),
+            point_contact_peak_pressure(q, rx, ry, E_PRIME),
+            point_contact_deflection(q, rx, ry, E_PRIME),
+        ]
+    )
 
 
 _all_d1 = jax.jit(jax.jacfwd(_all_outputs, argnums=(0, 1, 2)))
@@ -351,9 +380,14 @@ def test_saturation_at_huge_ratios():
 def _through_penetration(delta, rx, ry):
     k = point_contact_stiffness(rx, ry, E_PRIME)
     q = hertz_force(delta, k, 1e-9)
-    return jnp.stack([q, *point_contact_ellipse(q, rx, ry, E_PRIME),
-                      point_contact_peak_pressure(q, rx, ry, E_PRIME),
-                      point_contact_deflection(q, rx, ry, E_PRIME)])
+    return jnp.stack(
+        [
+            q,
+            *point_contact_ellipse(q, rx, ry, E_PRIME),
+            point_contact_peak_pressure(q, rx, ry, E_PRIME),
+            point_contact_deflection(q, rx, ry, E_PRIME),
+        ]
+    )
 
 
 _pen_d1 = jax.jit(jax.jacfwd(_through_penetration, argnums=(0, 1, 2)))
@@ -394,5 +428,6 @@ def test_broadcasting_and_vmap():
     k = point_contact_stiffness(rx, ry, E_PRIME)
     assert k.shape == (2, 3)
     kv = jax.jit(jax.vmap(jax.vmap(point_contact_stiffness, (0, None, None)), (None, 0, None)))(
-        rx, ry[:, 0], E_PRIME)
+        rx, ry[:, 0], E_PRIME
+    )
     np.testing.assert_allclose(k, kv, rtol=1e-14)

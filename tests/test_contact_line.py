@@ -70,15 +70,18 @@ def test_steel_basis_reproduces_the_point_contact_constant():
     e_star_mm = STEEL_ELASTIC_MODULUS / (2 * (1 - STEEL_POISSON_RATIO**2)) * 1e-6
     np.testing.assert_allclose(4 / 3 * math.sqrt(2) * e_star_mm, 2.15e5, rtol=1e-3)
     np.testing.assert_allclose(
-        effective_modulus(STEEL_ELASTIC_MODULUS, STEEL_POISSON_RATIO, STEEL_ELASTIC_MODULUS,
-                          STEEL_POISSON_RATIO), STEEL_E_PRIME, rtol=1e-15)
+        effective_modulus(
+            STEEL_ELASTIC_MODULUS, STEEL_POISSON_RATIO, STEEL_ELASTIC_MODULUS, STEEL_POISSON_RATIO
+        ),
+        STEEL_E_PRIME,
+        rtol=1e-15,
+    )
 
 
 def test_material_scaling():
     bearing = jb.reference_bearing()
     m = bearing.roller_material
-    e_m50 = effective_modulus(m.elastic_modulus, m.poisson_ratio, m.elastic_modulus,
-                              m.poisson_ratio)
+    e_m50 = effective_modulus(m.elastic_modulus, m.poisson_ratio, m.elastic_modulus, m.poisson_ratio)
     length = bearing.roller.effective_length
     ratio = line_contact_stiffness(length, e_m50) / line_contact_stiffness(length)
     np.testing.assert_allclose(ratio, e_m50 / STEEL_E_PRIME, rtol=1e-14)
@@ -95,8 +98,7 @@ def test_uniform_slices_carry_the_whole_contact_law(num_slices):
     np.testing.assert_allclose(jnp.sum(q), k_c * delta ** (10 / 9), rtol=1e-9)
     # and the roller between two raceways approaches by ISO's total approach
     load = float(jnp.sum(q))
-    np.testing.assert_allclose(2 * delta, (load / (35948.0 * 7.2 ** (8 / 9))) ** 0.9 * 1e-3,
-                               rtol=1e-9)
+    np.testing.assert_allclose(2 * delta, (load / (35948.0 * 7.2 ** (8 / 9))) ** 0.9 * 1e-3, rtol=1e-9)
 
 
 def test_tilted_roller_slices():
@@ -108,8 +110,7 @@ def test_tilted_roller_slices():
     delta = 1e-6 + 3e-6 * x
     q = line_slice_loads(delta, k_c, n, W)
     pos = np.asarray(delta) > 50 * W
-    np.testing.assert_allclose(np.asarray(q)[pos], k_c / n * np.asarray(delta)[pos] ** (10 / 9),
-                               rtol=1e-9)
+    np.testing.assert_allclose(np.asarray(q)[pos], k_c / n * np.asarray(delta)[pos] ** (10 / 9), rtol=1e-9)
     assert np.all(np.asarray(q)[np.asarray(delta) < -50 * W] < 1e-30)
 
 
@@ -142,8 +143,7 @@ def test_gradient_and_hessian_finite(delta):
     assert all(bool(jnp.all(jnp.isfinite(x))) for x in _jac(d, k_c))
     assert all(bool(jnp.all(jnp.isfinite(x))) for x in jax.tree_util.tree_leaves(_hess(d, k_c)))
     if delta >= 1e-6:  # d q_j / d delta_j = (10/9) (k_c/N_s) delta^(1/9)
-        np.testing.assert_allclose(jnp.diag(_jac(d, k_c)[0]),
-                                   10 / 9 * k_c / 5 * delta ** (1 / 9), rtol=1e-8)
+        np.testing.assert_allclose(jnp.diag(_jac(d, k_c)[0]), 10 / 9 * k_c / 5 * delta ** (1 / 9), rtol=1e-8)
 
 
 @settings(max_examples=50, deadline=None)

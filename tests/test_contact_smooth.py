@@ -84,15 +84,20 @@ def test_hertz_force_finite_derivatives(delta, exponent):
     assert _finite(_hf_d2(delta, k, W, exponent))
     if delta >= 1e-6:  # loaded: K delta^n and its derivatives (delta >> eps)
         np.testing.assert_allclose(_hf(delta, k, W, exponent), k * delta**exponent, rtol=1e-9)
-        np.testing.assert_allclose(_hf_d1(delta, k, W, exponent)[0],
-                                   k * exponent * delta ** (exponent - 1), rtol=1e-9)
-        np.testing.assert_allclose(_hf_d2(delta, k, W, exponent)[0][0],
-                                   k * exponent * (exponent - 1) * delta ** (exponent - 2),
-                                   rtol=1e-6, atol=1e-6 * k * delta ** (exponent - 2))
+        np.testing.assert_allclose(
+            _hf_d1(delta, k, W, exponent)[0], k * exponent * delta ** (exponent - 1), rtol=1e-9
+        )
+        np.testing.assert_allclose(
+            _hf_d2(delta, k, W, exponent)[0][0],
+            k * exponent * (exponent - 1) * delta ** (exponent - 2),
+            rtol=1e-6,
+            atol=1e-6 * k * delta ** (exponent - 2),
+        )
     if delta == 0.0:  # d/d delta [K s^n] = n K s^(n-1) sigmoid(0), s = eps ln 2
         s = W * math.log(2)
-        np.testing.assert_allclose(_hf_d1(delta, k, W, exponent)[0],
-                                   exponent * k * s ** (exponent - 1) * 0.5, rtol=1e-12)
+        np.testing.assert_allclose(
+            _hf_d1(delta, k, W, exponent)[0], exponent * k * s ** (exponent - 1) * 0.5, rtol=1e-12
+        )
     if delta <= -1e-6:  # far outside the contact: exactly zero, zero derivatives
         assert float(_hf(delta, k, W, exponent)) == 0.0
         assert float(_hf_d2(delta, k, W, exponent)[0][0]) == 0.0

@@ -53,15 +53,20 @@ def central_differences():
             xp, xm = X0.copy(), X0.copy()
             xp[i] += h
             xm[i] -= h
-            cols.append((np.asarray(_values(jnp.asarray(xp))) - np.asarray(_values(jnp.asarray(xm)))) / (2 * h))
+            cols.append(
+                (np.asarray(_values(jnp.asarray(xp))) - np.asarray(_values(jnp.asarray(xm)))) / (2 * h)
+            )
         out[rel] = np.stack(cols, axis=1)
     return np.asarray(_values(jnp.asarray(X0))), out
 
 
 @pytest.fixture(scope="module")
 def forward_jacobian():
-    f = jax.jit(lambda x: design_jacobian(REF, OP, DesignVariables.from_array(x),
-                                          duration=GRADIENT_HORIZON, mode="forward", **TIGHT))
+    f = jax.jit(
+        lambda x: design_jacobian(
+            REF, OP, DesignVariables.from_array(x), duration=GRADIENT_HORIZON, mode="forward", **TIGHT
+        )
+    )
     v, j = f(jnp.asarray(X0))
     return np.asarray(v), np.asarray(j)
 
@@ -127,9 +132,7 @@ def test_static_margins_match_design_zone_and_vmap():
         r, t = float(d.end_radius), float(d.layback_angle)
         assert float(m[k, 1]) == pytest.approx(1.8e-3 - (3.75e-3 - r * math.sin(t)), abs=1e-9)
     # gradients of the margins are finite and vmappable
-    jac = jax.vmap(jax.jacfwd(lambda x: zone_margins(REF, DesignVariables.from_array(x))))(
-        designs.as_array()
-    )
+    jac = jax.vmap(jax.jacfwd(lambda x: zone_margins(REF, DesignVariables.from_array(x))))(designs.as_array())
     assert jac.shape == (3, 4, 3) and bool(jnp.all(jnp.isfinite(jac)))
 
 
@@ -143,14 +146,17 @@ def test_seated_perturbation_starts_outermost_roller_at_contact():
 
 @pytest.mark.parametrize(
     "field,value,text",
-    [("end_radius", 1e-3, "design.end_radius = 0.001"),
-     ("layback_angle", -0.1, "design.layback_angle = -0.1"),
-     ("axial_clearance", 0.0, "design.axial_clearance = 0.0")],
+    [
+        ("end_radius", 1e-3, "design.end_radius = 0.001"),
+        ("layback_angle", -0.1, "design.layback_angle = -0.1"),
+        ("axial_clearance", 0.0, "design.axial_clearance = 0.0"),
+    ],
 )
 def test_bad_design_is_one_line_error(field, value, text):
     d = DesignVariables.of(REF)
-    d = DesignVariables(**{**{k: getattr(d, k) for k in ("end_radius", "layback_angle",
-                                                         "axial_clearance")}, field: value})
+    d = DesignVariables(
+        **{**{k: getattr(d, k) for k in ("end_radius", "layback_angle", "axial_clearance")}, field: value}
+    )
     with pytest.raises(UserInputError, match=text.replace(".", r"\.")) as e:
         design_metrics(REF, OP, d, duration=1e-4)
     assert "\n" not in str(e.value)

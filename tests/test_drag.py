@@ -48,9 +48,7 @@ def test_constant_cd_is_quadratic_and_opposes_motion():
     f1, _ = _roller_cd1(v, 0.0)
     f2, _ = _roller_cd1(2 * v, 0.0)
     np.testing.assert_allclose(np.asarray(f2), 4 * np.asarray(f1), rtol=1e-12)
-    np.testing.assert_allclose(
-        np.asarray(f1), -0.5 * RHO * D * LB1 * np.linalg.norm(v) * v, rtol=1e-12
-    )
+    np.testing.assert_allclose(np.asarray(f1), -0.5 * RHO * D * LB1 * np.linalg.norm(v) * v, rtol=1e-12)
     f, _ = _roller(v, 0.0)
     assert float(np.dot(f, v)) < 0
     np.testing.assert_allclose(np.asarray(f), -np.asarray(_roller(-v, 0.0)[0]), rtol=1e-14)

@@ -23,8 +23,11 @@ def test_examples_exist():
     assert _files("*sweep*.toml")
 
 
-@pytest.mark.parametrize("path", [p for p in _files("*.toml") if "sweep" not in p.name
-                                  and p.name != "optimise.toml"], ids=lambda p: p.name)
+@pytest.mark.parametrize(
+    "path",
+    [p for p in _files("*.toml") if "sweep" not in p.name and p.name != "optimise.toml"],
+    ids=lambda p: p.name,
+)
 def test_configuration_loads(path):
     cfg = jb.load_config(path)
     cfg.bearing()

@@ -47,8 +47,7 @@ def _rolling_state(bearing, azimuth, ring_sign, axial=0.0, axis=None):
     else:
         radius, w_ring = r_o, 0.0
     e = X if axis is None else axis
-    return (radius, p, jnp.asarray(e), v, w, jnp.zeros(3), jnp.zeros(3), w_ring * X, e_rad,
-            w_ring, w_c)
+    return (radius, p, jnp.asarray(e), v, w, jnp.zeros(3), jnp.zeros(3), w_ring * X, e_rad, w_ring, w_c)
 
 
 @jax.jit
@@ -130,8 +129,16 @@ def test_large_end_radius_converges_to_corner():
     touched), e.g. for 1e3, 1e4, 1e6 m and the paper's 1e10 mm. With the flange almost square
     to the axis (theta_f = 1e-4 rad) the contact stays on the arc up to R_end = 33.7 m and the
     geometric difference shrinks monotonically to zero as R_end grows through it."""
-    keys = ("interference", "normal_force", "peak_pressure", "sliding_speed", "pv",
-            "contact_radius", "contact_height", "on_arc")
+    keys = (
+        "interference",
+        "normal_force",
+        "peak_pressure",
+        "sliding_speed",
+        "pv",
+        "contact_radius",
+        "contact_height",
+        "on_arc",
+    )
 
     def case(theta, target):
         b = with_design(_bearing(), layback_angle=theta)
@@ -152,11 +159,13 @@ def test_large_end_radius_converges_to_corner():
     errs = []
     for r_end in (0.5, 2.0, 8.0, 20.0, 30.0, 33.0, 1e3, 1e4, 1e6):
         r = _contact(with_design(b, end_radius=r_end), 1.0, 1.0, st)
-        errs.append(max(
-            abs(float(r.interference - ref.interference)),
-            abs(float(r.contact_radius - ref.contact_radius)),
-            float(jnp.max(jnp.abs(r.contact_point - ref.contact_point))),
-        ))
+        errs.append(
+            max(
+                abs(float(r.interference - ref.interference)),
+                abs(float(r.contact_radius - ref.contact_radius)),
+                float(jnp.max(jnp.abs(r.contact_point - ref.contact_point))),
+            )
+        )
         if r_end >= 1e3:
             for k in keys:
                 np.testing.assert_allclose(getattr(r, k), getattr(ref, k), rtol=1e-13)
@@ -182,8 +191,11 @@ def test_skewed_roller_contact_point(skew, side, ring_sign):
     n = side * math.cos(theta) * X - ring_sign * math.sin(theta) * e_rad
     p0 = side * float(b.raceway_width) / 2 * X + radius * e_rad
     ro = b.roller
-    x_cor, r_ce, r_cor = float(ro.corner_centre_offset), float(ro.corner_centre_radius), \
-        float(ro.corner_radius)
+    x_cor, r_ce, r_cor = (
+        float(ro.corner_centre_offset),
+        float(ro.corner_centre_radius),
+        float(ro.corner_radius),
+    )
 
     # arc end: sphere centre on the axis at s L_beb, contact point O + R_end n
     r_end = float(ro.end_radius)
@@ -214,10 +226,12 @@ def test_skewed_roller_contact_point(skew, side, ring_sign):
     np.testing.assert_allclose(np.linalg.norm(rel), r_ce, rtol=1e-12)
     angle = math.atan2(rel @ tang, rel @ (-ring_sign * e_rad))
     assert abs(angle) > 0.1 * abs(skew) and abs(angle) < 2 * abs(skew) / math.tan(theta)
-    np.testing.assert_allclose(res.contact_radius, np.linalg.norm(c_torus - p - ((c_torus - p)
-                               @ x_end) * x_end), rtol=1e-12)
-    np.testing.assert_allclose(np.linalg.norm(np.asarray(res.end_face_position)),
-                               float(res.contact_radius), rtol=1e-12)
+    np.testing.assert_allclose(
+        res.contact_radius, np.linalg.norm(c_torus - p - ((c_torus - p) @ x_end) * x_end), rtol=1e-12
+    )
+    np.testing.assert_allclose(
+        np.linalg.norm(np.asarray(res.end_face_position)), float(res.contact_radius), rtol=1e-12
+    )
 
 
 # -- Hertz: sphere on plane ----------------------------------------------------------------
@@ -244,14 +258,12 @@ def test_sphere_on_plane_force_and_pressure():
         np.testing.assert_allclose(q, 4 / 3 * e_star * math.sqrt(r_end) * delta**1.5, rtol=1e-9)
         p_exact = (6 * q * e_star**2 / (math.pi**3 * r_end**2)) ** (1 / 3)
         np.testing.assert_allclose(float(res.peak_pressure), p_exact, rtol=1e-9)
-        np.testing.assert_allclose(np.asarray(res.ellipse_semi_axes), math.sqrt(r_end * delta),
-                                   rtol=1e-6)
+        np.testing.assert_allclose(np.asarray(res.ellipse_semi_axes), math.sqrt(r_end * delta), rtol=1e-6)
         a_x, a_y = (float(x) for x in res.ellipse_semi_axes)
         np.testing.assert_allclose(a_x, a_y, rtol=1e-6)  # a circle
         a_exact = (3 * q * r_end / (4 * e_star)) ** (1 / 3)
         np.testing.assert_allclose(a_x, a_exact, rtol=1e-9)
-        np.testing.assert_allclose(res.pv, float(res.peak_pressure) * float(res.sliding_speed),
-                                   rtol=1e-12)
+        np.testing.assert_allclose(res.pv, float(res.peak_pressure) * float(res.sliding_speed), rtol=1e-12)
 
 
 def test_corner_ellipse_is_long_along_the_parallel():
@@ -289,14 +301,15 @@ def test_forces_moments_and_friction():
     u = np.asarray(res.sliding_velocity)
     speed = np.linalg.norm(u)
     np.testing.assert_allclose(float(res.sliding_speed), speed, rtol=1e-12)
-    np.testing.assert_allclose(f_t, -0.08 * q * u / math.sqrt(speed**2 + 1e-6), rtol=1e-12,
-                               atol=1e-12 * q)
+    np.testing.assert_allclose(f_t, -0.08 * q * u / math.sqrt(speed**2 + 1e-6), rtol=1e-12, atol=1e-12 * q)
     np.testing.assert_allclose(res.force_on_ring, -f, rtol=1e-15)
     c = np.asarray(res.contact_point)
-    np.testing.assert_allclose(res.moment_on_roller, np.cross(c - np.asarray(st[1]), f),
-                               rtol=1e-12, atol=1e-15)
-    np.testing.assert_allclose(res.moment_on_ring, np.cross(c - np.asarray(st[5]), -f),
-                               rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(
+        res.moment_on_roller, np.cross(c - np.asarray(st[1]), f), rtol=1e-12, atol=1e-15
+    )
+    np.testing.assert_allclose(
+        res.moment_on_ring, np.cross(c - np.asarray(st[5]), -f), rtol=1e-12, atol=1e-15
+    )
     # the sliding velocity from rigid-body kinematics, tangential part
     v_b = np.asarray(st[3]) + np.cross(np.asarray(st[4]), c - np.asarray(st[1]))
     v_r = np.asarray(st[6]) + np.cross(np.asarray(st[7]), c - np.asarray(st[5]))
@@ -316,8 +329,14 @@ def test_all_flange_contacts_matches_single_calls():
     e /= np.linalg.norm(e, axis=1, keepdims=True)
     v = rng.normal(0, 1, (z, 3))
     w = rng.normal(0, 100, (z, 3))
-    ring = dict(c_i=rng.normal(0, 1e-5, 3), v_i=rng.normal(0, 0.01, 3), w_i=OMEGA_I * X,
-                c_o=np.zeros(3), v_o=np.zeros(3), w_o=np.zeros(3))
+    ring = dict(
+        c_i=rng.normal(0, 1e-5, 3),
+        v_i=rng.normal(0, 0.01, 3),
+        w_i=OMEGA_I * X,
+        c_o=np.zeros(3),
+        v_o=np.zeros(3),
+        w_o=np.zeros(3),
+    )
     out = jax.jit(all_flange_contacts)(b, p, e, v, w, *ring.values())
     assert isinstance(out, FlangeContact)
     assert out.normal_force.shape == (z, 4) and out.contact_point.shape == (z, 4, 3)
@@ -325,12 +344,12 @@ def test_all_flange_contacts_matches_single_calls():
     for j, (g, s) in enumerate(FLANGE_ORDER):
         inner = g > 0
         rad = b.inner_raceway_radius if inner else b.outer_raceway_radius
-        c, vr, wr = ((ring["c_i"], ring["v_i"], ring["w_i"]) if inner
-                     else (ring["c_o"], ring["v_o"], ring["w_o"]))
+        c, vr, wr = (
+            (ring["c_i"], ring["v_i"], ring["w_i"]) if inner else (ring["c_o"], ring["v_o"], ring["w_o"])
+        )
         for i in (0, 3):
             one = roller_flange_contact(b, rad, s, g, p[i], e[i], v[i], w[i], c, vr, wr)
-            for leaf_all, leaf_one in zip(jax.tree_util.tree_leaves(out),
-                                          jax.tree_util.tree_leaves(one)):
+            for leaf_all, leaf_one in zip(jax.tree_util.tree_leaves(out), jax.tree_util.tree_leaves(one)):
                 np.testing.assert_allclose(leaf_all[i, j], leaf_one, rtol=1e-12, atol=1e-18)
     assert FLANGE_ORDER == ((1.0, -1.0), (1.0, 1.0), (-1.0, -1.0), (-1.0, 1.0))
 
@@ -360,9 +379,11 @@ def test_force_and_gradient_continuous_across_limited_circle():
     band = LIMITED_CIRCLE_BAND / (r_end * math.cos(a_lim))  # the band in angle
     thetas = jnp.asarray(a_lim + np.linspace(-1.5 * band, 2.5 * band, 1201))
     h = float(thetas[1] - thetas[0])
-    f = jax.jit(jax.vmap(lambda t: (q(t), dq(t), d2q(t),
-                                    _contact(with_design(b, layback_angle=t), 1.0, 1.0,
-                                             st).on_arc)))
+    f = jax.jit(
+        jax.vmap(
+            lambda t: (q(t), dq(t), d2q(t), _contact(with_design(b, layback_angle=t), 1.0, 1.0, st).on_arc)
+        )
+    )
     qs, dqs, d2qs, w = (np.asarray(x) for x in f(thetas))
     assert w[0] == 1.0 and w[-1] == 0.0 and np.any((w > 0.05) & (w < 0.95))
     assert np.all(np.isfinite(qs)) and np.all(np.isfinite(dqs)) and np.all(np.isfinite(d2qs))
@@ -393,12 +414,18 @@ def test_design_gradients_match_finite_differences(end):
     b, st = _design_pose()
     if end == "corner":
         b = b.with_flat_ends()
-    x0 = np.array([float(b.roller.end_radius) if end == "arc" else 80e-3,
-                   float(b.flange.layback_angle), float(b.flange.axial_clearance)])
+    x0 = np.array(
+        [
+            float(b.roller.end_radius) if end == "arc" else 80e-3,
+            float(b.flange.layback_angle),
+            float(b.flange.axial_clearance),
+        ]
+    )
 
     def outputs(x):
-        bb = with_design(b, end_radius=x[0] if end == "arc" else None, layback_angle=x[1],
-                         axial_clearance=x[2])
+        bb = with_design(
+            b, end_radius=x[0] if end == "arc" else None, layback_angle=x[1], axial_clearance=x[2]
+        )
         r = _contact(bb, 1.0, 1.0, st)
         return jnp.stack([r.contact_height, r.pv])
 
@@ -432,8 +459,9 @@ def test_finite_everywhere():
     st0 = _rolling_state(b, 0.0, 1.0)
 
     def total(bb, p, e, v, w):
-        r = roller_flange_contact(bb, bb.inner_raceway_radius, 1.0, 1.0, p, e, v, w,
-                                  jnp.zeros(3), jnp.zeros(3), jnp.zeros(3))
+        r = roller_flange_contact(
+            bb, bb.inner_raceway_radius, 1.0, 1.0, p, e, v, w, jnp.zeros(3), jnp.zeros(3), jnp.zeros(3)
+        )
         return sum(jnp.sum(x) for x in jax.tree_util.tree_leaves(r))
 
     grad = jax.jit(jax.grad(total, argnums=(0, 1, 2, 3, 4)))

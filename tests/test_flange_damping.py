@@ -48,8 +48,19 @@ def _impact(v_in: float) -> float:
 
     @jax.jit
     def normal_force(s, s_dot):
-        c = roller_flange_contact(b, radius, 1.0, 1.0, start + s * n, jnp.asarray(X), s_dot * n,
-                                  jnp.zeros(3), ring, jnp.zeros(3), jnp.zeros(3))
+        c = roller_flange_contact(
+            b,
+            radius,
+            1.0,
+            1.0,
+            start + s * n,
+            jnp.asarray(X),
+            s_dot * n,
+            jnp.zeros(3),
+            ring,
+            jnp.zeros(3),
+            jnp.zeros(3),
+        )
         return jnp.dot(c.force_on_roller, n), c.approach_rate
 
     def rhs(t, y):
@@ -58,9 +69,18 @@ def _impact(v_in: float) -> float:
 
     def separated(t, y):
         return y[0] - 0.0  # back at the starting gap
+
     separated.terminal, separated.direction = True, -1
-    sol = solve_ivp(rhs, (0.0, 1e-3), [1e-12, v_in], rtol=1e-10, atol=1e-15, events=separated,
-                    method="DOP853", max_step=2e-8)
+    sol = solve_ivp(
+        rhs,
+        (0.0, 1e-3),
+        [1e-12, v_in],
+        rtol=1e-10,
+        atol=1e-15,
+        events=separated,
+        method="DOP853",
+        max_step=2e-8,
+    )
     assert sol.status == 1, "the roller did not come back"
     # the approach rate seen by the contact is the closing speed along n
     np.testing.assert_allclose(float(normal_force(0.0, v_in)[1]), v_in, rtol=1e-12)
@@ -85,8 +105,19 @@ def test_roller_surface_speed_is_the_papers_definition():
     w = 2000.0
     out = {}
     for name, bb in (("arc", b), ("corner", b.with_flat_ends())):
-        c = roller_flange_contact(bb, radius, 1.0, 1.0, centre, jnp.asarray(X), jnp.zeros(3),
-                                  -w * jnp.asarray(X), jnp.zeros(3), jnp.zeros(3), jnp.zeros(3))
+        c = roller_flange_contact(
+            bb,
+            radius,
+            1.0,
+            1.0,
+            centre,
+            jnp.asarray(X),
+            jnp.zeros(3),
+            -w * jnp.asarray(X),
+            jnp.zeros(3),
+            jnp.zeros(3),
+            jnp.zeros(3),
+        )
         out[name] = float(c.roller_surface_speed)
     theta, r = float(b.flange.layback_angle), b.roller
     rho_arc = float(r.end_radius) * np.sin(theta)

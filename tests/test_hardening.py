@@ -38,6 +38,7 @@ class ReachedTheSolver(AssertionError):
 @pytest.fixture
 def no_solve(monkeypatch):
     """Any solve fails at once (before compiling) instead of running."""
+
     def sentinel(*args, **kwargs):
         raise ReachedTheSolver("the input reached the solver: it was not validated")
 
@@ -51,6 +52,7 @@ def reference():
 
 def strict_loads(text: str):
     """json.loads that rejects NaN / Infinity tokens (as strict parsers do)."""
+
     def bad(token):
         raise ValueError(f"non-standard JSON token {token}")
 
@@ -65,15 +67,22 @@ def dead_pid() -> int:
 
 
 # -- 1. the solver arguments of simulate (the issue's list) -------------------------------------
-@pytest.mark.parametrize("name,value", [
-    ("rtol", math.nan),  # ran for over 10 minutes on 0.1 ms
-    ("duration", 0.0),  # returned status 'ok' with NaN statistics
-    ("duration", math.nan),  # returned status 'ok' with NaN statistics
-    ("duration", -1e-4),  # an equinox/JAX runtime traceback
-    ("max_steps", 0),  # diffrax "Must have at least one checkpoint"
-    ("atol", -1.0),  # accepted
-    ("rtol", 1.0), ("atol", math.inf), ("max_steps", 2.5), ("num_saves", 0), ("progress", "yes"),
-])
+@pytest.mark.parametrize(
+    "name,value",
+    [
+        ("rtol", math.nan),  # ran for over 10 minutes on 0.1 ms
+        ("duration", 0.0),  # returned status 'ok' with NaN statistics
+        ("duration", math.nan),  # returned status 'ok' with NaN statistics
+        ("duration", -1e-4),  # an equinox/JAX runtime traceback
+        ("max_steps", 0),  # diffrax "Must have at least one checkpoint"
+        ("atol", -1.0),  # accepted
+        ("rtol", 1.0),
+        ("atol", math.inf),
+        ("max_steps", 2.5),
+        ("num_saves", 0),
+        ("progress", "yes"),
+    ],
+)
 def test_simulate_rejects_bad_solver_arguments(no_solve, reference, name, value):
     kwargs = {"duration": SHORT, name: value}
     with pytest.raises(jb.UserInputError, match=rf"^{name} = \S+: must be "):
@@ -81,8 +90,9 @@ def test_simulate_rejects_bad_solver_arguments(no_solve, reference, name, value)
 
 
 @pytest.mark.parametrize("entry", ["solve", "flange_functionals"])
-@pytest.mark.parametrize("name,value", [("duration", 0.0), ("rtol", math.nan), ("atol", -1.0),
-                                        ("max_steps", 0)])
+@pytest.mark.parametrize(
+    "name,value", [("duration", 0.0), ("rtol", math.nan), ("atol", -1.0), ("max_steps", 0)]
+)
 def test_solve_and_gradient_path_reject_bad_solver_arguments(no_solve, reference, entry, name, value):
     kwargs = {"duration": SHORT, name: value}
     duration = kwargs.pop("duration")
@@ -129,8 +139,12 @@ def test_traced_values_are_skipped_static_ones_checked(reference):
 
     bearing, op = reference
     # traced: the partial check leaves out every key that reads a traced leaf
-    jax.eval_shape(lambda d: jb.validate_bearing(eqx.tree_at(lambda b: b.roller.diameter, bearing, d),
-                                                 op, traced="skip"), 7.5e-3)
+    jax.eval_shape(
+        lambda d: jb.validate_bearing(
+            eqx.tree_at(lambda b: b.roller.diameter, bearing, d), op, traced="skip"
+        ),
+        7.5e-3,
+    )
     with pytest.raises(jb.UserInputError, match=r"^max_steps = 0"):
         jax.eval_shape(lambda d: jb.solve(bearing, op, d, max_steps=0), SHORT)
 
@@ -151,22 +165,26 @@ def test_solver_argument_table_is_extensible():
 def test_quasi_static_uses_the_schema(reference):
     bearing, _ = reference
     with pytest.raises(jb.ConfigError, match=r"^operating\.speed_rpm: -100\.0 rpm is out of range"):
-        jb.quasi_static(bearing, jb.OperatingPoint(inner_speed=jb.rpm_to_rad_s(-100.0),
-                                                   radial_load=1000.0, gravity=9.81))
+        jb.quasi_static(
+            bearing, jb.OperatingPoint(inner_speed=jb.rpm_to_rad_s(-100.0), radial_load=1000.0, gravity=9.81)
+        )
 
 
 def test_nan_rtol_in_a_subprocess_fails_fast():
     """The real thing, no sentinel: rtol = nan is refused at once (it used to hang)."""
-    code = ("import math, jaxbearing as jb\n"
-            "jb.simulate(jb.reference_bearing(), jb.reference_operating_point(), "
-            "duration=1e-4, rtol=math.nan)\n")
+    code = (
+        "import math, jaxbearing as jb\n"
+        "jb.simulate(jb.reference_bearing(), jb.reference_operating_point(), "
+        "duration=1e-4, rtol=math.nan)\n"
+    )
     env = dict(os.environ, JAX_PLATFORMS="cpu", PYTHONPATH=str(REPO))
-    proc = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True,
-                          timeout=120, cwd=REPO)
+    proc = subprocess.run(
+        [sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=120, cwd=REPO
+    )
     assert proc.returncode == 1
     assert proc.stderr.strip().splitlines()[-1] == (
-        "jaxbearing._errors.UserInputError: rtol = nan: must be in (0, 1) and finite "
-        "(relative tolerance)")
+        "jaxbearing._errors.UserInputError: rtol = nan: must be in (0, 1) and finite (relative tolerance)"
+    )
 
 
 # -- 2. the optimise bounds use the bearing's roller ---------------------------------------------
@@ -178,8 +196,9 @@ def test_optimise_bounds_use_the_actual_roller():
     bounds = opt.bounds_from_engineering(end_radius_mm=[4.0, 120.0])  # > 3.75 of the reference
     opt.make_problem(cfg.bearing(), op, bounds=bounds)
     big = cfg.replace(**{"roller.diameter_mm": 9.0}).bearing()  # D/2 = 4.5 mm
-    with pytest.raises(jb.UserInputError,
-                       match=r"^bounds\.end_radius_mm lower bound = 4\.0: must be > D/2 = 4\.5 mm"):
+    with pytest.raises(
+        jb.UserInputError, match=r"^bounds\.end_radius_mm lower bound = 4\.0: must be > D/2 = 4\.5 mm"
+    ):
         opt.make_problem(big, op, bounds=bounds)
     small = cfg.replace(**{"roller.diameter_mm": 6.0}).bearing()  # D/2 = 3 mm
     opt.make_problem(small, op, bounds=opt.bounds_from_engineering(end_radius_mm=[3.5, 120.0]))
@@ -191,8 +210,14 @@ def test_optimise_bounds_use_the_actual_roller():
 def test_strict_json_nulls_with_reasons(tmp_path):
     from jaxbearing.io import dumps_strict, write_json
 
-    doc = {"status": "failed: x", "a": math.nan, "b": {"c": [1.0, np.inf]}, "d": np.float64(2.0),
-           "e": np.int32(3), "f": None}
+    doc = {
+        "status": "failed: x",
+        "a": math.nan,
+        "b": {"c": [1.0, np.inf]},
+        "d": np.float64(2.0),
+        "e": np.int32(3),
+        "f": None,
+    }
     text = dumps_strict(doc, reason="the run failed")
     out = strict_loads(text)
     assert out["a"] is None and out["b"]["c"] == [1.0, None] and out["d"] == 2.0 and out["e"] == 3
@@ -207,9 +232,17 @@ def _summary(status: str, height: float) -> dict:
     from jaxbearing.cli._simulate import _TABLE_ROWS
 
     block = {key: dict(stats) for key, *_ in _TABLE_ROWS}
-    block.update(status=status, on_arc_fraction=None, flange_contact_events=3, cage_speed_rpm=1.0,
-                 kinematic_cage_speed_rpm=1.0, cage_slip=math.nan, num_steps=10,
-                 wall_time_s=1.0, compile_time_s=1.0)
+    block.update(
+        status=status,
+        on_arc_fraction=None,
+        flange_contact_events=3,
+        cage_speed_rpm=1.0,
+        kinematic_cage_speed_rpm=1.0,
+        cage_slip=math.nan,
+        num_steps=10,
+        wall_time_s=1.0,
+        compile_time_s=1.0,
+    )
     return block
 
 
@@ -258,9 +291,17 @@ def test_progress_meter_says_where_a_failed_solve_stopped(capsys):
 
     def run(max_steps):
         return diffrax.diffeqsolve(
-            diffrax.ODETerm(lambda t, y, args: -y), diffrax.Tsit5(), 0.0, 10.0, 0.01, jnp.ones(()),
+            diffrax.ODETerm(lambda t, y, args: -y),
+            diffrax.Tsit5(),
+            0.0,
+            10.0,
+            0.01,
+            jnp.ones(()),
             stepsize_controller=diffrax.PIDController(rtol=1e-10, atol=1e-10),
-            max_steps=max_steps, throw=False, progress_meter=SolveProgress())
+            max_steps=max_steps,
+            throw=False,
+            progress_meter=SolveProgress(),
+        )
 
     ok = run(10_000)
     out = capsys.readouterr().out
@@ -282,9 +323,13 @@ def _fake_batch(spec, batch: int) -> dict:
     cases = spec.batch_cases(batch)
     n = len(cases)
     data = {name: np.full(n, 1.0 + batch) for name in variable_names()}
-    data.update(case_index=cases, status=np.asarray(["ok"] * n), result_code=np.zeros(n, np.int32),
-                contact_position=np.zeros((n, spec.max_positions, 2)),
-                contact_position_count=np.zeros(n, np.int32))
+    data.update(
+        case_index=cases,
+        status=np.asarray(["ok"] * n),
+        result_code=np.zeros(n, np.int32),
+        contact_position=np.zeros((n, spec.max_positions, 2)),
+        contact_position_count=np.zeros(n, np.int32),
+    )
     return data
 
 
@@ -345,8 +390,11 @@ def test_stale_temporary_files_are_removed(tmp_path, fake_solves):
     batches.mkdir(parents=True)
     host = socket.gethostname().replace(".", "_")
     dead = dead_pid()
-    stale = [batches / f".batch_00000.npz.tmp{dead}",  # the name older versions wrote
-             batches / f".batch_00001.npz.{host}.{dead}.tmp", tmp_path / f".spec.json.{host}.{dead}.tmp"]
+    stale = [
+        batches / f".batch_00000.npz.tmp{dead}",  # the name older versions wrote
+        batches / f".batch_00001.npz.{host}.{dead}.tmp",
+        tmp_path / f".spec.json.{host}.{dead}.tmp",
+    ]
     live = batches / f".batch_00001.npz.{host}.{os.getppid()}.tmp"  # a writer that still runs
     for p in (*stale, live):
         p.write_bytes(b"partial")
@@ -361,7 +409,9 @@ def test_second_sweep_into_a_locked_directory_exits_2(tmp_path, fake_solves, cap
     spec_path = SWEEPS / "small.toml"
     spec = load_sweep_spec(spec_path)
     with acquire_lock(tmp_path, "sweep.0.lock", what="sweep"):
-        with pytest.raises(DirectoryInUse, match=rf"^{tmp_path} is in use by another sweep \(pid {os.getpid()}"):
+        with pytest.raises(
+            DirectoryInUse, match=rf"^{tmp_path} is in use by another sweep \(pid {os.getpid()}"
+        ):
             run_sweep(spec, tmp_path, progress=False, assemble_results=False)
         capsys.readouterr()
         assert cli_main(["sweep", str(spec_path), "--out", str(tmp_path), "--no-progress"]) == 2
@@ -423,8 +473,11 @@ def test_config_check_runs_the_checks_of_simulate(tmp_path, capsys, no_solve, te
     assert sim_err == [f"jaxbearing simulate: error: {check_err}"]
     # the override that makes it runnable
     corner = tmp_path / "corner.toml"
-    corner.write_text(text.replace('end = "arc"', 'end = "corner"') if "arc" in text
-                      else text + '[simulation]\nend = "corner"\n')
+    corner.write_text(
+        text.replace('end = "arc"', 'end = "corner"')
+        if "arc" in text
+        else text + '[simulation]\nend = "corner"\n'
+    )
     assert cli_main(["config", "check", str(corner)]) == 0
 
 
@@ -436,8 +489,10 @@ def test_simulate_errors_name_the_file_and_the_option(tmp_path, capsys, no_solve
     assert len(err) == 1 and err[0].startswith(f"jaxbearing simulate: error: {cfg}: roller.corner_radius_mm:")
     assert cli_main(["simulate", "--duration-ms", "-1"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert err == ["jaxbearing simulate: error: --duration-ms: simulation.duration_ms: -1.0 ms is out "
-                   "of range: must be in (0, 10000] ms"]
+    assert err == [
+        "jaxbearing simulate: error: --duration-ms: simulation.duration_ms: -1.0 ms is out "
+        "of range: must be in (0, 10000] ms"
+    ]
 
 
 def test_simulate_out_naming_a_file_is_one_line(tmp_path, capsys, no_solve):
@@ -445,8 +500,9 @@ def test_simulate_out_naming_a_file_is_one_line(tmp_path, capsys, no_solve):
     target.write_text("keep me")
     assert cli_main(["simulate", "--out", str(target), "--no-progress"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert err == [f"jaxbearing simulate: error: --out {target}: exists and is not a directory; "
-                   "name a directory"]
+    assert err == [
+        f"jaxbearing simulate: error: --out {target}: exists and is not a directory; name a directory"
+    ]
     assert target.read_text() == "keep me"
 
 

@@ -81,7 +81,8 @@ def test_imports_point_down_and_use_public_names(path):
         if tgt_layer == src_layer or type_checking:  # annotations only: no run-time dependency
             continue
         assert RANK[tgt_layer] < RANK[src_layer], (
-            f"{source}:{line} imports {target}: layer {tgt_layer!r} is not below {src_layer!r}")
+            f"{source}:{line} imports {target}: layer {tgt_layer!r} is not below {src_layer!r}"
+        )
         private = [p for p in target.split(".")[2:] if p.startswith("_")]
         if tgt_layer != "_errors":
             assert not private, f"{source}:{line} imports a private module of another layer: {target}"
@@ -112,7 +113,7 @@ def test_no_import_cycle_between_modules():
             if dep in (node.rpartition(".")[0],):  # a module's own package __init__ (parent)
                 continue
             if state.get(dep) == 1:
-                cycle = stack[stack.index(dep):] + [dep]
+                cycle = stack[stack.index(dep) :] + [dep]
                 pytest.fail("import cycle: " + " -> ".join(cycle))
             if dep not in state:
                 visit(dep)

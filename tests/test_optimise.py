@@ -44,10 +44,12 @@ def test_bounds_scaling_roundtrip_and_fixed_variable():
 
 @pytest.mark.parametrize(
     "kw,text",
-    [(dict(end_radius_mm=[-2, 120]), "bounds.end_radius_mm lower bound = -2"),  # > D/2: make_problem
-     (dict(layback_angle_deg=[2.0, 1.0]), "lower bound above upper bound"),
-     (dict(axial_clearance_mm=[0.1]), "expected \\[lower, upper\\]"),
-     (dict(layback_angle_deg=[1.0, 50.0]), "bounds.layback_angle_deg upper bound = 50")],
+    [
+        (dict(end_radius_mm=[-2, 120]), "bounds.end_radius_mm lower bound = -2"),  # > D/2: make_problem
+        (dict(layback_angle_deg=[2.0, 1.0]), "lower bound above upper bound"),
+        (dict(axial_clearance_mm=[0.1]), "expected \\[lower, upper\\]"),
+        (dict(layback_angle_deg=[1.0, 50.0]), "bounds.layback_angle_deg upper bound = 50"),
+    ],
 )
 def test_bad_bounds_are_one_line_errors(kw, text):
     with pytest.raises(jb.UserInputError, match=text) as e:
@@ -67,8 +69,7 @@ def test_operating_envelope_is_speed_load_product():
 
 
 def test_smooth_max_and_mean_aggregation():
-    p = opt.make_problem(REF, OP, speeds_rpm=[5000, 10000, 20000], weights=[1, 1, 2],
-                         temperature=0.01)
+    p = opt.make_problem(REF, OP, speeds_rpm=[5000, 10000, 20000], weights=[1, 1, 2], temperature=0.01)
     pv = jnp.array([1.0, 3.0, 2.0])
     # log-sum-exp: max + T log(sum w exp((pv - max)/T)) -> within T log(w_max) of the max
     assert float(p.combine(pv)) == pytest.approx(3.0 + 0.01 * math.log(0.25), rel=1e-9)
@@ -143,8 +144,19 @@ def test_search_no_worse_than_grid(searched):
 
 # -- command line -------------------------------------------------------------------------------
 def _cli_args(out):
-    return ["run", "--starts", str(STARTS), "--iterations", str(ITERATIONS), "--duration-ms",
-            str(DURATION_MS), "--clearance-mm", f"{CLEARANCE_MM},{CLEARANCE_MM}", "--out", str(out)]
+    return [
+        "run",
+        "--starts",
+        str(STARTS),
+        "--iterations",
+        str(ITERATIONS),
+        "--duration-ms",
+        str(DURATION_MS),
+        "--clearance-mm",
+        f"{CLEARANCE_MM},{CLEARANCE_MM}",
+        "--out",
+        str(out),
+    ]
 
 
 def test_cli_end_to_end(tmp_path, capsys, searched):
@@ -172,11 +184,13 @@ def test_cli_no_feasible_design_exits_nonzero(tmp_path, capsys):
 
 @pytest.mark.parametrize(
     "args,text",
-    [(["--speeds-rpm", "fast"], "--speeds-rpm = 'fast'"),
-     (["--end-radius-mm", "60"], "--end-radius-mm = '60': expected LOWER,UPPER"),
-     (["--starts", "0"], "starts = 0: must be > 0"),
-     (["--layback-deg", "1,60"], "bounds.layback_angle_deg upper bound = 60"),
-     (["--config", "/nonexistent/x.toml"], "file: cannot read")],
+    [
+        (["--speeds-rpm", "fast"], "--speeds-rpm = 'fast'"),
+        (["--end-radius-mm", "60"], "--end-radius-mm = '60': expected LOWER,UPPER"),
+        (["--starts", "0"], "starts = 0: must be > 0"),
+        (["--layback-deg", "1,60"], "bounds.layback_angle_deg upper bound = 60"),
+        (["--config", "/nonexistent/x.toml"], "file: cannot read"),
+    ],
 )
 def test_cli_bad_input_one_line_exit_2(tmp_path, capsys, args, text):
     assert main(["run", "--out", str(tmp_path), *args]) == 2

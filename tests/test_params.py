@@ -12,8 +12,14 @@ from jaxbearing.geometry import arc_protrusion, limited_circle_radius, roller_ma
 
 
 def _roller(**kw):
-    base = dict(diameter=7.5e-3, length=8e-3, central_length=4.5e-3, crown_drop=4e-6,
-                corner_radius=0.4e-3, end_radius=jnp.inf)
+    base = dict(
+        diameter=7.5e-3,
+        length=8e-3,
+        central_length=4.5e-3,
+        crown_drop=4e-6,
+        corner_radius=0.4e-3,
+        end_radius=jnp.inf,
+    )
     base.update(kw)
     return jb.Roller(**base)
 
@@ -61,8 +67,9 @@ def test_arc_end_limits():
 
 def test_masses_differentiable():
     b = jb.reference_bearing()
-    g = jax.grad(lambda rr: roller_mass_properties(eqx.tree_at(lambda r: r.end_radius, b.roller, rr), 7830.0)[0])(
-        jnp.asarray(80e-3))
+    g = jax.grad(
+        lambda rr: roller_mass_properties(eqx.tree_at(lambda r: r.end_radius, b.roller, rr), 7830.0)[0]
+    )(jnp.asarray(80e-3))
     assert jnp.isfinite(g) and g < 0  # larger end radius, flatter caps, less mass
 
 
@@ -70,8 +77,9 @@ def test_reference_bearing_summary():
     b = jb.reference_bearing()
     op = jb.reference_operating_point()
     assert b.num_rollers == 26 and b.num_slices == 31
-    np.testing.assert_allclose(jb.rad_s_to_rpm(jb.kinematic_cage_speed(b, op)),
-                               20000 * (1 - 7.5 / 85) / 2, rtol=1e-12)
+    np.testing.assert_allclose(
+        jb.rad_s_to_rpm(jb.kinematic_cage_speed(b, op)), 20000 * (1 - 7.5 / 85) / 2, rtol=1e-12
+    )
     assert 0.05 < float(b.cage_mass) < 0.15
     assert b.roller_inertia.shape == (2,)
 

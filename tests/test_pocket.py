@@ -106,9 +106,7 @@ def test_action_reaction_and_cage_moment_arm():
     r = _contact(p, X, ZERO, ZERO, pc, t, ZERO, ZERO, cage_centre)
     np.testing.assert_allclose(np.asarray(r.force_on_cage), -np.asarray(r.force_on_roller))
     f_t = float(np.dot(r.force_on_cage, t))
-    np.testing.assert_allclose(
-        float(r.moment_on_cage[0]), float(BEARING.pitch_diameter) / 2 * f_t, rtol=1e-9
-    )
+    np.testing.assert_allclose(float(r.moment_on_cage[0]), float(BEARING.pitch_diameter) / 2 * f_t, rtol=1e-9)
     # moving bodies, friction on: total moment about the cage centre is zero
     v = np.array([0.01, 0.3, -0.2])
     w = np.array([8000.0, 20.0, -15.0])
@@ -117,11 +115,7 @@ def test_action_reaction_and_cage_moment_arm():
     r = _contact(p, X, v, w, pc, t, vc, wc, cage_centre)
     f = np.asarray(r.force_on_roller)
     np.testing.assert_allclose(np.asarray(r.force_on_cage), -f)
-    total = (
-        np.asarray(r.moment_on_roller)
-        + np.cross(p - cage_centre, f)
-        + np.asarray(r.moment_on_cage)
-    )
+    total = np.asarray(r.moment_on_roller) + np.cross(p - cage_centre, f) + np.asarray(r.moment_on_cage)
     np.testing.assert_allclose(total, 0.0, atol=1e-12 * np.abs(f).max())
 
 
@@ -178,6 +172,7 @@ def test_gradients_finite_at_zero_interference_and_zero_sliding():
     for y in (0.0, c_p / 2, c_p / 2 + 1e-6, -c_p / 2):
         g = grad(jnp.asarray(y), jnp.zeros(3), jnp.asarray(0.0))
         assert all(np.all(np.isfinite(np.asarray(x))) for x in g)
+
     # at exactly zero interference the load law has a finite slope: pushing the roller further
     # into the +wall makes the (signed) normal force more negative
     def normal(y):

@@ -36,9 +36,12 @@ from jaxbearing.io._validation import REFERENCE_VALUES
 
 EXAMPLES = int(os.environ.get("JAXBEARING_PROPERTY_EXAMPLES", "30"))
 EXAMPLE_LIMIT_S = 30
-SETTINGS = settings(max_examples=EXAMPLES, deadline=None, derandomize=EXAMPLES < 200,
-                    suppress_health_check=[HealthCheck.function_scoped_fixture,
-                                           HealthCheck.too_slow])
+SETTINGS = settings(
+    max_examples=EXAMPLES,
+    deadline=None,
+    derandomize=EXAMPLES < 200,
+    suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
+)
 SHORT = 0.05e-3
 BEARING, OP = jb.reference_bearing(), jb.reference_operating_point()
 DESIGN = jb.DesignVariables(end_radius=0.08, layback_angle=0.028, axial_clearance=0.15e-3)
@@ -95,17 +98,25 @@ def invalid_for_rule(rule: Rule):
         return st.one_of(*options, *wrong[:2], st.booleans())
     options = [st.sampled_from([math.nan, math.inf, -math.inf])]
     if rule.lo is not None:
-        options.append(st.floats(min_value=-1e12, max_value=rule.lo - (0 if not rule.lo_closed else _margin(rule.lo))))
+        options.append(
+            st.floats(min_value=-1e12, max_value=rule.lo - (0 if not rule.lo_closed else _margin(rule.lo)))
+        )
     if rule.hi is not None:
-        options.append(st.floats(min_value=rule.hi + (0 if not rule.hi_closed else _margin(rule.hi)), max_value=1e12))
+        options.append(
+            st.floats(min_value=rule.hi + (0 if not rule.hi_closed else _margin(rule.hi)), max_value=1e12)
+        )
     return st.one_of(*options, *wrong)
 
 
 #: the valid ranges the issue asks for, written out here (not read from the code's table, so a
 #: loosened rule in `jaxbearing.io.SOLVER_ARGUMENTS` is caught)
 EXPECTED = {
-    "duration": real(0), "rtol": real(0, 1), "atol": real(0, 1), "max_steps": count(1, 10**9),
-    "num_saves": count(0), "progress": Rule("bool"),
+    "duration": real(0),
+    "rtol": real(0, 1),
+    "atol": real(0, 1),
+    "max_steps": count(1, 10**9),
+    "num_saves": count(0),
+    "progress": Rule("bool"),
 }
 
 
@@ -165,8 +176,13 @@ def bad_pytrees(draw, op_fields: bool = True):
     keys = [k for k in FIELD_KEYS if op_fields or not k.attr.startswith("op.")]
     key = draw(st.sampled_from(keys))
     if key.path == "operating.gravity":
-        value = draw(st.one_of(st.floats(max_value=-1e-9), st.floats(min_value=100.001),
-                               st.sampled_from([math.nan, math.inf])))
+        value = draw(
+            st.one_of(
+                st.floats(max_value=-1e-9),
+                st.floats(min_value=100.001),
+                st.sampled_from([math.nan, math.inf]),
+            )
+        )
     else:
         value = draw(_config_value_invalid(key))
     bearing, op = _with_value(BEARING, OP, key, value)
@@ -228,14 +244,20 @@ def test_gradient_path_solver_arguments(entry, case):
 
 
 # -- the command line, the optimiser and the sweep -----------------------------------------------
-OPTIONS = {"--speed-rpm": "operating.speed_rpm", "--load-N": "operating.radial_load_N",
-           "--duration-ms": "simulation.duration_ms"}
+OPTIONS = {
+    "--speed-rpm": "operating.speed_rpm",
+    "--load-N": "operating.radial_load_N",
+    "--duration-ms": "simulation.duration_ms",
+}
 
 
 @SETTINGS
-@given(option=st.sampled_from(sorted(OPTIONS)),
-       value=st.one_of(st.floats(max_value=-1e-9), st.floats(min_value=1e9),
-                       st.sampled_from(["nan", "inf", "-inf"])))
+@given(
+    option=st.sampled_from(sorted(OPTIONS)),
+    value=st.one_of(
+        st.floats(max_value=-1e-9), st.floats(min_value=1e9), st.sampled_from(["nan", "inf", "-inf"])
+    ),
+)
 def test_simulate_command_line(option, value):
     from jaxbearing.cli import main
 
@@ -260,15 +282,23 @@ def test_optimise_problem_arguments(case):
 
 
 @SETTINGS
-@given(field=st.sampled_from(["end_radius_mm", "layback_angle_deg", "axial_clearance_mm"]),
-       which=st.sampled_from([0, 1]),
-       value=st.one_of(st.sampled_from([math.nan, math.inf, -math.inf]), st.floats(max_value=-1e-9),
-                       st.floats(min_value=45.0, max_value=1e6)))
+@given(
+    field=st.sampled_from(["end_radius_mm", "layback_angle_deg", "axial_clearance_mm"]),
+    which=st.sampled_from([0, 1]),
+    value=st.one_of(
+        st.sampled_from([math.nan, math.inf, -math.inf]),
+        st.floats(max_value=-1e-9),
+        st.floats(min_value=45.0, max_value=1e6),
+    ),
+)
 def test_optimise_bounds(field, which, value):
     import optimise as opt
 
-    pair = {"end_radius_mm": [60.0, 120.0], "layback_angle_deg": [1.0, 2.0],
-            "axial_clearance_mm": [0.1, 0.3]}[field]
+    pair = {
+        "end_radius_mm": [60.0, 120.0],
+        "layback_angle_deg": [1.0, 2.0],
+        "axial_clearance_mm": [0.1, 0.3],
+    }[field]
     if field != "layback_angle_deg" and math.isfinite(value) and value > 0:
         value = -value  # a large length is a valid bound; make it negative
     pair[which] = value
@@ -283,8 +313,11 @@ def test_optimise_bounds(field, which, value):
 
 
 @SETTINGS
-@given(case=st.sampled_from([k for k in FIELD_KEYS if k.kind is float]).flatmap(
-    lambda k: st.tuples(st.just(k), _config_value_invalid(k))))
+@given(
+    case=st.sampled_from([k for k in FIELD_KEYS if k.kind is float]).flatmap(
+        lambda k: st.tuples(st.just(k), _config_value_invalid(k))
+    )
+)
 def test_sweep_spec_axes(case):
     from jaxbearing.sweep import SweepSpecError, loads_sweep_spec
 
@@ -297,15 +330,13 @@ def test_sweep_spec_axes(case):
 
 
 @SETTINGS
-@given(process_id=st.one_of(st.integers(max_value=-1), st.integers(min_value=4), st.floats(),
-                            st.booleans()))
+@given(process_id=st.one_of(st.integers(max_value=-1), st.integers(min_value=4), st.floats(), st.booleans()))
 def test_sweep_process_layout(process_id, tmp_path_factory):
     from jaxbearing.sweep import load_sweep_spec, run_sweep
 
     spec = load_sweep_spec(os.path.join(os.path.dirname(__file__), "sweeps", "small.toml"))
     out = tmp_path_factory.mktemp("layout")
-    assert_rejected(lambda: run_sweep(spec, out, process_id=process_id, num_processes=4),
-                    "process_id")
+    assert_rejected(lambda: run_sweep(spec, out, process_id=process_id, num_processes=4), "process_id")
     assert not any(out.iterdir())
 
 

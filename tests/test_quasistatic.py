@@ -190,13 +190,21 @@ def test_solution_is_an_equilibrium_of_the_dynamic_contact():
     inner = contact(b, 1.0, b.inner_raceway_radius, p, e, zeros, zeros, qs.inner_ring_centre, ZERO, ZERO)
     outer = contact(b, -1.0, b.outer_raceway_radius, p, e, zeros, zeros, ZERO, ZERO, ZERO)
     np.testing.assert_allclose(np.asarray(outer.normal_load), np.asarray(qs.outer_load), rtol=1e-9)
-    np.testing.assert_allclose(np.asarray(outer.slice_loads), np.asarray(qs.outer_slice_loads), rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(
+        np.asarray(outer.slice_loads), np.asarray(qs.outer_slice_loads), rtol=1e-9, atol=1e-12
+    )
     assert float(inner.normal_load[0]) == pytest.approx(float(qs.inner_load[0]), rel=1e-9)
     loaded = np.asarray(qs.inner_load) > 1.0
-    np.testing.assert_allclose(np.asarray(inner.normal_load)[loaded], np.asarray(qs.inner_load)[loaded], rtol=5e-3)
+    np.testing.assert_allclose(
+        np.asarray(inner.normal_load)[loaded], np.asarray(qs.inner_load)[loaded], rtol=5e-3
+    )
     # net radial force on each roller = -m_b r_j omega_c^2 (centripetal) up to the linearised ring
     # kinematics (< 0.1 N) and F_c taken at the pitch radius, m_b (r_j - d_m/2) omega_c^2 ~ 0.03 N
-    f = inner.force_on_roller + outer.force_on_roller + b.roller_mass * op.gravity * jnp.array([0.0, 0.0, 1.0])
+    f = (
+        inner.force_on_roller
+        + outer.force_on_roller
+        + b.roller_mass * op.gravity * jnp.array([0.0, 0.0, 1.0])
+    )
     radial = jnp.sum(f * qs.radial_units, axis=-1)
     need = -b.roller_mass * qs.roller_radius * qs.cage_speed**2
     np.testing.assert_allclose(np.asarray(radial), np.asarray(need), rtol=0, atol=0.2)

@@ -79,7 +79,9 @@ def test_slice_positions_and_circular_crown():
     # no crown: exactly zero everywhere, finite gradient
     r0 = _bearing(crown=0.0).roller
     assert np.all(np.asarray(crown_drop(r0, x)) == 0.0)
-    assert np.isfinite(float(jax.grad(lambda c: crown_drop(eqx.tree_at(lambda q: q.crown_drop, r0, c), 3e-3))(0.0)))
+    assert np.isfinite(
+        float(jax.grad(lambda c: crown_drop(eqx.tree_at(lambda q: q.crown_drop, r0, c), 3e-3))(0.0))
+    )
 
 
 @pytest.mark.parametrize("ring_sign", [1.0, -1.0])
@@ -97,7 +99,9 @@ def test_uniform_approach_reproduces_whole_contact_law(ring_sign):
     np.testing.assert_allclose(np.asarray(c.interference), a, rtol=1e-9)
     # pure normal force along the raceway normal (into the roller), no traction at rest
     np.testing.assert_allclose(np.asarray(c.force_on_roller), ring_sign * expected * Z, rtol=1e-9, atol=1e-9)
-    np.testing.assert_allclose(np.asarray(c.normals), np.broadcast_to(ring_sign * Z, (b.num_slices, 3)), atol=1e-15)
+    np.testing.assert_allclose(
+        np.asarray(c.normals), np.broadcast_to(ring_sign * Z, (b.num_slices, 3)), atol=1e-15
+    )
     assert np.all(np.asarray(c.slice_traction) == 0.0)
     # symmetric slices: no moment about the roller centre
     np.testing.assert_allclose(np.asarray(c.moment_on_roller), 0.0, atol=1e-9 * expected * 1e-3)
@@ -122,8 +126,12 @@ def _rim_interference(b, ring_sign, radius, p, e, c):
         phis = np.linspace(0, 2 * np.pi, 721)
         vals = np.array([sign * dist(f) for f in phis])
         k = int(np.argmin(vals))
-        res = minimize_scalar(lambda f: sign * dist(f), bounds=(phis[k] - 0.02, phis[k] + 0.02),
-                              method="bounded", options={"xatol": 1e-12})
+        res = minimize_scalar(
+            lambda f: sign * dist(f),
+            bounds=(phis[k] - 0.02, phis[k] + 0.02),
+            method="bounded",
+            options={"xatol": 1e-12},
+        )
         d_ext = sign * res.fun
         out.append(radius - d_ext if ring_sign > 0 else d_ext - radius)
     return np.array(out)
@@ -144,7 +152,9 @@ def test_tilted_skewed_interference_matches_rim_search(ring_sign):
         c = np.array([0.0, *rng.uniform(-2e-5, 2e-5, size=2)])
         r_b = float(b.pitch_diameter) / 2 + rng.uniform(-5e-6, 5e-6)
         p = r_b * e_r + rng.uniform(-1e-4, 1e-4) * X
-        delta, _, _ = raceway_slice_geometry(b, ring_sign, radius, jnp.asarray(p), jnp.asarray(e), jnp.asarray(c))
+        delta, _, _ = raceway_slice_geometry(
+            b, ring_sign, radius, jnp.asarray(p), jnp.asarray(e), jnp.asarray(c)
+        )
         oracle = _rim_interference(b, ring_sign, radius, p, e, c)
         # documented approximation: raceway curvature across the footprint, ~1e-11 m at 10 mrad
         np.testing.assert_allclose(np.asarray(delta), oracle, rtol=0, atol=1e-10)
@@ -197,7 +207,9 @@ def test_crown_reduces_end_slice_loads():
 
 def _outputs(b, p, e, v, w):
     c = raceway_contact(b, 1.0, b.inner_raceway_radius, p, e, v, w, ZERO, ZERO, jnp.asarray(2000.0 * X))
-    return jnp.concatenate([c.force_on_roller, c.moment_on_roller, c.normal_load[None], c.mean_sliding_speed[None]])
+    return jnp.concatenate(
+        [c.force_on_roller, c.moment_on_roller, c.normal_load[None], c.mean_sliding_speed[None]]
+    )
 
 
 _jac_fwd = jax.jit(jax.jacfwd(_outputs, argnums=(1, 2, 3, 4)))
@@ -251,8 +263,12 @@ def test_forces_and_moments_on_roller_and_ring_are_opposite():
     assert np.linalg.norm(f) > 10.0 and np.linalg.norm(np.asarray(c.slice_traction)) > 1.0
     np.testing.assert_array_equal(np.asarray(c.force_on_ring), -f)
     # total moment about the origin vanishes: M_b + p x F_b + M_r + c_r x F_r = 0
-    total = (np.asarray(c.moment_on_roller) + np.cross(np.asarray(p), f)
-             + np.asarray(c.moment_on_ring) + np.cross(np.asarray(c_r), np.asarray(c.force_on_ring)))
+    total = (
+        np.asarray(c.moment_on_roller)
+        + np.cross(np.asarray(p), f)
+        + np.asarray(c.moment_on_ring)
+        + np.cross(np.asarray(c_r), np.asarray(c.force_on_ring))
+    )
     scale = np.linalg.norm(f) * float(b.pitch_diameter)
     assert np.linalg.norm(total) < 1e-12 * scale
     # and the per-slice forces add up to the resultant
@@ -267,18 +283,30 @@ def test_hunt_crossley_damping_vanishes_with_contact():
     rest = _contact(b, 1.0, b.inner_raceway_radius, p, jnp.asarray(X), ZERO, ZERO, ZERO, ZERO, ZERO)
     for vn in (0.1, -0.1, 1.0):
         # roller moving towards the inner raceway (-Z) closes the contact: d(delta)/dt = vn
-        c = _contact(b, 1.0, b.inner_raceway_radius, p, jnp.asarray(X), jnp.asarray(-vn * Z), ZERO, ZERO, ZERO, ZERO)
-        assert float(c.normal_load) == pytest.approx(float(rest.normal_load) * (1 + 1.5 * alpha * vn), rel=1e-12)
+        c = _contact(
+            b, 1.0, b.inner_raceway_radius, p, jnp.asarray(X), jnp.asarray(-vn * Z), ZERO, ZERO, ZERO, ZERO
+        )
+        assert float(c.normal_load) == pytest.approx(
+            float(rest.normal_load) * (1 + 1.5 * alpha * vn), rel=1e-12
+        )
     # separating faster than 1/(1.5 alpha): no adhesive pull, the force fades to zero
-    c = _contact(b, 1.0, b.inner_raceway_radius, p, jnp.asarray(X), jnp.asarray(10.0 * Z), ZERO, ZERO, ZERO, ZERO)
+    c = _contact(
+        b, 1.0, b.inner_raceway_radius, p, jnp.asarray(X), jnp.asarray(10.0 * Z), ZERO, ZERO, ZERO, ZERO
+    )
     assert 0.0 <= float(c.normal_load) < 1e-12 * float(rest.normal_load)
     # out of contact: no force whatever the approach speed
     p_far = _inner_position(b, -1e-6)
-    c = _contact(b, 1.0, b.inner_raceway_radius, p_far, jnp.asarray(X), jnp.asarray(-5.0 * Z), ZERO, ZERO, ZERO, ZERO)
+    c = _contact(
+        b, 1.0, b.inner_raceway_radius, p_far, jnp.asarray(X), jnp.asarray(-5.0 * Z), ZERO, ZERO, ZERO, ZERO
+    )
     assert float(c.normal_load) == 0.0 and np.all(np.asarray(c.force_on_roller) == 0.0)
     # ring moving into the roller is the same as the roller moving into the ring
-    c1 = _contact(b, 1.0, b.inner_raceway_radius, p, jnp.asarray(X), ZERO, ZERO, ZERO, jnp.asarray(0.1 * Z), ZERO)
-    c2 = _contact(b, 1.0, b.inner_raceway_radius, p, jnp.asarray(X), jnp.asarray(-0.1 * Z), ZERO, ZERO, ZERO, ZERO)
+    c1 = _contact(
+        b, 1.0, b.inner_raceway_radius, p, jnp.asarray(X), ZERO, ZERO, ZERO, jnp.asarray(0.1 * Z), ZERO
+    )
+    c2 = _contact(
+        b, 1.0, b.inner_raceway_radius, p, jnp.asarray(X), jnp.asarray(-0.1 * Z), ZERO, ZERO, ZERO, ZERO
+    )
     assert float(c1.normal_load) == pytest.approx(float(c2.normal_load), rel=1e-12)
 
 
@@ -287,9 +315,13 @@ def test_traction_follows_lubricant_curve_against_sliding():
     lub = b.lubricant
     p = _inner_position(b, 2e-6)
     u = 0.5  # axial sliding of the roller over the ring [m/s]
-    c = _contact(b, 1.0, b.inner_raceway_radius, p, jnp.asarray(X), jnp.asarray(u * X), ZERO, ZERO, ZERO, ZERO)
+    c = _contact(
+        b, 1.0, b.inner_raceway_radius, p, jnp.asarray(X), jnp.asarray(u * X), ZERO, ZERO, ZERO, ZERO
+    )
     s = math.sqrt(u**2 + 1e-3**2)  # SLIDING_EPS regularisation
-    kappa = (float(lub.traction_a) + float(lub.traction_b) * s) * math.exp(-float(lub.traction_c) * s) + float(lub.traction_d)
+    kappa = (float(lub.traction_a) + float(lub.traction_b) * s) * math.exp(
+        -float(lub.traction_c) * s
+    ) + float(lub.traction_d)
     assert kappa == pytest.approx(0.06, abs=1e-5)  # the curve's documented peak at 0.5 m/s
     n = float(c.normal_load)
     f = np.asarray(c.force_on_roller)
@@ -298,7 +330,9 @@ def test_traction_follows_lubricant_curve_against_sliding():
     assert float(c.mean_sliding_speed) == pytest.approx(u, rel=1e-12)
     # roller spinning against a fixed ring: the traction moment opposes the spin
     for spin in (500.0, -500.0):
-        c = _contact(b, 1.0, b.inner_raceway_radius, p, jnp.asarray(X), ZERO, jnp.asarray(spin * X), ZERO, ZERO, ZERO)
+        c = _contact(
+            b, 1.0, b.inner_raceway_radius, p, jnp.asarray(X), ZERO, jnp.asarray(spin * X), ZERO, ZERO, ZERO
+        )
         assert np.sign(float(c.moment_on_roller[0])) == -np.sign(spin)
         # sliding speed at the contact: spin * (D/2 - a/2) (contact point in the middle of the overlap)
         lever = float(b.roller.diameter) / 2 - 1e-6
@@ -316,11 +350,18 @@ def test_vmap_over_rollers_matches_single_calls():
     v = jnp.asarray(rng.normal(size=(n, 3)))
     w = jnp.asarray(rng.normal(size=(n, 3)) * 100)
     batched = jax.jit(jax.vmap(raceway_contact, in_axes=(None, None, None, 0, 0, 0, 0, None, None, None)))(
-        b, 1.0, b.inner_raceway_radius, p, e, v, w, ZERO, ZERO, jnp.asarray(1000.0 * X))
+        b, 1.0, b.inner_raceway_radius, p, e, v, w, ZERO, ZERO, jnp.asarray(1000.0 * X)
+    )
     for j in range(n):
-        single = _contact(b, 1.0, b.inner_raceway_radius, p[j], e[j], v[j], w[j], ZERO, ZERO, jnp.asarray(1000.0 * X))
-        np.testing.assert_allclose(np.asarray(batched.force_on_roller[j]), np.asarray(single.force_on_roller), rtol=1e-12)
-        np.testing.assert_allclose(np.asarray(batched.slice_loads[j]), np.asarray(single.slice_loads), rtol=1e-12)
+        single = _contact(
+            b, 1.0, b.inner_raceway_radius, p[j], e[j], v[j], w[j], ZERO, ZERO, jnp.asarray(1000.0 * X)
+        )
+        np.testing.assert_allclose(
+            np.asarray(batched.force_on_roller[j]), np.asarray(single.force_on_roller), rtol=1e-12
+        )
+        np.testing.assert_allclose(
+            np.asarray(batched.slice_loads[j]), np.asarray(single.slice_loads), rtol=1e-12
+        )
 
 
 def test_stiffness_is_the_whole_contact_coefficient():

@@ -16,9 +16,15 @@ def _solve(e0, w0, t1, moment=lambda e, w: jnp.zeros(3)):
 
     ts = jnp.linspace(0, t1, 201)
     sol = diffrax.diffeqsolve(
-        diffrax.ODETerm(f), diffrax.Tsit5(), 0.0, t1, t1 / 2000, (e0, w0),
+        diffrax.ODETerm(f),
+        diffrax.Tsit5(),
+        0.0,
+        t1,
+        t1 / 2000,
+        (e0, w0),
         saveat=diffrax.SaveAt(ts=ts),
-        stepsize_controller=diffrax.PIDController(rtol=1e-11, atol=1e-13), max_steps=200_000,
+        stepsize_controller=diffrax.PIDController(rtol=1e-11, atol=1e-13),
+        max_steps=200_000,
     )
     return ts, sol.ys
 
@@ -30,7 +36,9 @@ def test_torque_free_precession_energy_momentum():
     ts, (e, w) = _solve(e0, w0, 2e-3)
     h0 = angular_momentum(e0, w0, I_A, I_T)
     h = angular_momentum(e, w, I_A, I_T)
-    np.testing.assert_allclose(h, np.broadcast_to(h0, h.shape), rtol=0, atol=1e-9 * float(jnp.linalg.norm(h0)))
+    np.testing.assert_allclose(
+        h, np.broadcast_to(h0, h.shape), rtol=0, atol=1e-9 * float(jnp.linalg.norm(h0))
+    )
     t0 = kinetic_energy(e0, w0, I_A, I_T)
     np.testing.assert_allclose(kinetic_energy(e, w, I_A, I_T), t0, rtol=1e-9)
     spin = jnp.sum(w * e, axis=-1)

@@ -26,8 +26,14 @@ R_CE, X_COR = D / 2 - R_COR, L / 2 - R_COR
 
 
 def _roller(end_radius):
-    return jb.Roller(diameter=D, length=L, central_length=4.5e-3, crown_drop=4e-6,
-                     corner_radius=R_COR, end_radius=end_radius)
+    return jb.Roller(
+        diameter=D,
+        length=L,
+        central_length=4.5e-3,
+        crown_drop=4e-6,
+        corner_radius=R_COR,
+        end_radius=end_radius,
+    )
 
 
 def _profile_support(end_radius, alpha):
@@ -49,12 +55,20 @@ def _profile_support(end_radius, alpha):
         def sphere(phi):
             return (l_beb + end_radius * math.cos(phi), end_radius * math.sin(phi))
 
-        res = minimize_scalar(lambda f: -(np.dot(sphere(f), (c, s))), bounds=(0, phi_lim),
-                              method="bounded", options={"xatol": 1e-14})
+        res = minimize_scalar(
+            lambda f: -(np.dot(sphere(f), (c, s))),
+            bounds=(0, phi_lim),
+            method="bounded",
+            options={"xatol": 1e-14},
+        )
         cands.append((-res.fun, sphere(res.x)))
         phi0 = phi_lim
-    res = minimize_scalar(lambda f: -(np.dot(torus(f), (c, s))), bounds=(phi0, math.pi / 2),
-                          method="bounded", options={"xatol": 1e-14})
+    res = minimize_scalar(
+        lambda f: -(np.dot(torus(f), (c, s))),
+        bounds=(phi0, math.pi / 2),
+        method="bounded",
+        options={"xatol": 1e-14},
+    )
     cands.append((-res.fun, torus(res.x)))
     return max(cands, key=lambda t: t[0])
 
@@ -85,8 +99,7 @@ def test_branch_closed_forms(end_radius):
     alpha = 0.2  # on the torus
     h, a, rho = end_support(r, jnp.cos(alpha), jnp.sin(alpha))
     np.testing.assert_allclose(rho, R_CE + R_COR * math.sin(alpha), rtol=1e-14)
-    np.testing.assert_allclose(h, X_COR * math.cos(alpha) + R_CE * math.sin(alpha) + R_COR,
-                               rtol=1e-14)
+    np.testing.assert_allclose(h, X_COR * math.cos(alpha) + R_CE * math.sin(alpha) + R_COR, rtol=1e-14)
     # along the axis the support is the arc apex: L_b1/2 + e
     h0, _, _ = end_support(r, jnp.asarray(1.0), jnp.asarray(0.0))
     e = end_radius - R_COR - math.sqrt((end_radius - R_COR) ** 2 - R_CE**2)
@@ -145,8 +158,9 @@ def _support_3d(roller, v):
     return nv * end_support(roller, c, s)[0]
 
 
-@pytest.mark.parametrize("end_radius,alpha", [(80e-3, 0.02), (80e-3, 0.05), (math.inf, 0.028),
-                                              (120e-3, 0.035), (60e-3, 0.3)])
+@pytest.mark.parametrize(
+    "end_radius,alpha", [(80e-3, 0.02), (80e-3, 0.05), (math.inf, 0.028), (120e-3, 0.035), (60e-3, 0.3)]
+)
 def test_principal_radii_are_support_hessian_eigenvalues(end_radius, alpha):
     r = _roller(end_radius)
     n = jnp.array([math.cos(alpha), 0.0, math.sin(alpha)])

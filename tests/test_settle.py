@@ -8,8 +8,14 @@ import pytest
 
 from jaxbearing.cli import main
 
-EVENT_STATS = ("flange_force_N", "flange_pressure_Pa", "flange_sliding_velocity_m_s", "flange_pv_Pa_m_s",
-               "contact_height_m", "contact_radius_m")
+EVENT_STATS = (
+    "flange_force_N",
+    "flange_pressure_Pa",
+    "flange_sliding_velocity_m_s",
+    "flange_pv_Pa_m_s",
+    "contact_height_m",
+    "contact_radius_m",
+)
 
 
 @pytest.mark.parametrize(
@@ -44,8 +50,21 @@ def small_config(tmp_path_factory):
 def test_fixed_settle_reports_intervals(small_config, capsys):
     d, cfg = small_config
     out = d / "fixed"
-    code = main(["simulate", "--config", cfg, "--end", "arc", "--settle", "2", "--window-revs", "2",
-                 "--out", str(out)])
+    code = main(
+        [
+            "simulate",
+            "--config",
+            cfg,
+            "--end",
+            "arc",
+            "--settle",
+            "2",
+            "--window-revs",
+            "2",
+            "--out",
+            str(out),
+        ]
+    )
     text = capsys.readouterr().out
     assert code == 0, text
     s = json.loads((out / "summary.json").read_text())
@@ -68,8 +87,21 @@ def test_fixed_settle_reports_intervals(small_config, capsys):
 
 def test_auto_settle_hitting_the_cap_is_not_silent(small_config, capsys):
     _, cfg = small_config
-    code = main(["simulate", "--config", cfg, "--end", "arc", "--settle", "auto", "--settle-cap-ms", "1",
-                 "--window-revs", "2"])
+    code = main(
+        [
+            "simulate",
+            "--config",
+            cfg,
+            "--end",
+            "arc",
+            "--settle",
+            "auto",
+            "--settle-cap-ms",
+            "1",
+            "--window-revs",
+            "2",
+        ]
+    )
     text = capsys.readouterr().out
     assert code == 1
     assert "settled false" in text and "NOT SETTLED" in text

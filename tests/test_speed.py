@@ -30,7 +30,8 @@ def _random_state(z=5):
     leaves, treedef = jax.tree_util.tree_flatten(template)
     keys = jax.random.split(jax.random.PRNGKey(0), len(leaves))
     return jax.tree_util.tree_unflatten(
-        treedef, [jax.random.normal(k, x.shape) for k, x in zip(keys, leaves)])
+        treedef, [jax.random.normal(k, x.shape) for k, x in zip(keys, leaves)]
+    )
 
 
 def test_raceway_normal_norm_is_the_max_norm_with_radial_tolerances_loosened():
@@ -61,8 +62,16 @@ def test_solve_program_has_no_host_callback():
     import diffrax
 
     def plain(d):
-        return diffrax.diffeqsolve(diffrax.ODETerm(lambda t, y, a: -y), diffrax.Tsit5(), 0.0, d, 1e-3, 1.0,
-                                   saveat=diffrax.SaveAt(ts=jnp.linspace(0.0, d, 3)), throw=False).ys
+        return diffrax.diffeqsolve(
+            diffrax.ODETerm(lambda t, y, a: -y),
+            diffrax.Tsit5(),
+            0.0,
+            d,
+            1e-3,
+            1.0,
+            saveat=diffrax.SaveAt(ts=jnp.linspace(0.0, d, 3)),
+            throw=False,
+        ).ys
 
     assert "callback" in jax.jit(plain).lower(1.0).as_text()
 

@@ -64,15 +64,22 @@ def _history(edges, period_samples, z=2):
     radius = np.full(shape, 3.0e-3)
     for rev, peak in enumerate((10.0, 20.0)):
         i0 = rev * period_samples + 10
-        force[i0:i0 + 5, 0, 0] = peak * np.array([0.2, 0.6, 1.0, 0.6, 0.2])
+        force[i0 : i0 + 5, 0, 0] = peak * np.array([0.2, 0.6, 1.0, 0.6, 0.2])
         if rev == 1:
-            radius[i0:i0 + 5, 0, 0] = 3.5e-3
+            radius[i0 : i0 + 5, 0, 0] = 3.5e-3
     zeros = np.zeros(shape)
     return dict(
-        t=t, flange_force=force, flange_pressure=force * 1e7, flange_sliding_speed=zeros + 2.0, flange_roller_surface_speed=zeros + 3.0,
-        flange_pv=force * 2e7, contact_height=zeros + 1e-3, contact_radius=radius,
+        t=t,
+        flange_force=force,
+        flange_pressure=force * 1e7,
+        flange_sliding_speed=zeros + 2.0,
+        flange_roller_surface_speed=zeros + 3.0,
+        flange_pv=force * 2e7,
+        contact_height=zeros + 1e-3,
+        contact_radius=radius,
         on_arc=(radius < 3.2e-3).astype(float),
-        cage_speed=np.where(t < edges[1], 100.0, 110.0), roller_skew=np.full((n, z), -1e-4),
+        cage_speed=np.where(t < edges[1], 100.0, 110.0),
+        roller_skew=np.full((n, z), -1e-4),
     )
 
 

@@ -48,8 +48,17 @@ def subprocess_env(**extra) -> dict:
 
 
 def sweep_command(spec: pathlib.Path, out: pathlib.Path, *args: str) -> list[str]:
-    return [sys.executable, "-m", "jaxbearing.cli", "sweep", str(spec), "--out", str(out),
-            "--no-progress", *args]
+    return [
+        sys.executable,
+        "-m",
+        "jaxbearing.cli",
+        "sweep",
+        str(spec),
+        "--out",
+        str(out),
+        "--no-progress",
+        *args,
+    ]
 
 
 def assert_same_results(a, b) -> None:
@@ -79,13 +88,14 @@ BAD_SPECS = [
     ('"operating.speed_rad_s" = [2000.0]', "operating.speed_rad_s", "use operating.speed_rpm"),
     ('"roller.end_radius_mm" = ["80 mm"]', "roller.end_radius_mm", "units are part of the key"),
     ('"operating.speed_rpm" = []', "operating.speed_rpm", "empty axis"),
-    ('"operating.speed_rpm" = {start = 1e4, stop = 2e4, num = 0}', "operating.speed_rpm",
-     "empty axis"),
+    ('"operating.speed_rpm" = {start = 1e4, stop = 2e4, num = 0}', "operating.speed_rpm", "empty axis"),
     ('"roller.end_radius_mm" = [80.0, 2.0]', "roller.end_radius_mm", "out of range"),
-    ('"flange.layback_angle_deg" = {start = 1, stop = 12, num = 3}',
-     "flange.layback_angle_deg", "(0, 10]"),
-    ('"roller.central_length_mm" = [4.5, 7.5]', "roller.central_length_mm",
-     "length_mm - 2 corner_radius_mm = 7.2"),
+    ('"flange.layback_angle_deg" = {start = 1, stop = 12, num = 3}', "flange.layback_angle_deg", "(0, 10]"),
+    (
+        '"roller.central_length_mm" = [4.5, 7.5]',
+        "roller.central_length_mm",
+        "length_mm - 2 corner_radius_mm = 7.2",
+    ),
     ('"operating.speed_rpm" = [-100.0]', "operating.speed_rpm", "out of range"),
     ('"bearing.num_rollers" = [20, 26]', "bearing.num_rollers", "changes array shapes"),
     ('"simulation.max_steps" = [10, 20]', "simulation.max_steps", "static"),
@@ -109,11 +119,12 @@ def test_bad_spec_fields():
     with pytest.raises(SweepSpecError, match=r"^axes: no axes"):
         loads_sweep_spec("[sweep]\nbatch_size = 3\n")
     with pytest.raises(SweepSpecError, match=r"^operating.radial_load_N: zipped axes must have"):
-        loads_sweep_spec('[sweep]\nmode = "zip"\n[axes]\n"operating.speed_rpm" = [1e4, 2e4]\n'
-                         '"operating.radial_load_N" = [1e3]\n')
+        loads_sweep_spec(
+            '[sweep]\nmode = "zip"\n[axes]\n"operating.speed_rpm" = [1e4, 2e4]\n'
+            '"operating.radial_load_N" = [1e3]\n'
+        )
     with pytest.raises(SweepSpecError, match=r'^roller.end_radius_mm: case 1: end = "arc" needs'):
-        loads_sweep_spec('[base.simulation]\nend = "arc"\n[axes]\n'
-                         '"roller.end_radius_mm" = [80.0, inf]\n')
+        loads_sweep_spec('[base.simulation]\nend = "arc"\n[axes]\n"roller.end_radius_mm" = [80.0, inf]\n')
     with pytest.raises(SweepSpecError, match=r"^base.roller.diameter_mm: "):
         loads_sweep_spec('[base.roller]\ndiameter_mm = -1.0\n[axes]\nend = ["arc"]\n')
 
@@ -142,8 +153,12 @@ def test_grid_and_zip_layout():
     for case in range(12):
         e, z, r = np.unravel_index(case, spec.shape)
         v = spec.case_values(case)
-        assert v == {"end": ("arc", "corner")[e], "operating.speed_rpm": speeds[z],
-                     "operating.radial_load_N": loads[z], "roller.end_radius_mm": (60.0, 80.0)[r]}
+        assert v == {
+            "end": ("arc", "corner")[e],
+            "operating.speed_rpm": speeds[z],
+            "operating.radial_load_N": loads[z],
+            "roller.end_radius_mm": (60.0, 80.0)[r],
+        }
     cfg, end = spec.case_config(11)
     assert end == "corner" and cfg["operating.radial_load_N"] == 2000.0
     assert cfg["simulation.duration_ms"] == 0.2
@@ -168,15 +183,16 @@ def test_reference_dataset(reference):
     assert (ds["status"].values == "ok").all() and (ds["result_code"].values == 0).all()
     # independent checks: kinematic cage speed omega_i (1 - D/d_m) / 2, and the design zone
     kin = ds["speed_rpm"].values * (1 - 7.5 / 85.0) / 2
-    np.testing.assert_allclose(ds["kinematic_cage_speed_rpm"].values, np.stack([kin, kin]),
-                               rtol=1e-12)
+    np.testing.assert_allclose(ds["kinematic_cage_speed_rpm"].values, np.stack([kin, kin]), rtol=1e-12)
     assert (np.abs(ds["cage_slip"].values) < 0.05).all()
     # arc end: h_c = D/2 - R_end sin(theta_f) (MODEL.md 4.1), corner: D/2 - R_ce - R_cor sin
     s = np.sin(np.radians(1.6))
-    np.testing.assert_allclose(ds["zone_contact_height_m"].sel(end="arc").values,
-                               (3.75 - 80 * s) * 1e-3, rtol=1e-9)
-    np.testing.assert_allclose(ds["zone_contact_height_m"].sel(end="corner").values,
-                               (3.75 - 3.35 - 0.4 * s) * 1e-3, rtol=1e-9)
+    np.testing.assert_allclose(
+        ds["zone_contact_height_m"].sel(end="arc").values, (3.75 - 80 * s) * 1e-3, rtol=1e-9
+    )
+    np.testing.assert_allclose(
+        ds["zone_contact_height_m"].sel(end="corner").values, (3.75 - 3.35 - 0.4 * s) * 1e-3, rtol=1e-9
+    )
     assert (ds["zone_feasible"].sel(end="arc").values == 1).all()
     # one log entry per batch, each computed once
     assert sorted(computed_batches(out)) == [0, 1]
@@ -230,7 +246,7 @@ def test_kill_and_resume(tmp_path, reference):
     assert rerun.returncode == 0, rerun.stderr[-3000:]
     log = computed_batches(out)
     assert log[: len(done_before)] == done_before
-    assert sorted(log[len(done_before):]) == sorted({0, 1} - set(done_before))
+    assert sorted(log[len(done_before) :]) == sorted({0, 1} - set(done_before))
     assert first.stat().st_mtime_ns == stat.st_mtime_ns and first.read_bytes() == content
     from jaxbearing.sweep import open_results
 
@@ -273,14 +289,13 @@ def test_plot_draws_every_figure_from_assembled_batches(tmp_path, capsys):
 
     ds = open_results(tmp_path)
     assert ds["flange_pv_Pa_m_s_max"].dims == spec.dims
-    np.testing.assert_array_equal(ds["flange_pv_Pa_m_s_max"].values.ravel(),
-                                  data["flange_pv_Pa_m_s_max"])
+    np.testing.assert_array_equal(ds["flange_pv_Pa_m_s_max"].values.ravel(), data["flange_pv_Pa_m_s_max"])
     # design zone per case: arc contact height D/2 - R_end sin(theta_f) (MODEL.md 4.1)
     arc = ds.sel(end="arc", speed_rpm=10000.0, central_length_mm=4.5)
-    r, t = np.meshgrid(arc["end_radius_mm"].values, np.radians(arc["layback_angle_deg"].values),
-                       indexing="ij")
-    np.testing.assert_allclose(arc["zone_contact_height_m"].values, (3.75 - r * np.sin(t)) * 1e-3,
-                               rtol=1e-9)
+    r, t = np.meshgrid(
+        arc["end_radius_mm"].values, np.radians(arc["layback_angle_deg"].values), indexing="ij"
+    )
+    np.testing.assert_allclose(arc["zone_contact_height_m"].values, (3.75 - r * np.sin(t)) * 1e-3, rtol=1e-9)
 
 
 def test_plot_names_missing_axes(tmp_path, capsys):

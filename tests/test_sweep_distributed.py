@@ -41,8 +41,9 @@ def test_four_devices_match_single_device(tmp_path, reference):
     to a different step sequence within the solver tolerance.)"""
     out = tmp_path / "four"
     env = subprocess_env(XLA_FLAGS="--xla_force_host_platform_device_count=4")
-    run = subprocess.run(sweep_command(SMALL, out, "--batch-size", "8"), env=env,
-                         capture_output=True, text=True, timeout=400)
+    run = subprocess.run(
+        sweep_command(SMALL, out, "--batch-size", "8"), env=env, capture_output=True, text=True, timeout=400
+    )
     assert run.returncode == 0, run.stderr[-3000:]
     assert "process 0/1: 4 local device(s) (cpu)" in run.stderr
     assert computed_batches(out) == [0]  # one batch of 4 cases (padded to 8) over 4 devices
@@ -61,8 +62,12 @@ def test_two_processes_match_single_process(tmp_path, reference):
     port = free_port()
     env = subprocess_env()
     cmd = sweep_command(SMALL, out, "--coordinator", f"127.0.0.1:{port}", "--num-processes", "2")
-    procs = [subprocess.Popen(cmd + ["--process-id", str(i)], env=env, stdout=subprocess.PIPE,
-                              stderr=subprocess.PIPE, text=True) for i in range(2)]
+    procs = [
+        subprocess.Popen(
+            cmd + ["--process-id", str(i)], env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+        )
+        for i in range(2)
+    ]
     try:
         outputs = [p.communicate(timeout=400) for p in procs]
     finally:

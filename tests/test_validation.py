@@ -55,9 +55,14 @@ INT_KEYS = [k for k in KEYS if k.kind is int]
 BOOL_KEYS = [k for k in KEYS if k.kind is bool]
 #: float keys where a negative value is physically meaningful (written out by hand, not read
 #: from the schema): Poisson ratio of auxetic materials and the traction curve coefficients.
-NEGATIVE_OK = {"materials.ring.poisson_ratio", "materials.roller.poisson_ratio",
-               "materials.cage.poisson_ratio", "lubricant.traction_a",
-               "lubricant.traction_b_s_m", "lubricant.traction_d"}
+NEGATIVE_OK = {
+    "materials.ring.poisson_ratio",
+    "materials.roller.poisson_ratio",
+    "materials.cage.poisson_ratio",
+    "lubricant.traction_a",
+    "lubricant.traction_b_s_m",
+    "lubricant.traction_d",
+}
 
 
 # -- the bad files, through the real command ---------------------------------------------------
@@ -83,8 +88,8 @@ def test_bad_config_messages_name_value_and_range(capsys):
     path = BAD_DIR / "corner_radius_too_large.toml"
     assert cli_main(["config", "check", str(path)]) == 2
     assert capsys.readouterr().err == (
-        f"{path}: roller.corner_radius_mm: 4.0 mm is out of range: "
-        "must be in (0, diameter_mm/2 = 3.75) mm\n")
+        f"{path}: roller.corner_radius_mm: 4.0 mm is out of range: must be in (0, diameter_mm/2 = 3.75) mm\n"
+    )
 
 
 def test_console_script_checks_every_bad_file(tmp_path):
@@ -95,8 +100,9 @@ def test_console_script_checks_every_bad_file(tmp_path):
         pytest.skip("jaxbearing console script not installed")
     good = tmp_path / "good.toml"
     good.write_text("[roller]\nend_radius_mm = 90\n")
-    proc = subprocess.run([exe, "config", "check", str(good), *map(str, BAD_FILES)],
-                          capture_output=True, text=True, timeout=120)
+    proc = subprocess.run(
+        [exe, "config", "check", str(good), *map(str, BAD_FILES)], capture_output=True, text=True, timeout=120
+    )
     assert proc.returncode == 2
     assert proc.stdout == f"{good}: ok\n"
     lines = proc.stderr.splitlines()
@@ -116,9 +122,11 @@ def _load(data: dict):
 
 
 WRONG_TYPE = st.one_of(
-    st.text(max_size=8), st.lists(st.floats(allow_nan=False), max_size=3),
+    st.text(max_size=8),
+    st.lists(st.floats(allow_nan=False), max_size=3),
     st.dictionaries(st.text(min_size=1, max_size=5), st.integers(), max_size=2),
-    st.just(datetime.date(2025, 1, 1)), st.none(),
+    st.just(datetime.date(2025, 1, 1)),
+    st.none(),
 )
 
 
@@ -140,8 +148,7 @@ def test_bad_float_values_raise_config_error(key, data):
             "-inf": lambda: -math.inf,
             "bool": lambda: data.draw(st.booleans()),
             "wrong_type": lambda: data.draw(WRONG_TYPE),
-            "huge": lambda: data.draw(st.sampled_from([1.0, -1.0])) * data.draw(
-                st.floats(1e12, 1e300)),
+            "huge": lambda: data.draw(st.sampled_from([1.0, -1.0])) * data.draw(st.floats(1e12, 1e300)),
             "negative": lambda: -data.draw(st.floats(1e-300, 1e300)),
         }[kind]()
     with pytest.raises(ConfigError) as info:
@@ -150,9 +157,16 @@ def test_bad_float_values_raise_config_error(key, data):
 
 
 @settings(max_examples=150, deadline=None)
-@given(key=st.sampled_from(INT_KEYS), value=st.one_of(
-    st.integers(max_value=0), st.integers(min_value=10**10, max_value=10**40),
-    st.floats(allow_nan=True), st.booleans(), WRONG_TYPE))
+@given(
+    key=st.sampled_from(INT_KEYS),
+    value=st.one_of(
+        st.integers(max_value=0),
+        st.integers(min_value=10**10, max_value=10**40),
+        st.floats(allow_nan=True),
+        st.booleans(),
+        WRONG_TYPE,
+    ),
+)
 def test_bad_counts_raise_config_error(key, value):
     with pytest.raises(ConfigError) as info:
         jb.Config(_nested(key.path, value))
@@ -160,8 +174,7 @@ def test_bad_counts_raise_config_error(key, value):
 
 
 @settings(max_examples=60, deadline=None)
-@given(key=st.sampled_from(BOOL_KEYS),
-       value=st.one_of(st.integers(), st.floats(), st.text(max_size=5)))
+@given(key=st.sampled_from(BOOL_KEYS), value=st.one_of(st.integers(), st.floats(), st.text(max_size=5)))
 def test_bad_switches_raise_config_error(key, value):
     with pytest.raises(ConfigError) as info:
         _load(_nested(key.path, value))
@@ -173,8 +186,11 @@ ALL_NAMES = {k.path for k in KEYS} | {k.name for k in KEYS} | set(SECTIONS) | {"
 
 
 @settings(max_examples=200, deadline=None)
-@given(section=st.sampled_from([""] + SECTIONS), name=st.text(min_size=1, max_size=12),
-       value=st.one_of(st.floats(), st.integers(), st.text(max_size=4), st.booleans()))
+@given(
+    section=st.sampled_from([""] + SECTIONS),
+    name=st.text(min_size=1, max_size=12),
+    value=st.one_of(st.floats(), st.integers(), st.text(max_size=4), st.booleans()),
+)
 def test_unknown_keys_raise_config_error(section, name, value):
     assume(name not in ALL_NAMES)
     path = f"{section}.{name}" if section else name
@@ -186,8 +202,10 @@ def test_unknown_keys_raise_config_error(section, name, value):
 
 
 @settings(max_examples=100, deadline=None)
-@given(section=st.sampled_from(SECTIONS + ["materials"]),
-       value=st.one_of(st.floats(), st.integers(), st.text(max_size=4), st.lists(st.integers())))
+@given(
+    section=st.sampled_from(SECTIONS + ["materials"]),
+    value=st.one_of(st.floats(), st.integers(), st.text(max_size=4), st.lists(st.integers())),
+)
 def test_sections_that_are_not_tables_raise(section, value):
     with pytest.raises(ConfigError):
         jb.Config(_nested(section, value))
@@ -198,8 +216,9 @@ def test_example_message_is_exact():
     with pytest.raises(ConfigError) as info:
         jb.reference_config().replace(**{"roller.corner_radius_mm": 4.0})
     assert info.value.field == "roller.corner_radius_mm"
-    assert str(info.value) == ("roller.corner_radius_mm: 4.0 mm is out of range: "
-                               "must be in (0, diameter_mm/2 = 3.75) mm")
+    assert str(info.value) == (
+        "roller.corner_radius_mm: 4.0 mm is out of range: must be in (0, diameter_mm/2 = 3.75) mm"
+    )
 
 
 def test_rollers_around_the_pitch_circle():
@@ -229,20 +248,32 @@ def test_end_radius_must_exceed_half_diameter():
 def _traction_peak(a, b, c, d):
     """max |kappa| over du >= 0 by dense sampling (independent of the validator's closed form)."""
     du_star = 1.0 / c - (a / b if b else 0.0)
-    grid = np.concatenate([np.linspace(0.0, 60.0 / c, 200_001),
-                           du_star * (1 + np.linspace(-1e-3, 1e-3, 101)) if du_star > 0 else []])
+    grid = np.concatenate(
+        [
+            np.linspace(0.0, 60.0 / c, 200_001),
+            du_star * (1 + np.linspace(-1e-3, 1e-3, 101)) if du_star > 0 else [],
+        ]
+    )
     kappa = (a + b * grid) * np.exp(-c * grid) + d
     return float(np.max(np.abs(np.concatenate([kappa, [d]]))))
 
 
 @settings(max_examples=60, deadline=None)
-@given(a=st.floats(-1, 1), c=st.floats(0.05, 50), d=st.floats(-1, 1),
-       b=st.one_of(st.just(0.0), st.floats(1e-3, 20), st.floats(-20, -1e-3)))
+@given(
+    a=st.floats(-1, 1),
+    c=st.floats(0.05, 50),
+    d=st.floats(-1, 1),
+    b=st.one_of(st.just(0.0), st.floats(1e-3, 20), st.floats(-20, -1e-3)),
+)
 def test_traction_curve_bound_matches_sampling(a, b, c, d):
     peak = _traction_peak(a, b, c, d)
     assume(abs(peak - 1.0) > 1e-3)  # away from the boundary, where sampling is exact enough
-    change = {"lubricant.traction_a": a, "lubricant.traction_b_s_m": b,
-              "lubricant.traction_c_s_m": c, "lubricant.traction_d": d}
+    change = {
+        "lubricant.traction_a": a,
+        "lubricant.traction_b_s_m": b,
+        "lubricant.traction_c_s_m": c,
+        "lubricant.traction_d": d,
+    }
     if peak < 1.0:
         jb.reference_config().replace(**change)
     else:
@@ -283,16 +314,18 @@ def test_validate_reference_pytrees():
     assert jb.validate_bearing(b.with_flat_ends(), op) is None
 
 
-@pytest.mark.parametrize("where, value, field, shown", [
-    (lambda b: b.roller.corner_radius, 4e-3, "roller.corner_radius_mm", "4.0 mm"),
-    (lambda b: b.roller.end_radius, 3e-3, "roller.end_radius_mm", "3.0 mm"),
-    (lambda b: b.flange.layback_angle, math.radians(12.0), "flange.layback_angle_deg", "12.0 deg"),
-    (lambda b: b.radial_clearance, -5e-6, "bearing.radial_clearance_um", "-5.0 um"),
-    (lambda b: b.roller_material.poisson_ratio, 0.5, "materials.roller.poisson_ratio", "0.5 is"),
-    (lambda b: b.cage_material.elastic_modulus, -1e9, "materials.cage.elastic_modulus_GPa",
-     "-1.0 GPa"),
-    (lambda b: b.lubricant.oil_fraction, jnp.nan, "lubricant.oil_fraction", "nan is not finite"),
-])
+@pytest.mark.parametrize(
+    "where, value, field, shown",
+    [
+        (lambda b: b.roller.corner_radius, 4e-3, "roller.corner_radius_mm", "4.0 mm"),
+        (lambda b: b.roller.end_radius, 3e-3, "roller.end_radius_mm", "3.0 mm"),
+        (lambda b: b.flange.layback_angle, math.radians(12.0), "flange.layback_angle_deg", "12.0 deg"),
+        (lambda b: b.radial_clearance, -5e-6, "bearing.radial_clearance_um", "-5.0 um"),
+        (lambda b: b.roller_material.poisson_ratio, 0.5, "materials.roller.poisson_ratio", "0.5 is"),
+        (lambda b: b.cage_material.elastic_modulus, -1e9, "materials.cage.elastic_modulus_GPa", "-1.0 GPa"),
+        (lambda b: b.lubricant.oil_fraction, jnp.nan, "lubricant.oil_fraction", "nan is not finite"),
+    ],
+)
 def test_validate_bearing_names_config_key(where, value, field, shown):
     bad = eqx.tree_at(where, jb.reference_bearing(), jnp.asarray(value))
     with pytest.raises(ConfigError) as info:
@@ -305,8 +338,9 @@ def test_validate_operating_point():
     b = jb.reference_bearing()
     op = jb.reference_operating_point()
     with pytest.raises(ConfigError, match=r"operating\.speed_rpm: 150000\.0 rpm"):
-        jb.validate_bearing(b, eqx.tree_at(lambda o: o.inner_speed, op,
-                                           jnp.asarray(jb.rpm_to_rad_s(150_000.0))))
+        jb.validate_bearing(
+            b, eqx.tree_at(lambda o: o.inner_speed, op, jnp.asarray(jb.rpm_to_rad_s(150_000.0)))
+        )
     with pytest.raises(ConfigError, match=r"operating\.gravity"):
         jb.validate_bearing(b, eqx.tree_at(lambda o: o.gravity, op, jnp.asarray(-9.81)))
     jb.validate_bearing(b, eqx.tree_at(lambda o: o.gravity, op, jnp.asarray(0.0)))

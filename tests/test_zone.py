@@ -26,15 +26,21 @@ def _closed_form(r_end, theta, clearance, load, e_prime):
     h_c = D / 2 - rho
     # Hertz sphere on plane (Johnson 4.2): a = (3 Q R / (4 E*)), E* = E'/2
     a = (3 * load * r_end / (2 * e_prime)) ** (1 / 3)
-    return dict(rho=rho, rho_lim=rho_lim, e=e, h_c=h_c, a=a,
-                lam=clearance - 2 * e * math.cos(theta),
-                gap=(clearance - 2 * e) * math.cos(theta) + D * math.sin(theta)
-                - 2 * r_end * (1 - math.cos(theta)),
-                corner=R_CE + R_COR * math.sin(theta))
+    return dict(
+        rho=rho,
+        rho_lim=rho_lim,
+        e=e,
+        h_c=h_c,
+        a=a,
+        lam=clearance - 2 * e * math.cos(theta),
+        gap=(clearance - 2 * e) * math.cos(theta) + D * math.sin(theta) - 2 * r_end * (1 - math.cos(theta)),
+        corner=R_CE + R_COR * math.sin(theta),
+    )
 
 
-@pytest.mark.parametrize("r_end_mm,theta_deg,clear_mm", [(80, 1.6, 0.15), (60, 1.0, 0.2),
-                                                         (120, 1.5, 0.1), (100, 1.8, 0.3)])
+@pytest.mark.parametrize(
+    "r_end_mm,theta_deg,clear_mm", [(80, 1.6, 0.15), (60, 1.0, 0.2), (120, 1.5, 0.1), (100, 1.8, 0.3)]
+)
 def test_zone_matches_closed_forms(r_end_mm, theta_deg, clear_mm):
     r_end, theta, clear = r_end_mm * 1e-3, math.radians(theta_deg), clear_mm * 1e-3
     b = with_design(REF, r_end, theta, clear)
@@ -52,11 +58,12 @@ def test_zone_matches_closed_forms(r_end_mm, theta_deg, clear_mm):
     # exact Hertz: the sphere-on-plane contact circle (3 Q R / (4 E*))^(1/3)
     np.testing.assert_allclose(z.ellipse_half_width, ref["a"], rtol=1e-9)
     fl = REF.flange
-    np.testing.assert_allclose(z.relief_margin, float(z.contact_height)
-                               - float(z.ellipse_half_width) - float(fl.relief_height),
-                               rtol=1e-12)
-    np.testing.assert_allclose(z.height_margin, float(fl.contact_height_limit) - ref["h_c"],
-                               rtol=1e-9)
+    np.testing.assert_allclose(
+        z.relief_margin,
+        float(z.contact_height) - float(z.ellipse_half_width) - float(fl.relief_height),
+        rtol=1e-12,
+    )
+    np.testing.assert_allclose(z.height_margin, float(fl.contact_height_limit) - ref["h_c"], rtol=1e-9)
     np.testing.assert_allclose(z.limited_circle_margin, ref["rho_lim"] - ref["rho"], rtol=1e-9)
     np.testing.assert_allclose(z.clearance_margin, ref["lam"], rtol=1e-9, atol=1e-16)
     margins = [z.relief_margin, z.height_margin, z.limited_circle_margin, z.clearance_margin]
@@ -93,13 +100,13 @@ def test_zone_gradients():
 
     def f(x):
         z = design_zone(with_design(REF, x[0], x[1], x[2]), flange_load=100.0)
-        return jnp.stack([z.contact_height, z.actual_axial_clearance, z.relief_margin,
-                          z.seated_gap])
+        return jnp.stack([z.contact_height, z.actual_axial_clearance, z.relief_margin, z.seated_gap])
 
     jac = np.asarray(jax.jit(jax.jacfwd(f))(x0))
     r_end, theta = float(x0[0]), float(x0[1])
-    np.testing.assert_allclose(jac[0], [-math.sin(theta), -r_end * math.cos(theta), 0.0],
-                               rtol=1e-12, atol=1e-300)
+    np.testing.assert_allclose(
+        jac[0], [-math.sin(theta), -r_end * math.cos(theta), 0.0], rtol=1e-12, atol=1e-300
+    )
     np.testing.assert_allclose(jac[1, 2], 1.0, rtol=1e-12)
 
     def e_of(r):
@@ -111,8 +118,7 @@ def test_zone_gradients():
     fj = jax.jit(f)
     for k in range(3):
         step = 1e-6 * float(x0[k])
-        fd = (np.asarray(fj(x0.at[k].add(step))) - np.asarray(fj(x0.at[k].add(-step)))) / (
-            2 * step)
+        fd = (np.asarray(fj(x0.at[k].add(step))) - np.asarray(fj(x0.at[k].add(-step)))) / (2 * step)
         np.testing.assert_allclose(jac[:, k], fd, rtol=1e-6, atol=1e-9)
 
 
@@ -130,8 +136,11 @@ def test_grid_is_vmapped_design_zone():
 
 def test_figure_14_maps_have_a_bounded_feasible_zone():
     (r_mm, t_deg, hz), (_, c_mm, cz) = zone_maps(REF, 100.0, points=61)
-    feas = (np.asarray(hz.relief_margin) > 0) & (np.asarray(hz.height_margin) > 0) & (
-        np.asarray(hz.limited_circle_margin) > 0)
+    feas = (
+        (np.asarray(hz.relief_margin) > 0)
+        & (np.asarray(hz.height_margin) > 0)
+        & (np.asarray(hz.limited_circle_margin) > 0)
+    )
     assert feas.any() and not feas.all()
     bounded = 0
     for j in range(len(r_mm)):  # along theta_f at fixed R_end: one interval, both ends closed
@@ -144,8 +153,10 @@ def test_figure_14_maps_have_a_bounded_feasible_zone():
             bounded += 1
             # below: contact too high (upper limit); above: too low (relief / limited circle)
             assert float(hz.height_margin[idx[0] - 1, j]) <= 0
-            assert float(hz.relief_margin[idx[-1] + 1, j]) <= 0 or \
-                float(hz.limited_circle_margin[idx[-1] + 1, j]) <= 0
+            assert (
+                float(hz.relief_margin[idx[-1] + 1, j]) <= 0
+                or float(hz.limited_circle_margin[idx[-1] + 1, j]) <= 0
+            )
     assert bounded > len(r_mm) // 2
     # the reference design lies inside
     j = np.argmin(np.abs(r_mm - 80.0))
@@ -166,8 +177,15 @@ def test_cli_zone_prints_margins_and_writes_maps(tmp_path, capsys):
     rc = main(["zone", "--map", "--out", str(tmp_path / "maps"), "--flange-load-N", "80"])
     assert rc == 0
     out = capsys.readouterr().out
-    for word in ("contact height h_c", "relief", "height", "limited circle", "clearance",
-                 "80.0 N", "FEASIBLE"):
+    for word in (
+        "contact height h_c",
+        "relief",
+        "height",
+        "limited circle",
+        "clearance",
+        "80.0 N",
+        "FEASIBLE",
+    ):
         assert word in out
     assert out.count(" OK") == 4
     for name in ("zone_height_map.png", "zone_clearance_map.png"):

@@ -12,4 +12,14 @@ from ._main import COMMANDS, EXIT_CODES, build_parser, dispatch, exit_codes_text
 from ._simulate import format_table
 from ._zone import zone_lines, zone_maps
 
-__all__ = ["COMMANDS", "EXIT_CODES", "build_parser", "dispatch", "exit_codes_text", "format_table", "main", "zone_lines", "zone_maps"]
+__all__ = [
+    "COMMANDS",
+    "EXIT_CODES",
+    "build_parser",
+    "dispatch",
+    "exit_codes_text",
+    "format_table",
+    "main",
+    "zone_lines",
+    "zone_maps",
+]

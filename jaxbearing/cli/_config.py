@@ -1,10 +1,10 @@
 """`jaxbearing config`: show and check TOML configuration files.
 
-    jaxbearing config show                 the full reference configuration, every key commented
-    jaxbearing config show --config FILE   FILE merged over the reference
-    jaxbearing config check FILE [FILE...] "FILE: ok", or one line "FILE: <field>: <message>"
-                                           on stderr and exit status 2; the same checks as
-                                           `jaxbearing simulate --config FILE`
+jaxbearing config show                 the full reference configuration, every key commented
+jaxbearing config show --config FILE   FILE merged over the reference
+jaxbearing config check FILE [FILE...] "FILE: ok", or one line "FILE: <field>: <message>"
+                                       on stderr and exit status 2; the same checks as
+                                       `jaxbearing simulate --config FILE`
 """
 
 from __future__ import annotations
@@ -13,13 +13,20 @@ import sys
 
 
 def register(sub) -> None:
-    p = sub.add_parser("config", help="show or check a TOML configuration file",
-                       description="Show the full configuration (every key, its meaning, symbol "
-                       "and valid range) or check configuration files.")
+    p = sub.add_parser(
+        "config",
+        help="show or check a TOML configuration file",
+        description="Show the full configuration (every key, its meaning, symbol "
+        "and valid range) or check configuration files.",
+    )
     cmds = p.add_subparsers(dest="config_command", metavar="ACTION", required=True)
     show = cmds.add_parser("show", help="print the full configuration as commented TOML")
-    show.add_argument("--config", metavar="FILE", default=None,
-                      help="configuration file to merge over the reference (default: reference)")
+    show.add_argument(
+        "--config",
+        metavar="FILE",
+        default=None,
+        help="configuration file to merge over the reference (default: reference)",
+    )
     show.set_defaults(func=run_show)
     check = cmds.add_parser("check", help="validate configuration files")
     check.add_argument("files", metavar="FILE", nargs="+", help="TOML configuration file(s)")

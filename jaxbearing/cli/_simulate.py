@@ -51,13 +51,15 @@ def _load(args):
     from ..io import check_runnable
 
     cfg = load_named_config(args.config)
-    overrides = {key: getattr(args, attr) for attr, (_, key) in _OVERRIDES.items()
-                 if getattr(args, attr) is not None}
+    overrides = {
+        key: getattr(args, attr) for attr, (_, key) in _OVERRIDES.items() if getattr(args, attr) is not None
+    }
     try:
         cfg = cfg.replace(**overrides) if overrides else cfg
     except UserInputError as exc:
-        raise _named(exc, next((opt for opt, key in _OVERRIDES.values()
-                                if key == getattr(exc, "field", None)), None)) from None
+        raise _named(
+            exc, next((opt for opt, key in _OVERRIDES.values() if key == getattr(exc, "field", None)), None)
+        ) from None
     try:
         check_runnable(cfg)
     except UserInputError as exc:
@@ -142,7 +144,8 @@ def format_table(summaries: dict) -> str:
     stats = ("max", "mean", "median")
     widths = {e: max(12, len(f"{e} median") + 2) for e in ends}
     head = f"{'quantity':<22}{'unit':>9}" + "".join(
-        f"{e + ' ' + st:>{widths[e]}}" for e in ends for st in stats)
+        f"{e + ' ' + st:>{widths[e]}}" for e in ends for st in stats
+    )
     lines = [head, "-" * len(head)]
     for key, label, unit, k in _TABLE_ROWS:
         row = f"{label:<22}{unit:>9}"
@@ -151,8 +154,10 @@ def format_table(summaries: dict) -> str:
         lines.append(row)
     for e in ends:
         if failed[e]:
-            lines.append(f"{FAILED_MARK} [{e}] the run failed: statistics cover only the simulated "
-                         "time before the failure and are not reliable")
+            lines.append(
+                f"{FAILED_MARK} [{e}] the run failed: statistics cover only the simulated "
+                "time before the failure and are not reliable"
+            )
     lines.append("")
     for e in ends:
         s = summaries[e]
@@ -189,8 +194,9 @@ def _strict_summary(summary: dict) -> dict:
     block = dict(summary)
     failed = block.get("status", "ok") != "ok"
     if failed:
-        block["warning"] = ("the run failed: statistics cover only the simulated time before the "
-                            "failure and are not reliable")
+        block["warning"] = (
+            "the run failed: statistics cover only the simulated time before the failure and are not reliable"
+        )
     return with_null_reasons(block, "the run failed (see status)" if failed else "no value")
 
 

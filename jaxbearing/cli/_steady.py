@@ -21,13 +21,24 @@ _ROWS = (
 
 def add_arguments(p) -> None:
     g = p.add_argument_group("settled running (statistics with 95 % confidence intervals)")
-    g.add_argument("--settle", help='"auto" (detect settling), "off" (measure from the start) or a '
-                   "settling time in ms; without it, one fixed-duration run from the start")
-    g.add_argument("--window-revs", type=float, default=8, help="measurement window [cage revolutions] (default 8)")
+    g.add_argument(
+        "--settle",
+        help='"auto" (detect settling), "off" (measure from the start) or a '
+        "settling time in ms; without it, one fixed-duration run from the start",
+    )
+    g.add_argument(
+        "--window-revs", type=float, default=8, help="measurement window [cage revolutions] (default 8)"
+    )
     g.add_argument("--seeds", type=float, default=1, help="independent seeded runs (default 1: batch means)")
-    g.add_argument("--settle-tolerance", type=float, default=1e-3,
-                   help="relative change of the revolution-mean cage speed that counts as settled (default 1e-3)")
-    g.add_argument("--settle-cap-ms", type=float, default=300.0, help="longest settling time [ms] (default 300)")
+    g.add_argument(
+        "--settle-tolerance",
+        type=float,
+        default=1e-3,
+        help="relative change of the revolution-mean cage speed that counts as settled (default 1e-3)",
+    )
+    g.add_argument(
+        "--settle-cap-ms", type=float, default=300.0, help="longest settling time [ms] (default 300)"
+    )
 
 
 def options(args) -> dict | None:
@@ -37,11 +48,23 @@ def options(args) -> dict | None:
     from ..run import check_steady_options
 
     settle = args.settle if args.settle in ("auto", "off") else args.settle
-    names = {"settle": "--settle", "window_revs": "--window-revs", "seeds": "--seeds",
-             "tolerance": "--settle-tolerance", "cap_ms": "--settle-cap-ms"}
-    check_steady_options(settle, args.window_revs, args.seeds, args.settle_tolerance, args.settle_cap_ms, names)
-    return dict(settle=settle if settle in ("auto", "off") else float(settle), window_revs=int(args.window_revs),
-                seeds=int(args.seeds), tolerance=args.settle_tolerance, settle_cap_ms=args.settle_cap_ms)
+    names = {
+        "settle": "--settle",
+        "window_revs": "--window-revs",
+        "seeds": "--seeds",
+        "tolerance": "--settle-tolerance",
+        "cap_ms": "--settle-cap-ms",
+    }
+    check_steady_options(
+        settle, args.window_revs, args.seeds, args.settle_tolerance, args.settle_cap_ms, names
+    )
+    return dict(
+        settle=settle if settle in ("auto", "off") else float(settle),
+        window_revs=int(args.window_revs),
+        seeds=int(args.seeds),
+        tolerance=args.settle_tolerance,
+        settle_cap_ms=args.settle_cap_ms,
+    )
 
 
 def _ci(est, k, fmt=".4g") -> str:
@@ -67,7 +90,12 @@ def format_table(summaries: dict) -> str:
     extra = (
         ("contact radius, p99", "mm", lambda s: s.get("contact_radius_m", {}).get("p99"), 1e3),
         ("corner-contact share, time", "%", lambda s: s.get("corner_contact_share", {}).get("time"), 100.0),
-        ("corner-contact share, events", "%", lambda s: s.get("corner_contact_share", {}).get("events"), 100.0),
+        (
+            "corner-contact share, events",
+            "%",
+            lambda s: s.get("corner_contact_share", {}).get("events"),
+            100.0,
+        ),
         ("cage speed", "rpm", lambda s: s.get("cage_speed_rpm"), 1.0),
         ("cage slip", "%", lambda s: s.get("cage_slip"), 100.0),
         ("roller skew, mean |.|", "mrad", lambda s: s.get("roller_skew_rad", {}).get("mean_abs"), 1e3),
@@ -87,9 +115,11 @@ def format_table(summaries: dict) -> str:
             f"(+ compile {s['compile_time_s']:.1f} s)"
         )
         if s["settle_mode"] == "auto" and not s["settled"]:
-            lines.append(f"[{e}] NOT SETTLED: the cage speed still changed by more than "
-                         f"{s['settle_tolerance']:.2g} per revolution at the cap of {s['settle_cap_ms']:.0f} ms; "
-                         "the statistics come from a transient (fix a settling time with --settle MS)")
+            lines.append(
+                f"[{e}] NOT SETTLED: the cage speed still changed by more than "
+                f"{s['settle_tolerance']:.2g} per revolution at the cap of {s['settle_cap_ms']:.0f} ms; "
+                "the statistics come from a transient (fix a settling time with --settle MS)"
+            )
     return "\n".join(lines)
 
 

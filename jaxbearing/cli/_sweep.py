@@ -25,21 +25,41 @@ def register(sub) -> None:
     p.add_argument("spec", help="sweep spec (TOML: [sweep], [base], [axes])")
     p.add_argument("--out", required=True, help="output directory")
     p.add_argument("--batch-size", type=int, help="cases per vmapped batch (overrides the spec)")
-    p.add_argument("--resume", action=argparse.BooleanOptionalAction, default=True,
-                   help="skip batches already in DIR (default); --no-resume recomputes all")
-    p.add_argument("--coordinator", help="jax.distributed coordinator HOST:PORT (process 0's "
-                   "address; env JAXBEARING_COORDINATOR)")
-    p.add_argument("--num-processes", type=int, help="number of processes (env "
-                   "JAXBEARING_NUM_PROCESSES)")
-    p.add_argument("--process-id", type=int, help="this process, 0..num-processes-1 (env "
-                   "JAXBEARING_PROCESS_ID)")
-    p.add_argument("--wait-timeout-s", type=float, default=24 * 3600.0,
-                   help="process 0: how long to wait for the other processes' batches")
-    p.add_argument("--wait-for-lock", type=float, nargs="?", const=float("inf"), default=0.0,
-                   metavar="SECONDS", help="when another sweep is writing into DIR, wait for it "
-                   "(up to SECONDS; no value: as long as it takes) instead of exiting with status 2")
-    p.add_argument("--dry-run", action="store_true", help="validate the spec, list the axes "
-                   "and the number of cases and batches, compute nothing")
+    p.add_argument(
+        "--resume",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="skip batches already in DIR (default); --no-resume recomputes all",
+    )
+    p.add_argument(
+        "--coordinator",
+        help="jax.distributed coordinator HOST:PORT (process 0's address; env JAXBEARING_COORDINATOR)",
+    )
+    p.add_argument("--num-processes", type=int, help="number of processes (env JAXBEARING_NUM_PROCESSES)")
+    p.add_argument(
+        "--process-id", type=int, help="this process, 0..num-processes-1 (env JAXBEARING_PROCESS_ID)"
+    )
+    p.add_argument(
+        "--wait-timeout-s",
+        type=float,
+        default=24 * 3600.0,
+        help="process 0: how long to wait for the other processes' batches",
+    )
+    p.add_argument(
+        "--wait-for-lock",
+        type=float,
+        nargs="?",
+        const=float("inf"),
+        default=0.0,
+        metavar="SECONDS",
+        help="when another sweep is writing into DIR, wait for it "
+        "(up to SECONDS; no value: as long as it takes) instead of exiting with status 2",
+    )
+    p.add_argument(
+        "--dry-run",
+        action="store_true",
+        help="validate the spec, list the axes and the number of cases and batches, compute nothing",
+    )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.set_defaults(func=run)
 
@@ -50,23 +70,34 @@ def run(args) -> int:
     spec = load_sweep_spec(args.spec)
     if args.batch_size is not None:
         spec = spec.with_batch_size(args.batch_size)
-    print(f"sweep {args.spec}: {spec.num_cases} cases "
-          f"({' x '.join(f'{d} {n}' for d, n in zip(spec.dims, spec.shape))}), "
-          f"{spec.num_batches} batches of {spec.batch_size}; spec hash {spec.hash}",
-          file=sys.stderr)
+    print(
+        f"sweep {args.spec}: {spec.num_cases} cases "
+        f"({' x '.join(f'{d} {n}' for d, n in zip(spec.dims, spec.shape))}), "
+        f"{spec.num_batches} batches of {spec.batch_size}; spec hash {spec.hash}",
+        file=sys.stderr,
+    )
     if args.dry_run:
         for a in spec.axes:
             print(f"  {a.key} [{a.dim}]: {', '.join(map(str, a.values))}")
         return 0
-    process_id, num_processes = initialize_distributed(args.coordinator, args.num_processes,
-                                                       args.process_id)
+    process_id, num_processes = initialize_distributed(args.coordinator, args.num_processes, args.process_id)
     import jax
 
-    print(f"process {process_id}/{num_processes}: {jax.local_device_count()} local device(s) "
-          f"({jax.local_devices()[0].platform})", file=sys.stderr)
-    ds = run_sweep(spec, args.out, resume=args.resume, process_id=process_id,
-                   num_processes=num_processes, progress=not args.no_progress,
-                   wait_timeout_s=args.wait_timeout_s, lock_wait_s=args.wait_for_lock)
+    print(
+        f"process {process_id}/{num_processes}: {jax.local_device_count()} local device(s) "
+        f"({jax.local_devices()[0].platform})",
+        file=sys.stderr,
+    )
+    ds = run_sweep(
+        spec,
+        args.out,
+        resume=args.resume,
+        process_id=process_id,
+        num_processes=num_processes,
+        progress=not args.no_progress,
+        wait_timeout_s=args.wait_timeout_s,
+        lock_wait_s=args.wait_for_lock,
+    )
     if ds is None:
         print(f"process {process_id}: batches written to {args.out}/batches")
         return 0

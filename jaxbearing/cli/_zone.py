@@ -100,13 +100,9 @@ def zone_maps(bearing, flange_load: float, points: int = GRID_POINTS):
     t_deg = np.linspace(*LAYBACK_RANGE_DEG, points)
     c_mm = np.linspace(*CLEARANCE_RANGE_MM, points)
     rr, tt = np.meshgrid(r_mm, t_deg)
-    height = design_zone_grid(
-        bearing, rr * MM, np.radians(tt), bearing.flange.axial_clearance, flange_load
-    )
+    height = design_zone_grid(bearing, rr * MM, np.radians(tt), bearing.flange.axial_clearance, flange_load)
     rr2, cc = np.meshgrid(r_mm, c_mm)
-    clear = design_zone_grid(
-        bearing, rr2 * MM, bearing.flange.layback_angle, cc * MM, flange_load
-    )
+    clear = design_zone_grid(bearing, rr2 * MM, bearing.flange.layback_angle, cc * MM, flange_load)
     return (r_mm, t_deg, height), (r_mm, c_mm, clear)
 
 
@@ -120,8 +116,9 @@ def _height_feasible(z):
     )
 
 
-def _draw_map(x, y, field, *, colorbar, contours, feasible, star, xlabel, ylabel, title,
-              legend_loc, path, **contourf_kw) -> str:
+def _draw_map(
+    x, y, field, *, colorbar, contours, feasible, star, xlabel, ylabel, title, legend_loc, path, **contourf_kw
+) -> str:
     """One design-zone map: filled `field` over (x, y), zero lines of each (margin, colour,
     label) in `contours`, the feasible region hatched, the current design `star` (or None)."""
     import numpy as np
@@ -143,8 +140,9 @@ def _draw_map(x, y, field, *, colorbar, contours, feasible, star, xlabel, ylabel
     handles.append(Patch(facecolor="none", edgecolor="k", hatch="//", label="feasible"))
     if star is not None:
         ax.plot(*([v] for v in star), marker="*", ms=16, color="magenta", mec="k", ls="none")
-    handles.append(Line2D([], [], marker="*", ms=12, color="magenta", mec="k", ls="none",
-                          label="current design"))
+    handles.append(
+        Line2D([], [], marker="*", ms=12, color="magenta", mec="k", ls="none", label="current design")
+    )
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
     ax.set_title(title)
@@ -173,30 +171,47 @@ def write_maps(bearing, flange_load: float, out_dir: str) -> list[str]:
     arc_radius_margin = np.asarray(hz.limited_circle_radius) - rr * np.sin(tt)
     on_arc = np.asarray(hz.on_arc) > 0.5
     height = _draw_map(
-        r_mm, t_deg, np.asarray(hz.contact_height) / MM, levels=24, cmap="viridis",
+        r_mm,
+        t_deg,
+        np.asarray(hz.contact_height) / MM,
+        levels=24,
+        cmap="viridis",
         colorbar="contact height h_c [mm]",
         contours=[
             (hz.height_margin, "tab:red", "upper limit h_c = h_up"),
-            (np.where(on_arc, hz.relief_margin, np.nan), "tab:orange",
-             "relief (lower) limit h_c - a = h_rel"),
+            (
+                np.where(on_arc, hz.relief_margin, np.nan),
+                "tab:orange",
+                "relief (lower) limit h_c - a = h_rel",
+            ),
             (arc_radius_margin, "white", "limited circle rho_c = rho_lim"),
         ],
-        feasible=_height_feasible(hz), star=(r_now, t_now) if in_range else None,
-        xlabel="end radius R_end [mm]", ylabel="flange layback angle theta_f [deg]",
+        feasible=_height_feasible(hz),
+        star=(r_now, t_now) if in_range else None,
+        xlabel="end radius R_end [mm]",
+        ylabel="flange layback angle theta_f [deg]",
         title=f"Contact height (Delta_bf = {c_now:.3f} mm, flange load {flange_load:.0f} N)",
-        legend_loc="upper right", path=os.path.join(out_dir, "zone_height_map.png"),
+        legend_loc="upper right",
+        path=os.path.join(out_dir, "zone_height_map.png"),
     )
     lam = np.asarray(cz.actual_axial_clearance) / MM
     span = max(float(np.max(np.abs(lam))), 1e-6)
     clearance = _draw_map(
-        r_mm, c_mm, lam, levels=np.linspace(-span, span, 25), cmap="coolwarm_r",
+        r_mm,
+        c_mm,
+        lam,
+        levels=np.linspace(-span, span, 25),
+        cmap="coolwarm_r",
         norm=TwoSlopeNorm(0.0, -span, span),
         colorbar="actual axial clearance Lambda_bf [mm]",
         contours=[(lam, "k", "Lambda_bf = 0 (contact line)")],
-        feasible=np.asarray(cz.clearance_margin) > 0, star=(r_now, c_now) if in_range else None,
-        xlabel="end radius R_end [mm]", ylabel="axial clearance Delta_bf [mm]",
+        feasible=np.asarray(cz.clearance_margin) > 0,
+        star=(r_now, c_now) if in_range else None,
+        xlabel="end radius R_end [mm]",
+        ylabel="axial clearance Delta_bf [mm]",
         title=f"Actual axial clearance (theta_f = {t_now:.2f} deg)",
-        legend_loc="lower right", path=os.path.join(out_dir, "zone_clearance_map.png"),
+        legend_loc="lower right",
+        path=os.path.join(out_dir, "zone_clearance_map.png"),
     )
     return [height, clearance]
 

@@ -150,8 +150,7 @@ def ehl_parameters(
     viscosity: Float[ArrayLike, "*#batch"],
     pressure_viscosity: Float[ArrayLike, "*#batch"],
     speed_eps: Float[ArrayLike, "*#batch"] = SLIDING_EPS,
-) -> tuple[Float[Array, "*batch"], Float[Array, "*batch"], Float[Array, "*batch"],
-           Float[Array, "*batch"]]:
+) -> tuple[Float[Array, "*batch"], Float[Array, "*batch"], Float[Array, "*batch"], Float[Array, "*batch"]]:
     """Hamrock & Dowson's dimensionless (U, G, W, k) of an elliptical EHL contact.
 
     U = eta u / (E' R_x) with u = sqrt(u_e^2 + u_eps^2), G = alpha_p E',
@@ -169,11 +168,21 @@ def ehl_parameters(
     return speed, materials, load_parameter, ellipticity
 
 
-def _film(coefficients, load, radius_x, radius_y, entrainment_speed, e_prime, viscosity,
-          pressure_viscosity, speed_eps):
+def _film(
+    coefficients,
+    load,
+    radius_x,
+    radius_y,
+    entrainment_speed,
+    e_prime,
+    viscosity,
+    pressure_viscosity,
+    speed_eps,
+):
     c, nu, ng, nw, a, b = coefficients
-    u, g, w, k = ehl_parameters(load, radius_x, radius_y, entrainment_speed, e_prime, viscosity,
-                                pressure_viscosity, speed_eps)
+    u, g, w, k = ehl_parameters(
+        load, radius_x, radius_y, entrainment_speed, e_prime, viscosity, pressure_viscosity, speed_eps
+    )
     shape = 1.0 - a * jnp.exp(-b * k)
     return c * u**nu * g**ng * w**nw * shape * jnp.asarray(radius_x)
 
@@ -202,8 +211,9 @@ def minimum_film_thickness(
         pressure_viscosity: alpha_p [1/Pa] (> 0).
         speed_eps: u_eps [m/s].
     """
-    return _film(_MIN, load, radius_x, radius_y, entrainment_speed, e_prime, viscosity,
-                 pressure_viscosity, speed_eps)
+    return _film(
+        _MIN, load, radius_x, radius_y, entrainment_speed, e_prime, viscosity, pressure_viscosity, speed_eps
+    )
 
 
 def central_film_thickness(
@@ -218,8 +228,17 @@ def central_film_thickness(
 ) -> Float[Array, "*batch"]:
     """Hamrock-Dowson central EHL film h_c = R_x 2.69 U^0.67 G^0.53 W^-0.067
     (1 - 0.61 exp(-0.73 k)) [m]. Arguments as in `minimum_film_thickness`."""
-    return _film(_CENTRAL, load, radius_x, radius_y, entrainment_speed, e_prime, viscosity,
-                 pressure_viscosity, speed_eps)
+    return _film(
+        _CENTRAL,
+        load,
+        radius_x,
+        radius_y,
+        entrainment_speed,
+        e_prime,
+        viscosity,
+        pressure_viscosity,
+        speed_eps,
+    )
 
 
 def film_parameter(
@@ -234,8 +253,7 @@ def film_parameter(
         roughness_1, roughness_2: rms roughnesses R_q of the two surfaces [m].
     The floor s_f = `ROUGHNESS_FLOOR` only matters for ideally smooth surfaces.
     """
-    sigma2 = (jnp.square(jnp.asarray(roughness_1)) + jnp.square(jnp.asarray(roughness_2))
-              + ROUGHNESS_FLOOR**2)
+    sigma2 = jnp.square(jnp.asarray(roughness_1)) + jnp.square(jnp.asarray(roughness_2)) + ROUGHNESS_FLOOR**2
     return jnp.asarray(film_thickness) / jnp.sqrt(sigma2)
 
 
@@ -300,7 +318,5 @@ def mixed_traction_force(
     """
     u = jnp.asarray(sliding_velocity)
     s = jnp.sqrt(jnp.sum(u * u, axis=-1) + jnp.square(speed_eps))
-    mu = mixed_traction_coefficient(
-        film_parameter, boundary_coefficient, traction_coefficient(s, lubricant)
-    )
+    mu = mixed_traction_coefficient(film_parameter, boundary_coefficient, traction_coefficient(s, lubricant))
     return -(jnp.asarray(normal_load) * mu / s)[..., None] * u

@@ -98,9 +98,7 @@ def contact_loads(state: State, params: Params) -> Loads:
     inner_w = op.inner_speed * X
     zero = jnp.zeros(3)
 
-    raceway = jax.vmap(
-        raceway_contact, in_axes=(None, None, None, 0, 0, 0, 0, None, None, None)
-    )
+    raceway = jax.vmap(raceway_contact, in_axes=(None, None, None, 0, 0, 0, 0, None, None, None))
     inner = raceway(b, 1.0, b.inner_raceway_radius, p, e, v, w, inner_c, inner_v, inner_w)
     outer = raceway(b, -1.0, b.outer_raceway_radius, p, e, v, w, zero, zero, zero)
     flange = all_flange_contacts(b, p, e, v, w, inner_c, inner_v, inner_w, zero, zero, zero)
@@ -111,9 +109,9 @@ def contact_loads(state: State, params: Params) -> Loads:
     pocket_angle = cage.angle + 2 * jnp.pi * jnp.arange(b.num_rollers) / b.num_rollers
     pocket_c = cage_c + (b.pitch_diameter / 2) * radial_unit(pocket_angle)
     pocket_t = tangential_unit(pocket_angle)
-    pocket = jax.vmap(
-        pocket_contact, in_axes=(None, 0, 0, 0, 0, 0, 0, None, None, None)
-    )(b, p, e, v, w, pocket_c, pocket_t, cage_v, cage.speed * X, cage_c)
+    pocket = jax.vmap(pocket_contact, in_axes=(None, 0, 0, 0, 0, 0, 0, None, None, None))(
+        b, p, e, v, w, pocket_c, pocket_t, cage_v, cage.speed * X, cage_c
+    )
     return Loads(inner=inner, outer=outer, flange=flange, pocket=pocket)
 
 
@@ -182,9 +180,7 @@ def _cage_rates(cage: CageState, loads: Loads, params: Params) -> CageState:
     cage_c = jnp.concatenate([jnp.zeros(1), cage.centre])
     cage_v = jnp.concatenate([jnp.zeros(1), cage.velocity])
     land_f, land_m = cage_land_forces(b, cage_c, cage_v, cage.speed)
-    force = (
-        jnp.sum(loads.pocket.force_on_cage, axis=0) + land_f + b.cage_mass * _gravity(params.operating)
-    )
+    force = jnp.sum(loads.pocket.force_on_cage, axis=0) + land_f + b.cage_mass * _gravity(params.operating)
     torque = jnp.sum(loads.pocket.moment_on_cage[:, 0]) + land_m + cage_drag_torque(b, cage.speed)
     return CageState(
         centre=cage.velocity,

@@ -166,11 +166,7 @@ def _solve_rollers(prob: _Problem, d):
     half_d = b.roller.diameter / 2
     r_inner_touch = b.inner_raceway_radius + half_d + prob.radial_units_yz @ d
     r_outer_touch = b.outer_raceway_radius - half_d
-    margin = (
-        _deflection_bound(prob, prob.roller_external)
-        + b.roller.crown_drop
-        + 1e3 * PENETRATION_WIDTH
-    )
+    margin = _deflection_bound(prob, prob.roller_external) + b.roller.crown_drop + 1e3 * PENETRATION_WIDTH
     lo0 = jnp.minimum(r_inner_touch, r_outer_touch) - margin
     hi0 = jnp.maximum(r_inner_touch, r_outer_touch) + margin
 

@@ -146,17 +146,25 @@ class Scaling(eqx.Module):
 
     def _drift(self, t) -> State:
         zero = jax.tree_util.tree_map(jnp.zeros_like, self.nominal)
-        zero = eqx.tree_at(lambda s: s.rollers.azimuth, zero, self.orbit_speed * t * jnp.ones_like(self.nominal.rollers.azimuth))
+        zero = eqx.tree_at(
+            lambda s: s.rollers.azimuth,
+            zero,
+            self.orbit_speed * t * jnp.ones_like(self.nominal.rollers.azimuth),
+        )
         return eqx.tree_at(lambda s: s.cage.angle, zero, self.orbit_speed * t)
 
     def _drift_rate(self) -> State:
         zero = jax.tree_util.tree_map(jnp.zeros_like, self.nominal)
-        zero = eqx.tree_at(lambda s: s.rollers.azimuth, zero, self.orbit_speed * jnp.ones_like(self.nominal.rollers.azimuth))
+        zero = eqx.tree_at(
+            lambda s: s.rollers.azimuth, zero, self.orbit_speed * jnp.ones_like(self.nominal.rollers.azimuth)
+        )
         return eqx.tree_at(lambda s: s.cage.angle, zero, self.orbit_speed)
 
     def unscale(self, t, scaled: State) -> State:
         drift = self._drift(t)
-        return jax.tree_util.tree_map(lambda n, d, s, y: n + d + s * y, self.nominal, drift, self.scale, scaled)
+        return jax.tree_util.tree_map(
+            lambda n, d, s, y: n + d + s * y, self.nominal, drift, self.scale, scaled
+        )
 
     def scale_state(self, t, y: State) -> State:
         drift = self._drift(t)

@@ -34,8 +34,7 @@ def check_design(
     `min_clearance` finite when given."""
     if design is None:
         names = ("roller.end_radius", "flange.layback_angle", "flange.axial_clearance")
-        values = (bearing.roller.end_radius, bearing.flange.layback_angle,
-                  bearing.flange.axial_clearance)
+        values = (bearing.roller.end_radius, bearing.flange.layback_angle, bearing.flange.axial_clearance)
         clearance_ok, clearance_valid = (lambda v: v >= 0), ">= 0 m"
     else:
         names = ("design.end_radius", "design.layback_angle", "design.axial_clearance")
@@ -44,8 +43,9 @@ def check_design(
     if is_concrete(bearing.roller.diameter):
         half_d = float(np.max(np.asarray(bearing.roller.diameter))) / 2
         require(names[0], values[0], lambda v: v > half_d, f"> D/2 = {half_d} m (inf for flat ends)")
-    require(names[1], values[1], lambda v: (v >= 0) & (v < np.pi / 4),
-            "in [0, 45) deg (radians inside the code)")
+    require(
+        names[1], values[1], lambda v: (v >= 0) & (v < np.pi / 4), "in [0, 45) deg (radians inside the code)"
+    )
     require(names[2], values[2], clearance_ok, clearance_valid)
     if flange_load is not None:
         require("flange_load", flange_load, lambda v: v > 0, "> 0 N")

@@ -65,6 +65,7 @@ from ._geometry import flange_effective_modulus, flange_geometry
 Scalar = Float[Array, ""]
 Vec3 = Float[Array, "3"]
 
+
 class FlangeContact(eqx.Module):
     """Result of one roller-end/flange contact (leading batch axes when vmapped).
 
@@ -138,9 +139,7 @@ def roller_flange_contact(
     `ring_sign` g = +1 inner ring, -1 outer ring; roller centre p, unit axis e (about +X),
     velocity v and angular velocity w; ring centre c_r, velocity v_r, angular velocity w_r.
     """
-    g = flange_geometry(
-        bearing, raceway_radius, side, ring_sign, roller_centre, roller_axis, ring_centre
-    )
+    g = flange_geometry(bearing, raceway_radius, side, ring_sign, roller_centre, roller_axis, ring_centre)
     n = g.normal
     c = g.contact_point
     p = jnp.asarray(roller_centre)
@@ -223,6 +222,14 @@ def all_flange_contacts(
 
     per_roller = jax.vmap(one, in_axes=(0, 0, 0, 0, 0, 0, None, None, None, None))
     return jax.vmap(per_roller, in_axes=(None,) * 6 + (0, 0, 0, 0))(
-        radius, side, ring_sign, c_r, v_r, w_r,
-        roller_centre, roller_axis, roller_velocity, roller_angular_velocity,
+        radius,
+        side,
+        ring_sign,
+        c_r,
+        v_r,
+        w_r,
+        roller_centre,
+        roller_axis,
+        roller_velocity,
+        roller_angular_velocity,
     )

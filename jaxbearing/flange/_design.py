@@ -35,9 +35,7 @@ def with_design(
     if layback_angle is not None:
         out = eqx.tree_at(lambda b: b.flange.layback_angle, out, jnp.asarray(layback_angle, float))
     if axial_clearance is not None:
-        out = eqx.tree_at(
-            lambda b: b.flange.axial_clearance, out, jnp.asarray(axial_clearance, float)
-        )
+        out = eqx.tree_at(lambda b: b.flange.axial_clearance, out, jnp.asarray(axial_clearance, float))
     return out
 
 

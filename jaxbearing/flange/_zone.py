@@ -86,7 +86,9 @@ def design_zone(
     protrusion = h_axis - roller.length / 2
     clearance = bearing.flange.axial_clearance - 2 * protrusion * jnp.cos(theta)
     half_width, _ = point_contact_ellipse(
-        jnp.asarray(flange_load, dtype=float), geo.radius_meridian, geo.radius_parallel,
+        jnp.asarray(flange_load, dtype=float),
+        geo.radius_meridian,
+        geo.radius_parallel,
         flange_effective_modulus(bearing),
     )
     rho_lim = limited_circle_radius(roller)

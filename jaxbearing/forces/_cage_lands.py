@@ -170,9 +170,7 @@ def cage_land_forces(
 
     # rub contact on the lands
     v_n = jnp.dot(vel, n)
-    q_el = hertz_force(
-        e_len - clearance, land_contact_stiffness(bearing), penetration_width, _LINE_EXPONENT
-    )
+    q_el = hertz_force(e_len - clearance, land_contact_stiffness(bearing), penetration_width, _LINE_EXPONENT)
     factor = hunt_crossley_factor(v_n, damping)
     q = q_el * factor
     slide = jnp.dot(vel, t) + omega * radius

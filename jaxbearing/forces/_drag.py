@@ -100,12 +100,7 @@ def _cylinder_wall_shear(omega, radius, rho, eta) -> Array:
     """
     u = omega * radius
     turbulent = (
-        0.5
-        * rho
-        * _PRANDTL_CF
-        * (eta / (rho * 2 * jnp.pi * radius)) ** 0.2
-        * _safe_power(u * u, 0.4)
-        * u
+        0.5 * rho * _PRANDTL_CF * (eta / (rho * 2 * jnp.pi * radius)) ** 0.2 * _safe_power(u * u, 0.4) * u
     )
     return 2 * eta * omega + turbulent
 

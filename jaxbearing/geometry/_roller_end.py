@@ -87,9 +87,7 @@ LIMITED_CIRCLE_BAND = 5e-6
 SIN_ALPHA_FLOOR = 1e-6
 
 
-def end_support(
-    roller: Roller, cos_alpha: ArrayLike, sin_alpha: ArrayLike
-) -> tuple[Array, Array, Array]:
+def end_support(roller: Roller, cos_alpha: ArrayLike, sin_alpha: ArrayLike) -> tuple[Array, Array, Array]:
     """Support function and extreme point of the roller end in the direction
     n = (cos(alpha), sin(alpha)) of the meridian half-plane.
 

@@ -88,8 +88,10 @@ class Rule:
         unit = f" {self.unit}" if self.unit else ""
         lo, hi = self.lo, self.hi
         if lo is not None and hi is not None:
-            rng = (f"in {'[' if self.lo_closed else '('}{_short(lo)}, {_short(hi)}"
-                   f"{']' if self.hi_closed else ')'}{unit}")
+            rng = (
+                f"in {'[' if self.lo_closed else '('}{_short(lo)}, {_short(hi)}"
+                f"{']' if self.hi_closed else ')'}{unit}"
+            )
         elif lo is not None:
             rng = f"{'>=' if self.lo_closed else '>'} {_short(lo)}{unit}"
         elif hi is not None:
@@ -113,6 +115,7 @@ class Rule:
     def check(self, name: str, value) -> None:
         """Raise `UserInputError("{name} = {value}: must be {text}")` unless `value` is valid;
         traced (under jit/grad/vmap) values pass."""
+
         def fail(shown: str):
             raise UserInputError(f"{name} = {shown}: must be {self.text()}")
 
@@ -144,6 +147,7 @@ class Rule:
         if np.any(bad):
             first = float(v if v.ndim == 0 else v[bad].ravel()[0])
             fail(repr(float(f"{first:.12g}")) if math.isfinite(first) else repr(first))
+
 
 def real(lo=None, hi=None, *, lo_closed=False, hi_closed=False, unit="", note="") -> Rule:
     """A rule for a finite real number in the range lo..hi (open ends unless closed)."""
@@ -220,8 +224,15 @@ def check_model_inputs(bearing, op=None) -> None:
     validate_bearing(bearing, op, traced="skip")
 
 
-def check_solve_inputs(bearing, op, *, perturbation=None, functionals=None,
-                       rules: Mapping[str, Rule] | None = None, **solver_arguments) -> None:
+def check_solve_inputs(
+    bearing,
+    op,
+    *,
+    perturbation=None,
+    functionals=None,
+    rules: Mapping[str, Rule] | None = None,
+    **solver_arguments,
+) -> None:
     """Everything a solve takes, before anything is traced: the solver arguments
     (`SOLVER_ARGUMENTS`, or `rules` where given), the perturbation and functionals fields, then
     the bearing and operating point (`check_model_inputs`)."""
@@ -231,4 +242,3 @@ def check_solve_inputs(bearing, op, *, perturbation=None, functionals=None,
     if functionals is not None:
         check_fields("functionals", functionals, FUNCTIONALS_FIELDS)
     check_model_inputs(bearing, op)
-

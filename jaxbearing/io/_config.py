@@ -103,8 +103,7 @@ class SimulationSettings:
 
 
 # -- unknown keys --------------------------------------------------------------------------------
-def _unknown(path: str, name: str, node: Mapping[str, Any], prefix: str,
-             section: bool) -> ConfigError:
+def _unknown(path: str, name: str, node: Mapping[str, Any], prefix: str, section: bool) -> ConfigError:
     """Error for an unknown key or section `path`, with a "did you mean ...?" suggestion."""
     is_table = {n: isinstance(c, dict) for n, c in node.items()}
 
@@ -256,9 +255,15 @@ class Config:
             value = value if key.kind is int else key.to_si(value)
             group, _, field = key.attr.rpartition(".")
             (parts.setdefault(group, {}) if group else top)[field] = value
-        classes = {"roller": Roller, "flange": Flange, "cage": Cage, "lubricant": Lubricant,
-                   "ring_material": Material, "roller_material": Material,
-                   "cage_material": Material}
+        classes = {
+            "roller": Roller,
+            "flange": Flange,
+            "cage": Cage,
+            "lubricant": Lubricant,
+            "ring_material": Material,
+            "roller_material": Material,
+            "cage_material": Material,
+        }
         return Bearing(**top, **{g: classes[g](**kw) for g, kw in parts.items()})
 
     def operating_point(self) -> OperatingPoint:
@@ -273,8 +278,9 @@ class Config:
     @property
     def simulation(self) -> SimulationSettings:
         """The [simulation] settings."""
-        return SimulationSettings(**{f.name: self._values[f"simulation.{f.name}"]
-                                     for f in dataclasses.fields(SimulationSettings)})
+        return SimulationSettings(
+            **{f.name: self._values[f"simulation.{f.name}"] for f in dataclasses.fields(SimulationSettings)}
+        )
 
     # -- writing --------------------------------------------------------------------------------
     def to_toml(self, *, comments: bool = True) -> str:
@@ -353,8 +359,11 @@ def load_config(path: str | os.PathLike[str] | None = None) -> Config:
     try:
         text = raw.decode("utf-8-sig")  # without a leading byte-order mark
     except UnicodeDecodeError as exc:
-        hint = ("; it starts with a UTF-16 byte-order mark: save it as UTF-8"
-                if raw[:2] in (b"\xff\xfe", b"\xfe\xff") else "")
+        hint = (
+            "; it starts with a UTF-16 byte-order mark: save it as UTF-8"
+            if raw[:2] in (b"\xff\xfe", b"\xfe\xff")
+            else ""
+        )
         raise ConfigError("file", f"not UTF-8 text (byte {exc.start}){hint}") from None
     return loads_config(text)
 
@@ -367,9 +376,10 @@ def check_runnable(cfg: Config) -> None:
         if end == "arc" and not math.isfinite(cfg["roller.end_radius_mm"]):
             raise ConfigError(
                 "roller.end_radius_mm",
-                f'inf (flat end) cannot be simulated as an arc end (simulation.end = '
+                f"inf (flat end) cannot be simulated as an arc end (simulation.end = "
                 f'"{cfg.simulation.end}"): set simulation.end = "corner" (--end corner) or give '
-                "a finite end radius")
+                "a finite end radius",
+            )
 
 
 def reference_config() -> Config:

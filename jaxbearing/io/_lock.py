@@ -65,12 +65,15 @@ def _holder(path: pathlib.Path) -> dict:
 def _describe(info: dict) -> str:
     if not info:
         return "another process"
-    return (f"pid {info.get('pid')} on {info.get('host')}, started {info.get('started')}"
-            f"{': ' + info['command'] if info.get('command') else ''}")
+    return (
+        f"pid {info.get('pid')} on {info.get('host')}, started {info.get('started')}"
+        f"{': ' + info['command'] if info.get('command') else ''}"
+    )
 
 
-def acquire_lock(directory: str | os.PathLike, name: str, *, wait_s: float = 0.0,
-                 poll_s: float = 1.0, what: str = "run") -> DirectoryLock:
+def acquire_lock(
+    directory: str | os.PathLike, name: str, *, wait_s: float = 0.0, poll_s: float = 1.0, what: str = "run"
+) -> DirectoryLock:
     """Lock DIR/NAME for this process. A lock file whose holder has ended is taken over
     (`DirectoryLock.took_over` = the old holder's record); one held by a running process is
     waited for up to `wait_s` seconds (`math.inf`: as long as it takes), then raises
@@ -78,8 +81,10 @@ def acquire_lock(directory: str | os.PathLike, name: str, *, wait_s: float = 0.0
     path = pathlib.Path(directory) / name
     path.parent.mkdir(parents=True, exist_ok=True)
     if fcntl is None:  # pragma: no cover
-        print(f"warning: cannot lock {path} on this system; make sure no other {what} writes "
-              "there", file=sys.stderr)
+        print(
+            f"warning: cannot lock {path} on this system; make sure no other {what} writes there",
+            file=sys.stderr,
+        )
         return DirectoryLock(path, None, None)
     deadline = time.monotonic() + wait_s
     told = False
@@ -90,25 +95,35 @@ def acquire_lock(directory: str | os.PathLike, name: str, *, wait_s: float = 0.0
         except OSError as exc:
             os.close(fd)
             if exc.errno not in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES):
-                print(f"warning: cannot lock {path} ({exc.strerror}); make sure no other "
-                      f"{what} writes there", file=sys.stderr)
+                print(
+                    f"warning: cannot lock {path} ({exc.strerror}); make sure no other {what} writes there",
+                    file=sys.stderr,
+                )
                 return DirectoryLock(path, None, None)
             holder = _holder(path)
             if time.monotonic() >= deadline:
                 wait = "" if wait_s > 0 else "; wait for it to finish (--wait-for-lock)"
                 raise DirectoryInUse(
                     f"{directory} is in use by another {what} ({_describe(holder)}){wait} or "
-                    "use another output directory") from None
+                    "use another output directory"
+                ) from None
             if not told:
                 limit = "" if math.isinf(wait_s) else f" (up to {wait_s:g} s)"
-                print(f"{directory} is in use by another {what} ({_describe(holder)}); "
-                      f"waiting{limit}", file=sys.stderr, flush=True)
+                print(
+                    f"{directory} is in use by another {what} ({_describe(holder)}); waiting{limit}",
+                    file=sys.stderr,
+                    flush=True,
+                )
                 told = True
             time.sleep(max(0.01, min(poll_s, deadline - time.monotonic())))
             continue
         old = _holder(path)
-        record = {"pid": os.getpid(), "host": socket.gethostname(),
-                  "started": time.strftime("%Y-%m-%dT%H:%M:%S%z"), "command": " ".join(sys.argv)}
+        record = {
+            "pid": os.getpid(),
+            "host": socket.gethostname(),
+            "started": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
+            "command": " ".join(sys.argv),
+        }
         os.ftruncate(fd, 0)
         os.pwrite(fd, json.dumps(record).encode(), 0)
         os.fsync(fd)

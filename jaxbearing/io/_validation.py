@@ -235,8 +235,11 @@ class Key:
         if lo is not None and hi is None and not self.allow_inf:
             return (">= " if lo.closed else "> ") + show(lo)
         lo_s = ("[" if lo.closed else "(") + show(lo) if lo is not None else "(-inf"
-        hi_s = (show(hi) + ("]" if hi.closed else ")")) if hi is not None else "inf" + (
-            "]" if self.allow_inf else ")")
+        hi_s = (
+            (show(hi) + ("]" if hi.closed else ")"))
+            if hi is not None
+            else "inf" + ("]" if self.allow_inf else ")")
+        )
         return f"in {lo_s}, {hi_s}"
 
     def doc(self) -> str:
@@ -264,11 +267,15 @@ def _rollers_fit(v) -> str | None:
     z, d, cp = v["bearing.num_rollers"], v["roller.diameter_mm"], v["cage.pocket_clearance_mm"]
     circ = math.pi * v["bearing.pitch_diameter_mm"]
     if z * d >= circ:
-        return (f"{z} rollers do not fit around the pitch circle (neighbouring rollers overlap): "
-                f"Z D = {_derived(z * d)} mm must be < pi d_m = {_derived(circ)} mm")
+        return (
+            f"{z} rollers do not fit around the pitch circle (neighbouring rollers overlap): "
+            f"Z D = {_derived(z * d)} mm must be < pi d_m = {_derived(circ)} mm"
+        )
     if z * (d + cp) >= circ:
-        return (f"{z} rollers leave no room for the cage bars: Z (D + C_p) = "
-                f"{_derived(z * (d + cp))} mm must be < pi d_m = {_derived(circ)} mm")
+        return (
+            f"{z} rollers leave no room for the cage bars: Z (D + C_p) = "
+            f"{_derived(z * (d + cp))} mm must be < pi d_m = {_derived(circ)} mm"
+        )
     return None
 
 
@@ -302,10 +309,12 @@ def _traction_bounded(v) -> str | None:
     peak, at = _traction_extreme(a, b, c, d)
     if peak <= 1.0:
         return None
-    return (f"the traction curve kappa = (A + B du) exp(-C du) + D reaches |kappa| = "
-            f"{_derived(peak)} at du = {_derived(at)} m/s; it must stay within [-1, 1] "
-            f"(A = {format_value(a)}, B = {format_value(b)} s/m, C = {format_value(c)} s/m, "
-            f"D = {format_value(d)})")
+    return (
+        f"the traction curve kappa = (A + B du) exp(-C du) + D reaches |kappa| = "
+        f"{_derived(peak)} at du = {_derived(at)} m/s; it must stay within [-1, 1] "
+        f"(A = {format_value(a)}, B = {format_value(b)} s/m, C = {format_value(c)} s/m, "
+        f"D = {format_value(d)})"
+    )
 
 
 # -- the schema --------------------------------------------------------------------------------
@@ -318,142 +327,527 @@ _CP, _CG = "cage.pocket_clearance_mm", "cage.guiding_clearance_mm"
 def _material(part: str, attr: str, e: float, nu: float, rho: float, what: str) -> list[Key]:
     s = f"materials.{part}"
     return [
-        _k(f"{s}.elastic_modulus_GPa", float, e, "GPa", "E", f"elastic modulus of the {what}",
-           _const(0, False), _const(1500, True), attr=f"{attr}.elastic_modulus"),
-        _k(f"{s}.poisson_ratio", float, nu, "", "nu", f"Poisson ratio of the {what}",
-           _const(-1, False), _const(0.5, False), attr=f"{attr}.poisson_ratio"),
-        _k(f"{s}.density_kg_m3", float, rho, "kg/m^3", "rho", f"density of the {what}",
-           _const(0, False), _const(25000, True), attr=f"{attr}.density"),
+        _k(
+            f"{s}.elastic_modulus_GPa",
+            float,
+            e,
+            "GPa",
+            "E",
+            f"elastic modulus of the {what}",
+            _const(0, False),
+            _const(1500, True),
+            attr=f"{attr}.elastic_modulus",
+        ),
+        _k(
+            f"{s}.poisson_ratio",
+            float,
+            nu,
+            "",
+            "nu",
+            f"Poisson ratio of the {what}",
+            _const(-1, False),
+            _const(0.5, False),
+            attr=f"{attr}.poisson_ratio",
+        ),
+        _k(
+            f"{s}.density_kg_m3",
+            float,
+            rho,
+            "kg/m^3",
+            "rho",
+            f"density of the {what}",
+            _const(0, False),
+            _const(25000, True),
+            attr=f"{attr}.density",
+        ),
     ]
 
 
 KEYS: tuple[Key, ...] = (
     # [bearing]
-    _k(_DM, float, 85.0, "mm", "d_m", "pitch diameter", _const(0, False), _const(10000, True),
-       attr="pitch_diameter"),
-    _k(_PD, float, 20.0, "um", "P_d", "radial clearance (diametral, split between the rings)",
-       _const(0, True), _rel("pitch_diameter_mm*10", (_DM,), lambda dm: dm * 10, True),
-       attr="radial_clearance", note="at most 1 % of the pitch diameter"),
-    _k("bearing.num_rollers", int, 26, "", "Z", "number of rollers", _const(3, True),
-       attr="num_rollers",
-       extras=(Extra((_DM, _D, _CP), _rollers_fit,
-                     "rollers and cage bars fit around the pitch circle: Z (D + C_p) < pi d_m"),)),
-    _k("bearing.num_slices", int, 31, "", "N_s", "raceway slices per roller (odd)", _const(3, True),
-       _const(200, True), attr="num_slices", note="odd, so that a slice sits at the roller centre",
-       extras=(Extra(("bearing.num_slices",), _odd_slices, "the slice count is odd"),)),
-    _k("bearing.inner_ring_mass_kg", float, 0.5, "kg", "m_i",
-       "effective mass of inner ring and shaft", _const(0, False), _const(1e5, True),
-       attr="inner_ring_mass"),
-    _k("bearing.flange_traction", float, 0.08, "", "mu_f", "roller-flange traction coefficient",
-       _const(0, True), _const(1, True), attr="flange_traction"),
-    _k("bearing.pocket_friction", float, 0.10, "", "mu_p", "roller-pocket friction coefficient",
-       _const(0, True), _const(1, True), attr="pocket_friction"),
+    _k(
+        _DM,
+        float,
+        85.0,
+        "mm",
+        "d_m",
+        "pitch diameter",
+        _const(0, False),
+        _const(10000, True),
+        attr="pitch_diameter",
+    ),
+    _k(
+        _PD,
+        float,
+        20.0,
+        "um",
+        "P_d",
+        "radial clearance (diametral, split between the rings)",
+        _const(0, True),
+        _rel("pitch_diameter_mm*10", (_DM,), lambda dm: dm * 10, True),
+        attr="radial_clearance",
+        note="at most 1 % of the pitch diameter",
+    ),
+    _k(
+        "bearing.num_rollers",
+        int,
+        26,
+        "",
+        "Z",
+        "number of rollers",
+        _const(3, True),
+        attr="num_rollers",
+        extras=(
+            Extra(
+                (_DM, _D, _CP),
+                _rollers_fit,
+                "rollers and cage bars fit around the pitch circle: Z (D + C_p) < pi d_m",
+            ),
+        ),
+    ),
+    _k(
+        "bearing.num_slices",
+        int,
+        31,
+        "",
+        "N_s",
+        "raceway slices per roller (odd)",
+        _const(3, True),
+        _const(200, True),
+        attr="num_slices",
+        note="odd, so that a slice sits at the roller centre",
+        extras=(Extra(("bearing.num_slices",), _odd_slices, "the slice count is odd"),),
+    ),
+    _k(
+        "bearing.inner_ring_mass_kg",
+        float,
+        0.5,
+        "kg",
+        "m_i",
+        "effective mass of inner ring and shaft",
+        _const(0, False),
+        _const(1e5, True),
+        attr="inner_ring_mass",
+    ),
+    _k(
+        "bearing.flange_traction",
+        float,
+        0.08,
+        "",
+        "mu_f",
+        "roller-flange traction coefficient",
+        _const(0, True),
+        _const(1, True),
+        attr="flange_traction",
+    ),
+    _k(
+        "bearing.pocket_friction",
+        float,
+        0.10,
+        "",
+        "mu_p",
+        "roller-pocket friction coefficient",
+        _const(0, True),
+        _const(1, True),
+        attr="pocket_friction",
+    ),
     # [roller]
-    _k(_D, float, 7.5, "mm", "D", "roller diameter", _const(0, False),
-       _rel("pitch_diameter_mm/2", (_DM,), lambda dm: dm / 2, False), attr="roller.diameter"),
-    _k(_L, float, 8.0, "mm", "L_b1", "overall roller length (flat-end roller)",
-       _rel("2 corner_radius_mm", (_RC,), lambda rc: 2 * rc, False),
-       _rel("10 diameter_mm", (_D,), lambda d: 10 * d, True), attr="roller.length"),
-    _k("roller.central_length_mm", float, 4.5, "mm", "L_b2",
-       "straight central length of the generatrix (crowned outside it)", _const(0, True),
-       _rel("length_mm - 2 corner_radius_mm", (_L, _RC), lambda lb, rc: lb - 2 * rc, True),
-       attr="roller.central_length"),
-    _k("roller.crown_drop_um", float, 4.0, "um", "c_crown",
-       "crown drop at the ends of the effective length", _const(0, True),
-       _rel("diameter_mm/10", (_D,), lambda d: d * 100, True), attr="roller.crown_drop"),
-    _k(_RC, float, 0.4, "mm", "R_cor", "corner radius", _const(0, False),
-       _rel("diameter_mm/2", (_D,), lambda d: d / 2, False), attr="roller.corner_radius"),
+    _k(
+        _D,
+        float,
+        7.5,
+        "mm",
+        "D",
+        "roller diameter",
+        _const(0, False),
+        _rel("pitch_diameter_mm/2", (_DM,), lambda dm: dm / 2, False),
+        attr="roller.diameter",
+    ),
+    _k(
+        _L,
+        float,
+        8.0,
+        "mm",
+        "L_b1",
+        "overall roller length (flat-end roller)",
+        _rel("2 corner_radius_mm", (_RC,), lambda rc: 2 * rc, False),
+        _rel("10 diameter_mm", (_D,), lambda d: 10 * d, True),
+        attr="roller.length",
+    ),
+    _k(
+        "roller.central_length_mm",
+        float,
+        4.5,
+        "mm",
+        "L_b2",
+        "straight central length of the generatrix (crowned outside it)",
+        _const(0, True),
+        _rel("length_mm - 2 corner_radius_mm", (_L, _RC), lambda lb, rc: lb - 2 * rc, True),
+        attr="roller.central_length",
+    ),
+    _k(
+        "roller.crown_drop_um",
+        float,
+        4.0,
+        "um",
+        "c_crown",
+        "crown drop at the ends of the effective length",
+        _const(0, True),
+        _rel("diameter_mm/10", (_D,), lambda d: d * 100, True),
+        attr="roller.crown_drop",
+    ),
+    _k(
+        _RC,
+        float,
+        0.4,
+        "mm",
+        "R_cor",
+        "corner radius",
+        _const(0, False),
+        _rel("diameter_mm/2", (_D,), lambda d: d / 2, False),
+        attr="roller.corner_radius",
+    ),
     # the sphere meets the corner torus tangentially only if R_end - R_cor > R_ce, i.e.
     # R_end > D/2 (paper Eq. 19: L_beb = x_cor - sqrt((R_end - R_cor)^2 - R_ce^2)); then the
     # limited circle rho_lim = R_ce R_end/(R_end - R_cor) < D/2 and the end is convex.
-    _k("roller.end_radius_mm", float, 80.0, "mm", "R_end",
-       "end (arc) radius",
-       _rel("diameter_mm/2", (_D,), lambda d: d / 2, False), None, attr="roller.end_radius",
-       allow_inf=True, note="inf = flat end with corner radii only"),
+    _k(
+        "roller.end_radius_mm",
+        float,
+        80.0,
+        "mm",
+        "R_end",
+        "end (arc) radius",
+        _rel("diameter_mm/2", (_D,), lambda d: d / 2, False),
+        None,
+        attr="roller.end_radius",
+        allow_inf=True,
+        note="inf = flat end with corner radii only",
+    ),
     # [flange]
-    _k(_H, float, 2.0, "mm", "H_rf", "flange height above the raceway", _const(0, False),
-       _rel("diameter_mm", (_D,), lambda d: d, False), attr="flange.height"),
-    _k(_HREL, float, 0.3, "mm", "h_rel", "flange base relief (undercut) height", _const(0, True),
-       _rel("height_mm", (_H,), lambda h: h, False), attr="flange.relief_height"),
-    _k("flange.contact_height_limit_mm", float, 1.8, "mm", "h_up",
-       "upper limit of the contact height on the flange",
-       _rel("relief_height_mm", (_HREL,), lambda h: h, False),
-       _rel("height_mm", (_H,), lambda h: h, True), attr="flange.contact_height_limit"),
-    _k("flange.layback_angle_deg", float, 1.6, "deg", "theta_f", "flange layback (opening) angle",
-       _const(0, False), _const(10, True), attr="flange.layback_angle"),
-    _k("flange.axial_clearance_mm", float, 0.15, "mm", "Delta_bf",
-       "axial clearance (flange spacing minus length_mm)", _const(0, True),
-       _rel("length_mm", (_L,), lambda lb: lb, False), attr="flange.axial_clearance"),
+    _k(
+        _H,
+        float,
+        2.0,
+        "mm",
+        "H_rf",
+        "flange height above the raceway",
+        _const(0, False),
+        _rel("diameter_mm", (_D,), lambda d: d, False),
+        attr="flange.height",
+    ),
+    _k(
+        _HREL,
+        float,
+        0.3,
+        "mm",
+        "h_rel",
+        "flange base relief (undercut) height",
+        _const(0, True),
+        _rel("height_mm", (_H,), lambda h: h, False),
+        attr="flange.relief_height",
+    ),
+    _k(
+        "flange.contact_height_limit_mm",
+        float,
+        1.8,
+        "mm",
+        "h_up",
+        "upper limit of the contact height on the flange",
+        _rel("relief_height_mm", (_HREL,), lambda h: h, False),
+        _rel("height_mm", (_H,), lambda h: h, True),
+        attr="flange.contact_height_limit",
+    ),
+    _k(
+        "flange.layback_angle_deg",
+        float,
+        1.6,
+        "deg",
+        "theta_f",
+        "flange layback (opening) angle",
+        _const(0, False),
+        _const(10, True),
+        attr="flange.layback_angle",
+    ),
+    _k(
+        "flange.axial_clearance_mm",
+        float,
+        0.15,
+        "mm",
+        "Delta_bf",
+        "axial clearance (flange spacing minus length_mm)",
+        _const(0, True),
+        _rel("length_mm", (_L,), lambda lb: lb, False),
+        attr="flange.axial_clearance",
+    ),
     # [cage]
-    _k("cage.inner_diameter_mm", float, 80.0, "mm", "", "cage bore",
-       _rel("inner raceway diameter", (_DM, _D, _PD), lambda dm, d, pd: dm - d - pd / 2000, False),
-       _rel("pitch_diameter_mm", (_DM,), lambda dm: dm, False), attr="cage.inner_diameter",
-       note="inner raceway diameter = pitch_diameter_mm - diameter_mm - radial_clearance_um/2000"),
-    _k("cage.outer_diameter_mm", float, 90.0, "mm", "",
-       "cage outside diameter (guided on the outer-ring lands)",
-       _rel("pitch_diameter_mm", (_DM,), lambda dm: dm, False),
-       _rel("outer raceway diameter - guiding_clearance_mm", (_DM, _D, _PD, _CG),
-            lambda dm, d, pd, cg: dm + d + pd / 2000 - cg, True), attr="cage.outer_diameter",
-       note="outer raceway diameter = pitch_diameter_mm + diameter_mm + radial_clearance_um/2000"),
-    _k("cage.width_mm", float, 14.0, "mm", "", "cage width",
-       _rel("length_mm + pocket_clearance_mm", (_L, _CP), lambda lb, cp: lb + cp, False),
-       _rel("3 length_mm", (_L,), lambda lb: 3 * lb, True), attr="cage.width"),
-    _k(_CP, float, 0.20, "mm", "C_p", "pocket clearance (circumferential, total)",
-       _const(0, False), _rel("diameter_mm/2", (_D,), lambda d: d / 2, False),
-       attr="cage.pocket_clearance"),
-    _k(_CG, float, 0.40, "mm", "C_g", "guiding clearance on the outer-ring lands (diametral)",
-       _const(0, False), _rel("diameter_mm/2", (_D,), lambda d: d / 2, False),
-       attr="cage.guiding_clearance"),
-    _k("cage.land_width_mm", float, 3.0, "mm", "b_l", "guiding land width (each of two)",
-       _const(0, False), _rel("width_mm/2", ("cage.width_mm",), lambda w: w / 2, True),
-       attr="cage.land_width"),
+    _k(
+        "cage.inner_diameter_mm",
+        float,
+        80.0,
+        "mm",
+        "",
+        "cage bore",
+        _rel("inner raceway diameter", (_DM, _D, _PD), lambda dm, d, pd: dm - d - pd / 2000, False),
+        _rel("pitch_diameter_mm", (_DM,), lambda dm: dm, False),
+        attr="cage.inner_diameter",
+        note="inner raceway diameter = pitch_diameter_mm - diameter_mm - radial_clearance_um/2000",
+    ),
+    _k(
+        "cage.outer_diameter_mm",
+        float,
+        90.0,
+        "mm",
+        "",
+        "cage outside diameter (guided on the outer-ring lands)",
+        _rel("pitch_diameter_mm", (_DM,), lambda dm: dm, False),
+        _rel(
+            "outer raceway diameter - guiding_clearance_mm",
+            (_DM, _D, _PD, _CG),
+            lambda dm, d, pd, cg: dm + d + pd / 2000 - cg,
+            True,
+        ),
+        attr="cage.outer_diameter",
+        note="outer raceway diameter = pitch_diameter_mm + diameter_mm + radial_clearance_um/2000",
+    ),
+    _k(
+        "cage.width_mm",
+        float,
+        14.0,
+        "mm",
+        "",
+        "cage width",
+        _rel("length_mm + pocket_clearance_mm", (_L, _CP), lambda lb, cp: lb + cp, False),
+        _rel("3 length_mm", (_L,), lambda lb: 3 * lb, True),
+        attr="cage.width",
+    ),
+    _k(
+        _CP,
+        float,
+        0.20,
+        "mm",
+        "C_p",
+        "pocket clearance (circumferential, total)",
+        _const(0, False),
+        _rel("diameter_mm/2", (_D,), lambda d: d / 2, False),
+        attr="cage.pocket_clearance",
+    ),
+    _k(
+        _CG,
+        float,
+        0.40,
+        "mm",
+        "C_g",
+        "guiding clearance on the outer-ring lands (diametral)",
+        _const(0, False),
+        _rel("diameter_mm/2", (_D,), lambda d: d / 2, False),
+        attr="cage.guiding_clearance",
+    ),
+    _k(
+        "cage.land_width_mm",
+        float,
+        3.0,
+        "mm",
+        "b_l",
+        "guiding land width (each of two)",
+        _const(0, False),
+        _rel("width_mm/2", ("cage.width_mm",), lambda w: w / 2, True),
+        attr="cage.land_width",
+    ),
     # [materials.*]
     *_material("ring", "ring_material", 203.0, 0.28, 7830.0, "rings (AISI M50)"),
     *_material("roller", "roller_material", 203.0, 0.28, 7830.0, "rollers (AISI M50)"),
     *_material("cage", "cage_material", 205.0, 0.29, 7850.0, "cage (AISI 4340)"),
     # [lubricant]
-    _k("lubricant.viscosity_Pa_s", float, 0.055, "Pa s", "eta_0",
-       "dynamic viscosity at the operating temperature", _const(0, False), _const(100, True),
-       attr="lubricant.viscosity"),
-    _k("lubricant.pressure_viscosity_1_Pa", float, 1.85e-8, "1/Pa", "alpha_p",
-       "pressure-viscosity coefficient", _const(0, True), _const(1e-6, True),
-       attr="lubricant.pressure_viscosity"),
-    _k("lubricant.temperature_viscosity_1_C", float, 0.0315, "1/C", "beta_T",
-       "temperature-viscosity coefficient", _const(0, True), _const(1, True),
-       attr="lubricant.temperature_viscosity"),
-    _k("lubricant.density_kg_m3", float, 960.0, "kg/m^3", "rho_oil", "lubricant density",
-       _const(0, False), _const(2000, True), attr="lubricant.density"),
-    _k("lubricant.oil_fraction", float, 0.05, "", "f_oil", "oil volume fraction in the cavity",
-       _const(0, True), _const(1, True), attr="lubricant.oil_fraction"),
-    _k("lubricant.traction_a", float, -0.04, "", "A", "traction curve constant", _const(-1, True),
-       _const(1, True), attr="lubricant.traction_a",
-       note="rolling-contact traction kappa(du) = (A + B du) exp(-C du) + D, du = sliding speed"),
-    _k("lubricant.traction_b_s_m", float, 0.2528, "s/m", "B", "traction curve slope",
-       _const(-1e4, True), _const(1e4, True), attr="lubricant.traction_b",
-       extras=(Extra(("lubricant.traction_a", "lubricant.traction_c_s_m", "lubricant.traction_d"),
-                     _traction_bounded, "|kappa(du)| <= 1 for all du >= 0"),)),
-    _k("lubricant.traction_c_s_m", float, 2.926, "s/m", "C", "traction curve decay",
-       _const(0, False), _const(1e4, True), attr="lubricant.traction_c"),
-    _k("lubricant.traction_d", float, 0.04, "", "D", "traction at high sliding speed",
-       _const(-1, True), _const(1, True), attr="lubricant.traction_d"),
+    _k(
+        "lubricant.viscosity_Pa_s",
+        float,
+        0.055,
+        "Pa s",
+        "eta_0",
+        "dynamic viscosity at the operating temperature",
+        _const(0, False),
+        _const(100, True),
+        attr="lubricant.viscosity",
+    ),
+    _k(
+        "lubricant.pressure_viscosity_1_Pa",
+        float,
+        1.85e-8,
+        "1/Pa",
+        "alpha_p",
+        "pressure-viscosity coefficient",
+        _const(0, True),
+        _const(1e-6, True),
+        attr="lubricant.pressure_viscosity",
+    ),
+    _k(
+        "lubricant.temperature_viscosity_1_C",
+        float,
+        0.0315,
+        "1/C",
+        "beta_T",
+        "temperature-viscosity coefficient",
+        _const(0, True),
+        _const(1, True),
+        attr="lubricant.temperature_viscosity",
+    ),
+    _k(
+        "lubricant.density_kg_m3",
+        float,
+        960.0,
+        "kg/m^3",
+        "rho_oil",
+        "lubricant density",
+        _const(0, False),
+        _const(2000, True),
+        attr="lubricant.density",
+    ),
+    _k(
+        "lubricant.oil_fraction",
+        float,
+        0.05,
+        "",
+        "f_oil",
+        "oil volume fraction in the cavity",
+        _const(0, True),
+        _const(1, True),
+        attr="lubricant.oil_fraction",
+    ),
+    _k(
+        "lubricant.traction_a",
+        float,
+        -0.04,
+        "",
+        "A",
+        "traction curve constant",
+        _const(-1, True),
+        _const(1, True),
+        attr="lubricant.traction_a",
+        note="rolling-contact traction kappa(du) = (A + B du) exp(-C du) + D, du = sliding speed",
+    ),
+    _k(
+        "lubricant.traction_b_s_m",
+        float,
+        0.2528,
+        "s/m",
+        "B",
+        "traction curve slope",
+        _const(-1e4, True),
+        _const(1e4, True),
+        attr="lubricant.traction_b",
+        extras=(
+            Extra(
+                ("lubricant.traction_a", "lubricant.traction_c_s_m", "lubricant.traction_d"),
+                _traction_bounded,
+                "|kappa(du)| <= 1 for all du >= 0",
+            ),
+        ),
+    ),
+    _k(
+        "lubricant.traction_c_s_m",
+        float,
+        2.926,
+        "s/m",
+        "C",
+        "traction curve decay",
+        _const(0, False),
+        _const(1e4, True),
+        attr="lubricant.traction_c",
+    ),
+    _k(
+        "lubricant.traction_d",
+        float,
+        0.04,
+        "",
+        "D",
+        "traction at high sliding speed",
+        _const(-1, True),
+        _const(1, True),
+        attr="lubricant.traction_d",
+    ),
     # [operating]
-    _k("operating.speed_rpm", float, 20000.0, "rpm", "n_i", "inner ring speed (outer ring fixed)",
-       _const(0, True), _const(100000, True), attr="op.inner_speed"),
-    _k("operating.radial_load_N", float, 1000.0, "N", "F_r", "radial load on the inner ring (+Z)",
-       _const(0, True), _const(1e8, True), attr="op.radial_load"),
-    _k("operating.gravity", bool, True, "", "g", "gravity on every body (9.81 m/s^2 along +Z)",
-       attr="op.gravity"),
+    _k(
+        "operating.speed_rpm",
+        float,
+        20000.0,
+        "rpm",
+        "n_i",
+        "inner ring speed (outer ring fixed)",
+        _const(0, True),
+        _const(100000, True),
+        attr="op.inner_speed",
+    ),
+    _k(
+        "operating.radial_load_N",
+        float,
+        1000.0,
+        "N",
+        "F_r",
+        "radial load on the inner ring (+Z)",
+        _const(0, True),
+        _const(1e8, True),
+        attr="op.radial_load",
+    ),
+    _k(
+        "operating.gravity",
+        bool,
+        True,
+        "",
+        "g",
+        "gravity on every body (9.81 m/s^2 along +Z)",
+        attr="op.gravity",
+    ),
     # [simulation]
-    _k("simulation.end", str, "both", "", "", "roller ends to simulate",
-       choices=("arc", "corner", "both"), note="the arc run needs a finite end_radius_mm"),
-    _k("simulation.duration_ms", float, 20.0, "ms", "", "simulated time", _const(0, False),
-       _const(10000, True)),
-    _k("simulation.rtol", float, 1e-3, "", "", "relative tolerance of the step-size controller",
-       _const(0, False), _const(1, False)),
-    _k("simulation.atol", float, 1e-6, "", "", "absolute tolerance (on the scaled state)",
-       _const(0, False), _const(1, False)),
-    _k("simulation.max_steps", int, 2_000_000, "", "", "maximum number of integrator steps",
-       _const(1, True), _const(1_000_000_000, True)),
+    _k(
+        "simulation.end",
+        str,
+        "both",
+        "",
+        "",
+        "roller ends to simulate",
+        choices=("arc", "corner", "both"),
+        note="the arc run needs a finite end_radius_mm",
+    ),
+    _k(
+        "simulation.duration_ms",
+        float,
+        20.0,
+        "ms",
+        "",
+        "simulated time",
+        _const(0, False),
+        _const(10000, True),
+    ),
+    _k(
+        "simulation.rtol",
+        float,
+        1e-3,
+        "",
+        "",
+        "relative tolerance of the step-size controller",
+        _const(0, False),
+        _const(1, False),
+    ),
+    _k(
+        "simulation.atol",
+        float,
+        1e-6,
+        "",
+        "",
+        "absolute tolerance (on the scaled state)",
+        _const(0, False),
+        _const(1, False),
+    ),
+    _k(
+        "simulation.max_steps",
+        int,
+        2_000_000,
+        "",
+        "",
+        "maximum number of integrator steps",
+        _const(1, True),
+        _const(1_000_000_000, True),
+    ),
     _k("simulation.progress", bool, True, "", "", "show a progress meter"),
 )
 
@@ -496,8 +890,11 @@ def coerce(key: Key, value: Any) -> Any:
         if arr.ndim == 0 and arr.dtype.kind in "biuf":
             value = arr.item()
     unit = f" ({key.unit})" if key.unit else ""
-    got = f"got {type_name(value)} {format_value(value)}" if isinstance(
-        value, (numbers.Number, str, np.bool_)) else f"got {type_name(value)}"
+    got = (
+        f"got {type_name(value)} {format_value(value)}"
+        if isinstance(value, (numbers.Number, str, np.bool_))
+        else f"got {type_name(value)}"
+    )
     is_bool = isinstance(value, (bool, np.bool_))
     if key.kind is float:
         if is_bool or not isinstance(value, numbers.Real):
@@ -505,14 +902,18 @@ def coerce(key: Key, value: Any) -> Any:
         try:
             return float(value)
         except OverflowError:
-            raise ConfigError(key.path, f"{type_name(value)} too large for a float{unit}; must be "
-                              f"{key.range_text()}{(' ' + key.unit) if key.unit else ''}") from None
+            raise ConfigError(
+                key.path,
+                f"{type_name(value)} too large for a float{unit}; must be "
+                f"{key.range_text()}{(' ' + key.unit) if key.unit else ''}",
+            ) from None
     if key.kind is int:
         if is_bool or not isinstance(value, numbers.Real):
             raise ConfigError(key.path, f"expected an integer, {got}")
         if not isinstance(value, numbers.Integral):
-            raise ConfigError(key.path, f"expected an integer (a count, written without a decimal "
-                              f"point), {got}")
+            raise ConfigError(
+                key.path, f"expected an integer (a count, written without a decimal point), {got}"
+            )
         return int(value)
     if key.kind is bool:
         if not is_bool:
@@ -533,8 +934,9 @@ def check_key(key: Key, values: Mapping[str, Any]) -> None:
             raise ConfigError(key.path, f"{format_value(v)} is not {key.range_text()}")
     elif key.kind in (float, int):
         if key.kind is float and not math.isfinite(v) and not (key.allow_inf and v == math.inf):
-            raise ConfigError(key.path, f"{format_value(v)}{unit} is not finite: must be "
-                              f"{key.range_text(values)}{unit}")
+            raise ConfigError(
+                key.path, f"{format_value(v)}{unit} is not finite: must be {key.range_text(values)}{unit}"
+            )
         ok = True
         if key.lo is not None:
             lo = key.lo.value(values)
@@ -543,8 +945,9 @@ def check_key(key: Key, values: Mapping[str, Any]) -> None:
             hi = key.hi.value(values)
             ok &= v <= hi if key.hi.closed else v < hi
         if not ok:
-            raise ConfigError(key.path, f"{format_value(v)}{unit} is out of range: must be "
-                              f"{key.range_text(values)}{unit}")
+            raise ConfigError(
+                key.path, f"{format_value(v)}{unit} is out of range: must be {key.range_text(values)}{unit}"
+            )
     for extra in key.extras:
         msg = extra.check(values)
         if msg is not None:
@@ -591,8 +994,7 @@ def validate_bearing(bearing, op=None, *, traced: str = "error") -> None:
     """
     if traced not in ("error", "skip"):
         raise ValueError(f"traced = {traced!r}: must be 'error' or 'skip'")
-    keys = [k for k in KEYS
-            if k.attr is not None and (op is not None or not k.attr.startswith("op."))]
+    keys = [k for k in KEYS if k.attr is not None and (op is not None or not k.attr.startswith("op."))]
     leaves = {k.path: _leaf(bearing, op, k.attr) for k in keys}
     skipped = {p for p, v in leaves.items() if _traced(v)}
     if skipped and traced == "error":
@@ -627,5 +1029,8 @@ def _check_gravity(g: np.ndarray, shape: tuple) -> None:
     if bad.any():
         idx = tuple(int(i) for i in np.argwhere(bad)[0])
         where = f"(batch element {idx}) " if shape else ""
-        raise ConfigError("operating.gravity", f"{where}{format_value(float(g[idx]))} m/s^2 is "
-                          "out of range: must be in [0, 100] m/s^2 (9.81 = on, 0 = off)")
+        raise ConfigError(
+            "operating.gravity",
+            f"{where}{format_value(float(g[idx]))} m/s^2 is "
+            "out of range: must be in [0, 100] m/s^2 (9.81 = on, 0 = off)",
+        )

@@ -110,8 +110,7 @@ class DesignMetrics(eqx.Module):
     def margins(self) -> Float[Array, "*batch 4"]:
         """(relief, height, limited circle, clearance) margins [m] on a trailing axis."""
         return jnp.stack(
-            [self.relief_margin, self.height_margin, self.limited_circle_margin,
-             self.clearance_margin],
+            [self.relief_margin, self.height_margin, self.limited_circle_margin, self.clearance_margin],
             axis=-1,
         )
 
@@ -137,19 +136,22 @@ def seated_perturbation(bearing: Bearing, *, seed: int = 0, skew: float = 1e-4) 
 
     with jax.ensure_compile_time_eval():  # the seeded draws are constants, also under jit
         k1, _ = jax.random.split(jax.random.PRNGKey(seed))
-        u_max = float(np.max(np.abs(np.asarray(
-            jax.random.uniform(k1, (bearing.num_rollers,), minval=-1.0, maxval=1.0)))))
+        u_max = float(
+            np.max(
+                np.abs(np.asarray(jax.random.uniform(k1, (bearing.num_rollers,), minval=-1.0, maxval=1.0)))
+            )
+        )
     half_gap = design_zone(bearing).seated_gap / 2
     return Perturbation(seed=seed, axial=half_gap / u_max, skew=skew)
 
 
-def _check_design_inputs(bearing, op, design, duration, solve_kwargs, flange_load=None,
-                         min_clearance=None):
+def _check_design_inputs(bearing, op, design, duration, solve_kwargs, flange_load=None, min_clearance=None):
     """Before tracing: the solver arguments among `solve_kwargs` and the duration, the base
     bearing and operating point (`check_model_inputs`) and the design (`check_design`); `solve`
     checks the rest."""
-    check_solver_arguments(duration=duration, **{k: v for k, v in solve_kwargs.items()
-                                                 if k in SOLVER_ARGUMENTS})
+    check_solver_arguments(
+        duration=duration, **{k: v for k, v in solve_kwargs.items() if k in SOLVER_ARGUMENTS}
+    )
     check_model_inputs(bearing, op)
     check_design(bearing, design, flange_load=flange_load, min_clearance=min_clearance)
 

@@ -71,7 +71,12 @@ def plot_run(out_dir: pathlib.Path, results: dict) -> list[pathlib.Path]:
         h = res.histories
         ax.plot(np.asarray(h["t"]) * 1e3, rad_s_to_rpm(np.asarray(h["cage_speed"])), label=end)
     res0 = next(iter(results.values()))[0]
-    ax.axhline(float(rad_s_to_rpm(kinematic_cage_speed(res0.bearing, res0.operating))), color="k", ls="--", label="kinematic")
+    ax.axhline(
+        float(rad_s_to_rpm(kinematic_cage_speed(res0.bearing, res0.operating))),
+        color="k",
+        ls="--",
+        label="kinematic",
+    )
     ax.set_xlabel("time [ms]")
     ax.set_ylabel("cage speed [rpm]")
     ax.legend()

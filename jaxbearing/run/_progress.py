@@ -52,8 +52,7 @@ def _show(progress, idx) -> np.ndarray:
         meter["shown"] = p
         elapsed = time.perf_counter() - meter["start"]
         left = f", about {elapsed * (1 - p) / p:.0f} s left" if 0 < p < 1 else ""
-        print(f"{_INDENT}{100 * p:3.0f}% of the simulated time, {elapsed:.1f} s elapsed{left}",
-              flush=True)
+        print(f"{_INDENT}{100 * p:3.0f}% of the simulated time, {elapsed:.1f} s elapsed{left}", flush=True)
     return np.asarray(idx, dtype=np.int32)
 
 
@@ -65,8 +64,11 @@ def _close(idx, latest) -> None:
         return
     elapsed = time.perf_counter() - meter["start"]
     if p < 1.0:
-        print(f"{_INDENT}stopped at {100 * p:.1f}% of the simulated time after {elapsed:.1f} s: "
-              "the solve failed (see its status)", flush=True)
+        print(
+            f"{_INDENT}stopped at {100 * p:.1f}% of the simulated time after {elapsed:.1f} s: "
+            "the solve failed (see its status)",
+            flush=True,
+        )
     elif meter["shown"] < 1.0:
         print(f"{_INDENT}100% of the simulated time, {elapsed:.1f} s elapsed", flush=True)
 
@@ -93,8 +95,9 @@ class SolveProgress(diffrax.AbstractProgressMeter):
         show = (progress - state.shown >= self.minimum_increase) | (progress >= 1.0)
         idx = jax.lax.cond(
             show,
-            lambda i: jax.pure_callback(_show, jax.ShapeDtypeStruct((), jnp.int32), progress, i,
-                                        vmap_method="expand_dims"),
+            lambda i: jax.pure_callback(
+                _show, jax.ShapeDtypeStruct((), jnp.int32), progress, i, vmap_method="expand_dims"
+            ),
             lambda i: i,
             state.idx,
         )

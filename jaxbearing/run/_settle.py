@@ -51,14 +51,20 @@ def solve_from(params: Params, start: State, duration, *, num_saves: int, rtol, 
     b = params.bearing
     zero_acc = jax.tree_util.tree_map(jnp.zeros_like, start.accumulators)
     start = State(rollers=start.rollers, cage=start.cage, inner_ring=start.inner_ring, accumulators=zero_acc)
-    scaling = Scaling(nominal=start, scale=state_scales(b.num_rollers, b.pitch_diameter / 2),
-                      orbit_speed=start.cage.speed)
+    scaling = Scaling(
+        nominal=start, scale=state_scales(b.num_rollers, b.pitch_diameter / 2), orbit_speed=start.cage.speed
+    )
     args = SolveArgs(params=params, scaling=scaling)
-    saveat = diffrax.SaveAt(subs=[diffrax.SubSaveAt(ts=jnp.linspace(0.0, duration, num_saves + 1)[:-1], fn=_save),
-                                  diffrax.SubSaveAt(t1=True)])
+    saveat = diffrax.SaveAt(
+        subs=[
+            diffrax.SubSaveAt(ts=jnp.linspace(0.0, duration, num_saves + 1)[:-1], fn=_save),
+            diffrax.SubSaveAt(t1=True),
+        ]
+    )
     y0_scaled = scaling.scale_state(0.0, start)
-    controller = diffrax.PIDController(rtol=rtol, atol=atol, pcoeff=0.3, icoeff=0.4,
-                                       norm=raceway_normal_norm(y0_scaled), dtmin=1e-13)
+    controller = diffrax.PIDController(
+        rtol=rtol, atol=atol, pcoeff=0.3, icoeff=0.4, norm=raceway_normal_norm(y0_scaled), dtmin=1e-13
+    )
     with checks_without_host_callbacks():  # the same integrator and error norm as `solve`
         sol = _diffeqsolve(y0_scaled, args, duration, saveat, controller, max_steps, None, False)
     hist, final = sol.ys
@@ -73,6 +79,7 @@ def _compiled(params, start, num_saves, max_steps):
     leaves, treedef = jax.tree_util.tree_flatten((params, start))
     key = (treedef, tuple((jnp.shape(x), jnp.result_type(x)) for x in leaves), num_saves, max_steps)
     if key not in _COMPILED:
+
         def run(p, s, d, r, a):
             return solve_from(p, s, d, num_saves=num_saves, rtol=r, atol=a, max_steps=max_steps)
 
@@ -98,13 +105,27 @@ class SeedRun:
 
 def check_steady_options(settle, window_revs, seeds, tolerance, cap_ms, names=None) -> None:
     """One-line `UserInputError` naming the option for a bad value of the settled-run options."""
-    n = {"settle": "settle", "window_revs": "window_revs", "seeds": "seeds",
-         "tolerance": "settle_tolerance", "cap_ms": "settle_cap_ms", **(names or {})}
+    n = {
+        "settle": "settle",
+        "window_revs": "window_revs",
+        "seeds": "seeds",
+        "tolerance": "settle_tolerance",
+        "cap_ms": "settle_cap_ms",
+        **(names or {}),
+    }
     if not (isinstance(settle, str) and settle in ("auto", "off")):
-        require(n["settle"], _as_float(n["settle"], settle), lambda v: np.isfinite(v) & (v >= 0),
-                '"auto", "off" or a settling time >= 0 ms')
-    require(n["window_revs"], window_revs, lambda v: (v >= 2) & (v == np.round(v)),
-            "an integer >= 2 (cage revolutions; batch means need two batches)")
+        require(
+            n["settle"],
+            _as_float(n["settle"], settle),
+            lambda v: np.isfinite(v) & (v >= 0),
+            '"auto", "off" or a settling time >= 0 ms',
+        )
+    require(
+        n["window_revs"],
+        window_revs,
+        lambda v: (v >= 2) & (v == np.round(v)),
+        "an integer >= 2 (cage revolutions; batch means need two batches)",
+    )
     require(n["seeds"], seeds, lambda v: (v >= 1) & (v == np.round(v)), "an integer >= 1")
     require(n["tolerance"], tolerance, lambda v: (v > 0) & (v < 1), "in (0, 1) (relative change)")
     require(n["cap_ms"], cap_ms, lambda v: np.isfinite(v) & (v > 0), "> 0 ms")
@@ -116,7 +137,9 @@ def _as_float(name, value):
     except (TypeError, ValueError):
         from .._errors import UserInputError
 
-        raise UserInputError(f'{name} = {value!r}: must be "auto", "off" or a settling time >= 0 ms') from None
+        raise UserInputError(
+            f'{name} = {value!r}: must be "auto", "off" or a settling time >= 0 ms'
+        ) from None
 
 
 def _run_seed(params, start, *, settle, window_revs, tolerance, cap, rtol, atol, max_steps, saves, progress):
@@ -135,7 +158,9 @@ def _run_seed(params, start, *, settle, window_revs, tolerance, cap, rtol, atol,
         hist = {k: np.asarray(v) for k, v in hist.items() if k != "accumulators"}
         steps += int(n)
         if int(code) != 0 or not np.all(np.isfinite(hist["cage_speed"])):
-            status = f"failed: the solver did not succeed in the revolution ending at {(t + rev) * 1e3:.2f} ms"
+            status = (
+                f"failed: the solver did not succeed in the revolution ending at {(t + rev) * 1e3:.2f} ms"
+            )
             break
         hist["t"] = hist["t"] + t
         t += rev
@@ -143,8 +168,11 @@ def _run_seed(params, start, *, settle, window_revs, tolerance, cap, rtol, atol,
         speeds.append(float(rad_s_to_rpm(np.mean(hist["cage_speed"]))))
         ends.append(t)
         if progress:
-            print(f"  t = {t * 1e3:7.2f} ms: cage {speeds[-1]:9.2f} rpm over the last revolution"
-                  f"{' (window)' if measuring else ''}", flush=True)
+            print(
+                f"  t = {t * 1e3:7.2f} ms: cage {speeds[-1]:9.2f} rpm over the last revolution"
+                f"{' (window)' if measuring else ''}",
+                flush=True,
+            )
         if measuring:
             windows.append(hist)
             edges.append(t - rev)
@@ -235,14 +263,33 @@ def simulate_steady(
         compile_time += time.perf_counter() - c0
         if progress:
             print(f"seed {seed}: settling ({settle}), then {window_revs} revolutions", flush=True)
-        out = _run_seed(params, y0, settle=settle, window_revs=int(window_revs), tolerance=tolerance,
-                        cap=settle_cap_ms * 1e-3, rtol=rtol, atol=atol, max_steps=int(max_steps),
-                        saves=int(saves_per_rev), progress=progress)
+        out = _run_seed(
+            params,
+            y0,
+            settle=settle,
+            window_revs=int(window_revs),
+            tolerance=tolerance,
+            cap=settle_cap_ms * 1e-3,
+            rtol=rtol,
+            atol=atol,
+            max_steps=int(max_steps),
+            saves=int(saves_per_rev),
+            progress=progress,
+        )
         runs.append(SeedRun(perturbation.seed + seed, *out))
     wall = time.perf_counter() - wall0 - compile_time
-    return SteadyResult(runs=runs, settle=settle, window_revs=int(window_revs), tolerance=tolerance,
-                        cap=settle_cap_ms * 1e-3, start=start, wall_time_s=wall, compile_time_s=compile_time,
-                        bearing=bearing, operating=op)
+    return SteadyResult(
+        runs=runs,
+        settle=settle,
+        window_revs=int(window_revs),
+        tolerance=tolerance,
+        cap=settle_cap_ms * 1e-3,
+        start=start,
+        wall_time_s=wall,
+        compile_time_s=compile_time,
+        bearing=bearing,
+        operating=op,
+    )
 
 
 def summarise_steady(result: SteadyResult, threshold: float = 1.0) -> dict:
@@ -261,18 +308,31 @@ def summarise_steady(result: SteadyResult, threshold: float = 1.0) -> dict:
         "window_ms": float(np.mean([r.edges[-1] - r.edges[0] for r in ok])) * 1e3 if ok else 0.0,
         "seeds": [r.seed for r in runs],
         "start": result.start,
-        "kinematic_cage_speed_rpm": float(rad_s_to_rpm(kinematic_cage_speed(result.bearing, result.operating))),
-        "per_seed": [{"seed": r.seed, "settled": r.settled, "settle_time_ms": r.settle_time * 1e3,
-                      "status": r.status, "num_steps": r.num_steps,
-                      "revolution_end_ms": [t * 1e3 for t in r.revolution_ends],
-                      "revolution_cage_speed_rpm": r.revolution_speeds_rpm} for r in runs],
+        "kinematic_cage_speed_rpm": float(
+            rad_s_to_rpm(kinematic_cage_speed(result.bearing, result.operating))
+        ),
+        "per_seed": [
+            {
+                "seed": r.seed,
+                "settled": r.settled,
+                "settle_time_ms": r.settle_time * 1e3,
+                "status": r.status,
+                "num_steps": r.num_steps,
+                "revolution_end_ms": [t * 1e3 for t in r.revolution_ends],
+                "revolution_cage_speed_rpm": r.revolution_speeds_rpm,
+            }
+            for r in runs
+        ],
         "num_steps": sum(r.num_steps for r in runs),
         "wall_time_s": result.wall_time_s,
         "compile_time_s": result.compile_time_s,
     }
     if ok:
-        block.update(steady_statistics([r.window for r in ok], [r.edges for r in ok], result.bearing,
-                                       result.operating, threshold))
+        block.update(
+            steady_statistics(
+                [r.window for r in ok], [r.edges for r in ok], result.bearing, result.operating, threshold
+            )
+        )
     return block
 
 

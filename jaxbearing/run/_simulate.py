@@ -76,7 +76,9 @@ def initial_state(bearing: Bearing, op: OperatingPoint, perturbation: Perturbati
         skew = perturbation.skew * jax.random.uniform(k2, (z,), minval=-1.0, maxval=1.0)
     # skew: rotation of the axis about the roller's radial direction, towards e_tan
 
-    axis = jnp.cos(skew)[:, None] * jnp.array([1.0, 0.0, 0.0]) + jnp.sin(skew)[:, None] * tangential_unit(azimuth)
+    axis = jnp.cos(skew)[:, None] * jnp.array([1.0, 0.0, 0.0]) + jnp.sin(skew)[:, None] * tangential_unit(
+        azimuth
+    )
     # pure rolling on the outer raceway: absolute roller spin -omega_c d_m / D about its axis
     spin = -omega_c * bearing.pitch_diameter / bearing.roller.diameter
     rollers = RollerState(
@@ -198,8 +200,15 @@ class Solution(eqx.Module):
 #: outcomes of a solve, by their `diffrax.RESULTS` names; `Solution.result` is the index here
 #: (0 = successful; len(RESULT_NAMES) = an outcome not listed). A stable code, independent of
 #: diffrax's internal numbering.
-RESULT_NAMES = ("successful", "max_steps_reached", "dt_min_reached", "nonfinite",
-                "max_steps_rejected", "event_occurred", "internal_error")
+RESULT_NAMES = (
+    "successful",
+    "max_steps_reached",
+    "dt_min_reached",
+    "nonfinite",
+    "max_steps_rejected",
+    "event_occurred",
+    "internal_error",
+)
 _RESULT_TEXT = {
     "max_steps_reached": "the step limit max_steps was reached",
     "dt_min_reached": "the step size collapsed below dtmin (non-finite or unresolvable dynamics)",
@@ -221,8 +230,9 @@ def _check_solve(bearing, op, duration, *, adjoint=None, **kwargs) -> None:
     """`check_solve_inputs` of the solver arguments, perturbation, functionals and pytrees;
     `adjoint` must be a diffrax adjoint or None."""
     if adjoint is not None and not isinstance(adjoint, diffrax.AbstractAdjoint):
-        raise UserInputError(f"adjoint = {adjoint!r}: must be a diffrax adjoint "
-                             "(e.g. diffrax.ForwardMode()) or None")
+        raise UserInputError(
+            f"adjoint = {adjoint!r}: must be a diffrax adjoint (e.g. diffrax.ForwardMode()) or None"
+        )
     check_solve_inputs(bearing, op, duration=duration, **kwargs)
 
 
@@ -279,9 +289,19 @@ def solve(
     one-line `UserInputError`/`ConfigError`); under jit/vmap/grad traced values cannot be
     checked and pass (`simulate` and the sweep check them concretely first).
     """
-    _check_solve(bearing, op, duration, num_saves=num_saves, rtol=rtol, atol=atol,
-                 max_steps=max_steps, progress=progress, perturbation=perturbation,
-                 functionals=functionals, adjoint=adjoint)
+    _check_solve(
+        bearing,
+        op,
+        duration,
+        num_saves=num_saves,
+        rtol=rtol,
+        atol=atol,
+        max_steps=max_steps,
+        progress=progress,
+        perturbation=perturbation,
+        functionals=functionals,
+        adjoint=adjoint,
+    )
     y0 = initial_state(bearing, op, perturbation)
     scaling = Scaling(
         nominal=y0,
@@ -295,9 +315,7 @@ def solve(
     else:
         saveat = diffrax.SaveAt(t1=True, fn=_save_functionals)
     norm = error_norm if error_norm is not None else raceway_normal_norm(y0_scaled, raceway_loosen)
-    controller = diffrax.PIDController(
-        rtol=rtol, atol=atol, pcoeff=0.3, icoeff=0.4, norm=norm, dtmin=1e-13
-    )
+    controller = diffrax.PIDController(rtol=rtol, atol=atol, pcoeff=0.3, icoeff=0.4, norm=norm, dtmin=1e-13)
     with checks_without_host_callbacks():  # cacheable program (`_compile_cache`)
         sol = _diffeqsolve(y0_scaled, args, duration, saveat, controller, max_steps, adjoint, progress)
     if num_saves:
@@ -336,9 +354,15 @@ def _compiled_solve(bearing, op, duration, rtol, atol, static: tuple):
     arguments, so arc and corner ends, other speeds, loads, tolerances and seeds of the initial
     scatter reuse one compilation (the scatter's seed and amplitudes are traced)."""
     num_saves, max_steps, progress, perturbation, functionals = static
-    scatter = None if perturbation is None else (
-        jnp.asarray(perturbation.seed, jnp.int32), jnp.asarray(perturbation.axial, float),
-        jnp.asarray(perturbation.skew, float))
+    scatter = (
+        None
+        if perturbation is None
+        else (
+            jnp.asarray(perturbation.seed, jnp.int32),
+            jnp.asarray(perturbation.axial, float),
+            jnp.asarray(perturbation.skew, float),
+        )
+    )
     dyn = (bearing, op, duration, rtol, atol, scatter)
     static = (num_saves, max_steps, progress, perturbation is None, functionals)
     leaves, treedef = jax.tree_util.tree_flatten(dyn)
@@ -347,8 +371,18 @@ def _compiled_solve(bearing, op, duration, rtol, atol, static: tuple):
 
         def run(b, o, d, r, a, sc):
             pert = None if sc is None else Perturbation(seed=sc[0], axial=sc[1], skew=sc[2])
-            return solve(b, o, d, num_saves=num_saves, rtol=r, atol=a, max_steps=max_steps,
-                         progress=progress, perturbation=pert, functionals=functionals)
+            return solve(
+                b,
+                o,
+                d,
+                num_saves=num_saves,
+                rtol=r,
+                atol=a,
+                max_steps=max_steps,
+                progress=progress,
+                perturbation=pert,
+                functionals=functionals,
+            )
 
         _COMPILED[key] = jax.jit(run).lower(*dyn).compile()
     return functools.partial(_COMPILED[key], *dyn)
@@ -371,9 +405,19 @@ def simulate(
 
     Compiles once per bearing structure (cached) and reports compile and run time separately.
     """
-    _check_solve(bearing, op, duration, num_saves=num_saves, rtol=rtol, atol=atol,
-                 max_steps=max_steps, progress=progress, perturbation=perturbation,
-                 functionals=functionals, rules={"num_saves": SIMULATE_NUM_SAVES})
+    _check_solve(
+        bearing,
+        op,
+        duration,
+        num_saves=num_saves,
+        rtol=rtol,
+        atol=atol,
+        max_steps=max_steps,
+        progress=progress,
+        perturbation=perturbation,
+        functionals=functionals,
+        rules={"num_saves": SIMULATE_NUM_SAVES},
+    )
     dyn = (bearing, op, jnp.asarray(duration, float), jnp.asarray(rtol, float), jnp.asarray(atol, float))
     static = (int(num_saves), int(max_steps), bool(progress), perturbation, functionals)
     start = time.perf_counter()
@@ -391,7 +435,9 @@ def _result_message(code: int) -> str:
     return _RESULT_TEXT.get(name, f"the solver did not succeed ({name}, result code {code})")
 
 
-def simulation_result(sol: Solution, bearing, op, functionals, duration, wall, compile_time) -> SimulationResult:
+def simulation_result(
+    sol: Solution, bearing, op, functionals, duration, wall, compile_time
+) -> SimulationResult:
     hist = jax.tree_util.tree_map(np.asarray, sol.histories)
     code = int(sol.result)
     ok = code == 0

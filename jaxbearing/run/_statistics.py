@@ -68,8 +68,12 @@ class Estimate:
         def num(x):
             return float(x) if np.isfinite(x) else None
 
-        return {"value": num(self.value), "ci95_low": num(self.ci95_low),
-                "ci95_high": num(self.ci95_high), "n": int(self.n)}
+        return {
+            "value": num(self.value),
+            "ci95_low": num(self.ci95_low),
+            "ci95_high": num(self.ci95_high),
+            "n": int(self.n),
+        }
 
 
 def student_t_interval(samples, confidence: float = CONFIDENCE) -> Estimate:
@@ -105,8 +109,9 @@ def _window(hist: dict, t0: float, t1: float) -> dict:
     return {k: np.asarray(v)[keep] for k, v in hist.items()}
 
 
-def revolution_statistics(hist: dict, edges, rho_lim: float, kinematic_speed: float,
-                          threshold: float = 1.0) -> dict[str, np.ndarray]:
+def revolution_statistics(
+    hist: dict, edges, rho_lim: float, kinematic_speed: float, threshold: float = 1.0
+) -> dict[str, np.ndarray]:
     """Every reported statistic, one value per revolution [edges[i], edges[i+1]) (NaN where a
     revolution has no contact for a contact statistic). Keys are "group.reduction"."""
     edges = np.asarray(edges, dtype=float)
@@ -122,9 +127,16 @@ def revolution_statistics(hist: dict, edges, rho_lim: float, kinematic_speed: fl
                 if v.size:
                     vals[i] = fn(v)
             out[f"{key}.{red}"] = vals
-    for name in ("cage_speed_rpm", "cage_slip", "roller_skew_rad.mean_abs", "roller_skew_rad.max_abs",
-                 "corner_contact_share.time", "corner_contact_share.events", "contact_radius_m.p99",
-                 "flange_contact_events_per_rev"):
+    for name in (
+        "cage_speed_rpm",
+        "cage_slip",
+        "roller_skew_rad.mean_abs",
+        "roller_skew_rad.max_abs",
+        "corner_contact_share.time",
+        "corner_contact_share.events",
+        "contact_radius_m.p99",
+        "flange_contact_events_per_rev",
+    ):
         out[name] = np.full(nrev, np.nan)
     kin_rpm = float(rad_s_to_rpm(kinematic_speed))
     for i in range(nrev):

@@ -61,7 +61,9 @@ class RacewayNormalNorm(eqx.Module):
     weights: State
 
     def __call__(self, x: State) -> Float[Array, ""]:
-        leaves = jax.tree_util.tree_leaves(jax.tree_util.tree_map(lambda w, v: jnp.max(jnp.abs(w * v)), self.weights, x))
+        leaves = jax.tree_util.tree_leaves(
+            jax.tree_util.tree_map(lambda w, v: jnp.max(jnp.abs(w * v)), self.weights, x)
+        )
         return jnp.max(jnp.stack(leaves))
 
 

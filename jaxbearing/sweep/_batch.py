@@ -88,13 +88,20 @@ def batch_runner(num_saves: int, max_steps: int, devices: tuple):
     from ..run import solve
 
     def one(bearing, op, duration, rtol, atol):
-        return solve(bearing, op, duration, num_saves=num_saves, rtol=rtol, atol=atol,
-                     max_steps=max_steps, progress=False)
+        return solve(
+            bearing,
+            op,
+            duration,
+            num_saves=num_saves,
+            rtol=rtol,
+            atol=atol,
+            max_steps=max_steps,
+            progress=False,
+        )
 
     mesh = Mesh(np.asarray(devices), ("cases",))
     spec = PartitionSpec("cases")
-    sharded = jax.shard_map(jax.vmap(one), mesh=mesh, in_specs=(spec,) * 5, out_specs=spec,
-                            check_vma=False)
+    sharded = jax.shard_map(jax.vmap(one), mesh=mesh, in_specs=(spec,) * 5, out_specs=spec, check_vma=False)
     return jax.jit(sharded)
 
 
@@ -114,8 +121,10 @@ def solve_batch(spec: SweepSpec, cases: Sequence[int], devices: Sequence | None 
     stacked = jax.tree_util.tree_map(lambda *xs: np.stack(xs), *inputs)
     runner = batch_runner(spec.num_saves, spec.base.simulation.max_steps, devices)
     sol = jax.device_get(runner(*stacked))
-    rows = [_summarise_case(spec, jax.tree_util.tree_map(lambda a: a[i], sol), inputs[i])
-            for i in range(len(cases))]
+    rows = [
+        _summarise_case(spec, jax.tree_util.tree_map(lambda a: a[i], sol), inputs[i])
+        for i in range(len(cases))
+    ]
     out = {"case_index": np.asarray(cases, dtype=np.int64)}
     for key in rows[0]:
         out[key] = np.stack([r[key] for r in rows])

@@ -53,32 +53,51 @@ def assemble(out_dir: str | os.PathLike, spec: SweepSpec | None = None):
     for b in range(spec.num_batches):
         data = read_batch(out_dir, spec, b)
         if data is None:
-            raise UserInputError(f"{out_dir}: {batch_path(out_dir, b).name} is missing or "
-                                 "damaged; run the sweep command again to compute it")
+            raise UserInputError(
+                f"{out_dir}: {batch_path(out_dir, b).name} is missing or "
+                "damaged; run the sweep command again to compute it"
+            )
         batches.append(data)
-    cols = {k: np.concatenate([d[k] for d in batches]) for k in batches[0]
-            if k not in ("spec_hash", "batch")}
+    cols = {k: np.concatenate([d[k] for d in batches]) for k in batches[0] if k not in ("spec_hash", "batch")}
     shape = spec.shape
     dims = spec.dims
     data_vars: dict[str, Any] = {}
     for name in variable_names():
         attrs = {"description": f"summarise()['{name}'] of the case"}
         data_vars[name] = (dims, cols[name].reshape(shape), attrs)
-    data_vars["status"] = (dims, cols["status"].astype(str).reshape(shape),
-                           {"description": "\"ok\" or the solver failure"})
-    data_vars["result_code"] = (dims, cols["result_code"].astype(np.int32).reshape(shape),
-                                {"description": "diffrax result code (0 = successful)"})
+    data_vars["status"] = (
+        dims,
+        cols["status"].astype(str).reshape(shape),
+        {"description": '"ok" or the solver failure'},
+    )
+    data_vars["result_code"] = (
+        dims,
+        cols["result_code"].astype(np.int32).reshape(shape),
+        {"description": "diffrax result code (0 = successful)"},
+    )
     data_vars["contact_position"] = (
         dims + ("sample", "end_face_axis"),
         cols["contact_position"].reshape(shape + cols["contact_position"].shape[1:]),
-        {"units": "m", "description": "flange contact points on the roller end face (roller "
-         "frame y, z), evenly subsampled over all contact samples; NaN-padded"})
-    data_vars["contact_position_count"] = (dims, cols["contact_position_count"].astype(np.int32)
-                                           .reshape(shape), {"description": "valid samples"})
+        {
+            "units": "m",
+            "description": "flange contact points on the roller end face (roller "
+            "frame y, z), evenly subsampled over all contact samples; NaN-padded",
+        },
+    )
+    data_vars["contact_position_count"] = (
+        dims,
+        cols["contact_position_count"].astype(np.int32).reshape(shape),
+        {"description": "valid samples"},
+    )
     for name, values in design_zone_cases(spec).items():
-        data_vars[name] = (dims, values.reshape(shape),
-                           {"description": "jaxbearing.design_zone of the case (aligned roller, "
-                            "flange load 100 N); margins > 0 are feasible"})
+        data_vars[name] = (
+            dims,
+            values.reshape(shape),
+            {
+                "description": "jaxbearing.design_zone of the case (aligned roller, "
+                "flange load 100 N); margins > 0 are feasible"
+            },
+        )
     coords: dict[str, Any] = {}
     for a in spec.axes:
         unit = KEY_BY_PATH[a.key].unit if a.key in KEY_BY_PATH else ""

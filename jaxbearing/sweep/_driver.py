@@ -44,8 +44,11 @@ class _Progress:
         el = time.perf_counter() - self.start
         rate = (self.done - self.start_done) / el if el > 0 and self.done > self.start_done else 0
         eta = f", ETA {(self.total - self.done) / rate:.0f} s" if rate else ""
-        print(f"{self.prefix}[{bar}] {self.done}/{self.total} cases ({frac:.0%}), "
-              f"{el:.1f} s{eta}", file=sys.stderr, flush=True)
+        print(
+            f"{self.prefix}[{bar}] {self.done}/{self.total} cases ({frac:.0%}), {el:.1f} s{eta}",
+            file=sys.stderr,
+            flush=True,
+        )
 
     def update(self, n: int) -> None:
         self.done += n
@@ -87,17 +90,30 @@ def run_sweep(
     check_run_arguments(process_id, num_processes, wait_timeout_s, lock_wait_s)
     with acquire_lock(out_dir, f"sweep.{process_id}.lock", wait_s=lock_wait_s, what="sweep") as lock:
         if lock.took_over:
-            _say(progress, f"sweep: {out_dir} was left locked by a run that ended "
-                 f"(pid {lock.took_over.get('pid')} on {lock.took_over.get('host')}); resuming")
-        return _run_locked(spec, out_dir, resume, process_id, num_processes, progress,
-                           assemble_results, wait_timeout_s, devices)
+            _say(
+                progress,
+                f"sweep: {out_dir} was left locked by a run that ended "
+                f"(pid {lock.took_over.get('pid')} on {lock.took_over.get('host')}); resuming",
+            )
+        return _run_locked(
+            spec,
+            out_dir,
+            resume,
+            process_id,
+            num_processes,
+            progress,
+            assemble_results,
+            wait_timeout_s,
+            devices,
+        )
 
 
 def check_run_arguments(process_id, num_processes, wait_timeout_s, lock_wait_s) -> None:
     """The process layout and the waiting times, before anything is locked or computed."""
     check_arguments({"num_processes": num_processes}, {"num_processes": count(1)})
-    check_arguments({"process_id": process_id},
-                    {"process_id": count(0, num_processes - 1, note="0..num_processes-1")})
+    check_arguments(
+        {"process_id": process_id}, {"process_id": count(0, num_processes - 1, note="0..num_processes-1")}
+    )
     for name, value in (("wait_timeout_s", wait_timeout_s), ("lock_wait_s", lock_wait_s)):
         if not (isinstance(value, (int, float)) and not isinstance(value, bool) and value >= 0):
             raise UserInputError(f"{name} = {value!r}: must be >= 0 s (inf: no limit)")
@@ -117,15 +133,28 @@ def recover(out_dir: pathlib.Path, mine: list[int], process_id: int, num_process
             remove_stale_temporaries(directory, all_hosts=num_processes == 1)
     moved = set_aside_damaged(out_dir, mine)
     for b, reason, target in moved:
-        print(f"sweep: {batch_path(out_dir, b).name} is damaged ({reason}); moved to "
-              f"{target.relative_to(out_dir)}; computing it again", file=sys.stderr, flush=True)
-        append_log(out_dir, {"event": "damaged", "batch": b, "process": process_id,
-                             "reason": reason, "moved_to": str(target.relative_to(out_dir))})
+        print(
+            f"sweep: {batch_path(out_dir, b).name} is damaged ({reason}); moved to "
+            f"{target.relative_to(out_dir)}; computing it again",
+            file=sys.stderr,
+            flush=True,
+        )
+        append_log(
+            out_dir,
+            {
+                "event": "damaged",
+                "batch": b,
+                "process": process_id,
+                "reason": reason,
+                "moved_to": str(target.relative_to(out_dir)),
+            },
+        )
     return [b for b, _, _ in moved]
 
 
-def _run_locked(spec, out_dir, resume, process_id, num_processes, progress, assemble_results,
-                wait_timeout_s, devices):
+def _run_locked(
+    spec, out_dir, resume, process_id, num_processes, progress, assemble_results, wait_timeout_s, devices
+):
     prepare_dir(out_dir, spec, resume, process_id)
     mine = assigned_batches(spec, process_id, num_processes)
     recover(out_dir, mine, process_id, num_processes)
@@ -139,10 +168,17 @@ def _run_locked(spec, out_dir, resume, process_id, num_processes, progress, asse
         start = time.perf_counter()
         data = solve_batch(spec, cases, devices)
         write_batch(out_dir, spec, b, data)
-        append_log(out_dir, {"event": "batch", "batch": b, "process": process_id,
-                       "cases": [int(cases[0]), int(cases[-1])],
-                       "failed": int(np.sum(data["result_code"] != 0)),
-                       "wall_s": round(time.perf_counter() - start, 3)})
+        append_log(
+            out_dir,
+            {
+                "event": "batch",
+                "batch": b,
+                "process": process_id,
+                "cases": [int(cases[0]), int(cases[-1])],
+                "failed": int(np.sum(data["result_code"] != 0)),
+                "wall_s": round(time.perf_counter() - start, 3),
+            },
+        )
         bar.update(len(cases))
     if process_id != 0 or not assemble_results:
         return None
@@ -151,7 +187,8 @@ def _run_locked(spec, out_dir, resume, process_id, num_processes, progress, asse
         raise UserInputError(
             f"{len(missing)} batch file(s) of {out_dir} still missing after {wait_timeout_s:g} s "
             f"(first: {batch_path(out_dir, missing[0]).name}); run the same command again to "
-            "finish them")
+            "finish them"
+        )
     return assemble(out_dir, spec)
 
 
@@ -167,7 +204,10 @@ def _wait_for_batches(out_dir, spec, timeout_s, progress) -> list[int]:
         if not missing or time.monotonic() >= deadline:
             return missing
         if progress and not told:
-            print(f"sweep: waiting for {len(missing)} batch(es) from the other processes",
-                  file=sys.stderr, flush=True)
+            print(
+                f"sweep: waiting for {len(missing)} batch(es) from the other processes",
+                file=sys.stderr,
+                flush=True,
+            )
             told = True
         time.sleep(0.5)

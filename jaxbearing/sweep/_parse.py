@@ -26,8 +26,10 @@ def _wrong_unit(path: str) -> str | None:
             continue
         stem = key.name[: len(key.name) - len(key.path.rpartition("_")[2]) - 1]
         if "_" in key.name and name.startswith(stem + "_"):
-            return (f"wrong unit suffix: configuration keys are in engineering units with the "
-                    f"unit in the name; use {key.path} [{key.unit}]")
+            return (
+                f"wrong unit suffix: configuration keys are in engineering units with the "
+                f"unit in the name; use {key.path} [{key.unit}]"
+            )
     return None
 
 
@@ -36,12 +38,18 @@ def _axis_values(key: str, raw) -> tuple:
     if isinstance(raw, Mapping):
         unknown = [k for k in raw if k not in _RANGE_FIELDS]
         if unknown:
-            raise SweepSpecError(key, f"unknown range field {unknown[0]!r}; a range is "
-                                 "{ start = ..., stop = ..., num = ... } (stop included)")
+            raise SweepSpecError(
+                key,
+                f"unknown range field {unknown[0]!r}; a range is "
+                "{ start = ..., stop = ..., num = ... } (stop included)",
+            )
         missing = [k for k in _RANGE_FIELDS if k not in raw]
         if missing:
-            raise SweepSpecError(key, f"range is missing {missing[0]!r}; a range is "
-                                 "{ start = ..., stop = ..., num = ... } (stop included)")
+            raise SweepSpecError(
+                key,
+                f"range is missing {missing[0]!r}; a range is "
+                "{ start = ..., stop = ..., num = ... } (stop included)",
+            )
         num = raw["num"]
         if isinstance(num, bool) or not isinstance(num, numbers.Integral):
             raise SweepSpecError(key, f"range num must be an integer, got {type_name(num)}")
@@ -50,15 +58,19 @@ def _axis_values(key: str, raw) -> tuple:
         for f in ("start", "stop"):
             v = raw[f]
             if isinstance(v, bool) or not isinstance(v, numbers.Real) or not math.isfinite(v):
-                raise SweepSpecError(key, f"range {f} must be a finite number, got "
-                                     f"{type_name(v)} {format_value(v)}")
+                raise SweepSpecError(
+                    key, f"range {f} must be a finite number, got {type_name(v)} {format_value(v)}"
+                )
         return tuple(float(v) for v in np.linspace(raw["start"], raw["stop"], num))
     if isinstance(raw, (list, tuple)):
         if not raw:
             raise SweepSpecError(key, "empty axis: give at least one value")
         return tuple(raw)
-    raise SweepSpecError(key, f"expected a list of values or a range table "
-                         f"{{start, stop, num}}, got {type_name(raw)} {format_value(raw)}")
+    raise SweepSpecError(
+        key,
+        f"expected a list of values or a range table "
+        f"{{start, stop, num}}, got {type_name(raw)} {format_value(raw)}",
+    )
 
 
 def _check_axis_key(key: str) -> None:
@@ -93,8 +105,7 @@ def build_spec(data: Mapping[str, Any], base_dir: str | os.PathLike | None = Non
     Every case is validated through `Config.replace`; errors name the axis."""
     unknown = [k for k in data if k not in ("sweep", "base", "axes")]
     if unknown:
-        raise SweepSpecError(unknown[0], "unknown table; a sweep spec has [sweep], [base] "
-                             "and [axes]")
+        raise SweepSpecError(unknown[0], "unknown table; a sweep spec has [sweep], [base] and [axes]")
     sweep = _sweep_table(data.get("sweep", {}))
     base = _base_config(sweep, data.get("base", {}), base_dir)
     values = _axis_values_by_key(data.get("axes", {}))
@@ -131,8 +142,9 @@ def _base_config(sweep: Mapping[str, Any], inline, base_dir) -> Config:
     the inline [base.*] tables merged over it."""
     base_ref = sweep.get("base", "reference")
     if not isinstance(base_ref, str):
-        raise SweepSpecError("sweep.base", f"expected a config file path or \"reference\", "
-                             f"got {type_name(base_ref)}")
+        raise SweepSpecError(
+            "sweep.base", f'expected a config file path or "reference", got {type_name(base_ref)}'
+        )
     if base_ref == "reference":
         base = Config()
     else:
@@ -180,8 +192,9 @@ def _flat_axes(axes_raw) -> dict[str, Any]:
 
     walk(axes_raw, "")
     if not flat:
-        raise SweepSpecError("axes", "no axes: give at least one, e.g. "
-                             "\"operating.speed_rpm\" = [10000, 20000]")
+        raise SweepSpecError(
+            "axes", 'no axes: give at least one, e.g. "operating.speed_rpm" = [10000, 20000]'
+        )
     return flat
 
 
@@ -194,16 +207,21 @@ def _axis_values_by_key(axes_raw) -> dict[str, tuple]:
         if key == "end":
             bad = [v for v in vals if v not in ("arc", "corner")]
             if bad:
-                raise SweepSpecError("end", f"{format_value(bad[0])} is not a roller end type; "
-                                     "values are \"arc\" and \"corner\"")
+                raise SweepSpecError(
+                    "end", f'{format_value(bad[0])} is not a roller end type; values are "arc" and "corner"'
+                )
         else:
             cfg_key = KEY_BY_PATH[key]
             for v in vals:
                 if isinstance(v, str):
-                    raise SweepSpecError(key, f"expected numbers [{cfg_key.unit}], got string "
-                                         f"{format_value(v)}; units are part of the key name")
-            vals = tuple(cfg_key.kind(v) if cfg_key.kind is float and not isinstance(v, bool)
-                         else v for v in vals)
+                    raise SweepSpecError(
+                        key,
+                        f"expected numbers [{cfg_key.unit}], got string "
+                        f"{format_value(v)}; units are part of the key name",
+                    )
+            vals = tuple(
+                cfg_key.kind(v) if cfg_key.kind is float and not isinstance(v, bool) else v for v in vals
+            )
         if len(set(vals)) != len(vals):
             dup = next(v for v in vals if vals.count(v) > 1)
             raise SweepSpecError(key, f"value {format_value(dup)} appears twice")
@@ -216,8 +234,9 @@ def _zip_groups(sweep: Mapping[str, Any], values: Mapping[str, tuple], mode: str
     groups_raw = sweep.get("zip", [])
     if mode == "zip":
         if groups_raw:
-            raise SweepSpecError("sweep.zip", "give either mode = \"zip\" (all axes zipped) or "
-                                 "zip groups, not both")
+            raise SweepSpecError(
+                "sweep.zip", 'give either mode = "zip" (all axes zipped) or zip groups, not both'
+            )
         groups = [list(values)]
     else:
         if not isinstance(groups_raw, list) or not all(isinstance(g, list) for g in groups_raw):
@@ -227,8 +246,7 @@ def _zip_groups(sweep: Mapping[str, Any], values: Mapping[str, tuple], mode: str
     for gi, group in enumerate(groups):
         for key in group:
             if key not in values:
-                raise SweepSpecError("sweep.zip", f"{key!r} is not an axis (axes: "
-                                     f"{', '.join(values)})")
+                raise SweepSpecError("sweep.zip", f"{key!r} is not an axis (axes: {', '.join(values)})")
             if key in grouped:
                 raise SweepSpecError("sweep.zip", f"{key!r} is in two zip groups")
             grouped[key] = gi
@@ -236,8 +254,11 @@ def _zip_groups(sweep: Mapping[str, Any], values: Mapping[str, tuple], mode: str
         if len(set(lengths.values())) > 1:
             first = group[0]
             other = next(k for k in group if lengths[k] != lengths[first])
-            raise SweepSpecError(other, f"zipped axes must have equal lengths: {other} has "
-                                 f"{lengths[other]} values, {first} has {lengths[first]}")
+            raise SweepSpecError(
+                other,
+                f"zipped axes must have equal lengths: {other} has "
+                f"{lengths[other]} values, {first} has {lengths[first]}",
+            )
     return grouped
 
 
@@ -245,7 +266,7 @@ def _dimensions(sweep: Mapping[str, Any], values: Mapping[str, tuple]):
     """(axes, dims, shape): every axis its own dimension, unless zipped."""
     mode = sweep.get("mode", "grid")
     if mode not in ("grid", "zip"):
-        raise SweepSpecError("sweep.mode", f"{format_value(mode)} is not \"grid\" or \"zip\"")
+        raise SweepSpecError("sweep.mode", f'{format_value(mode)} is not "grid" or "zip"')
     grouped = _zip_groups(sweep, values, mode)
     names = _coordinate_names(list(values))
     dims: list[str] = []
@@ -286,12 +307,16 @@ def validate_cases(spec: SweepSpec) -> None:
                         axis = k
                         break
             shown = ", ".join(f"{k} = {format_value(v)}" for k, v in values.items())
-            raise SweepSpecError(axis or " + ".join(values),
-                                 f"case {case} ({shown}) is invalid: {exc}") from None
+            raise SweepSpecError(
+                axis or " + ".join(values), f"case {case} ({shown}) is invalid: {exc}"
+            ) from None
         if end == "arc" and not math.isfinite(cfg["roller.end_radius_mm"]):
             axis = "roller.end_radius_mm" if "roller.end_radius_mm" in values else "end"
-            raise SweepSpecError(axis, f"case {case}: end = \"arc\" needs a finite "
-                                 "roller.end_radius_mm (inf is the flat end); use end = \"corner\"")
+            raise SweepSpecError(
+                axis,
+                f'case {case}: end = "arc" needs a finite '
+                'roller.end_radius_mm (inf is the flat end); use end = "corner"',
+            )
 
 
 def loads_sweep_spec(text: str, base_dir: str | os.PathLike | None = None) -> SweepSpec:

@@ -38,8 +38,6 @@ _SLIDING = ("flange_sliding_velocity_m_s", "sliding velocity [m/s]", 1.0)
 _PV = ("flange_pv_Pa_m_s", "PV [GPa m/s]", 1e-9)
 
 
-
-
 def coordinate_for(ds, key: str) -> str | None:
     """Name of the coordinate of `ds` that sweeps configuration key `key` (or "end")."""
     for name, coord in ds.coords.items():
@@ -130,8 +128,7 @@ def _positions_figure(ds, key: str, path: pathlib.Path, max_panels: int = 6):
         if math.isfinite(r_end):
             r_ce = diameter / 2 - corner
             rho_lim = r_ce * r_end / (r_end - corner)
-            ax.plot(rho_lim * np.cos(t), rho_lim * np.sin(t), "r--", lw=0.8,
-                    label="limited circle")
+            ax.plot(rho_lim * np.cos(t), rho_lim * np.sin(t), "r--", lw=0.8, label="limited circle")
         if len(pts):
             ax.plot(pts[:, 0], pts[:, 1], ".", ms=3, label="contact")
         else:
@@ -141,8 +138,10 @@ def _positions_figure(ds, key: str, path: pathlib.Path, max_panels: int = 6):
         ax.set_xlabel("y [mm]")
         ax.set_ylabel("z [mm]")
     axes[0][0].legend(fontsize=7, loc="lower left")
-    fig.suptitle("Contact positions on the roller end face (cf. paper Fig. 13)"
-                 + (f"\n({note})" if note else ""), fontsize=10)
+    fig.suptitle(
+        "Contact positions on the roller end face (cf. paper Fig. 13)" + (f"\n({note})" if note else ""),
+        fontsize=10,
+    )
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
@@ -165,8 +164,9 @@ def plot_sweep(ds, out_dir) -> tuple[list[tuple[str, pathlib.Path]], list[tuple[
             continue
         path = out_dir / f"figure{fig_no}_{panel[0]}_vs_speed.png"
         ends = "arc and corner ends" if has["end"] else f"{ds.attrs.get('base_end')} end"
-        _line_figure(ds, _SPEED, [panel], f"{panel[1].split(' [')[0]} vs speed, {ends} "
-                     f"(cf. paper Fig. {fig_no})", path)
+        _line_figure(
+            ds, _SPEED, [panel], f"{panel[1].split(' [')[0]} vs speed, {ends} (cf. paper Fig. {fig_no})", path
+        )
         drawn.append((label, path))
 
     for key, tag in ((_R_END, "end_radius"), (_LAYBACK, "layback_angle")):
@@ -175,13 +175,21 @@ def plot_sweep(ds, out_dir) -> tuple[list[tuple[str, pathlib.Path]], list[tuple[
             skipped.append((label, f"needs the axis {key}"))
             continue
         path = out_dir / f"figure12_vs_{tag}.png"
-        _line_figure(ds, key, [_SLIDING, _PV], f"sliding velocity and PV vs {tag.replace('_', ' ')}"
-                     ", arc end (cf. paper Fig. 12)", path, arc_only=True)
+        _line_figure(
+            ds,
+            key,
+            [_SLIDING, _PV],
+            f"sliding velocity and PV vs {tag.replace('_', ' ')}, arc end (cf. paper Fig. 12)",
+            path,
+            arc_only=True,
+        )
         drawn.append((label, path))
 
-    for key, tag, plural in ((_LAYBACK, "layback_angle", "layback angles"),
-                             (_R_END, "end_radius", "end radii"),
-                             (_CENTRAL, "central_length", "central lengths")):
+    for key, tag, plural in (
+        (_LAYBACK, "layback_angle", "layback angles"),
+        (_R_END, "end_radius", "end radii"),
+        (_CENTRAL, "central_length", "central lengths"),
+    ):
         label = f"Figure 13 (contact positions for several {plural})"
         if not has[key]:
             skipped.append((label, f"needs the axis {key}"))

@@ -48,7 +48,6 @@ case (`flange_pv_Pa_m_s_max`, ...), `status`, the design-zone margins of every c
 roller frame, m; NaN-padded).
 """
 
-
 from __future__ import annotations
 
 import dataclasses
@@ -70,13 +69,14 @@ FORMAT_VERSION = 1
 _STATIC_KEYS = {
     "bearing.num_rollers": "it changes array shapes (static); run one sweep per value",
     "bearing.num_slices": "it changes array shapes (static); run one sweep per value",
-    "simulation.max_steps": "it is a static argument of the compiled solve; set it in "
-    "[base.simulation]",
+    "simulation.max_steps": "it is a static argument of the compiled solve; set it in [base.simulation]",
     "simulation.progress": "progress is not a model parameter",
-    "simulation.end": "use the special axis \"end\" = [\"arc\", \"corner\"]",
+    "simulation.end": 'use the special axis "end" = ["arc", "corner"]',
 }
 _SWEEP_FIELDS = ("base", "mode", "zip", "batch_size", "num_saves", "max_positions")
 _RANGE_FIELDS = ("start", "stop", "num")
+
+
 class SweepSpecError(UserInputError):
     """A sweep spec is malformed; `axis` names the offending axis or spec field."""
 
@@ -141,8 +141,9 @@ class SweepSpec:
         return {
             "format": FORMAT_VERSION,
             "base": self.base.to_dict(),
-            "axes": [{"key": a.key, "name": a.name, "values": list(a.values), "dim": a.dim}
-                     for a in self.axes],
+            "axes": [
+                {"key": a.key, "name": a.name, "values": list(a.values), "dim": a.dim} for a in self.axes
+            ],
             "dims": list(self.dims),
             "shape": list(self.shape),
             "batch_size": self.batch_size,
@@ -158,11 +159,21 @@ class SweepSpec:
     @classmethod
     def from_canonical(cls, data: Mapping) -> SweepSpec:
         if data.get("format") != FORMAT_VERSION:
-            raise SweepSpecError("spec.json", f"format {data.get('format')!r} is not "
-                                 f"{FORMAT_VERSION}; written by another jaxbearing version")
+            raise SweepSpecError(
+                "spec.json",
+                f"format {data.get('format')!r} is not "
+                f"{FORMAT_VERSION}; written by another jaxbearing version",
+            )
         axes = tuple(Axis(a["key"], a["name"], tuple(a["values"]), a["dim"]) for a in data["axes"])
-        return cls(Config(data["base"]), axes, tuple(data["dims"]), tuple(data["shape"]),
-                   data["batch_size"], data["num_saves"], data["max_positions"])
+        return cls(
+            Config(data["base"]),
+            axes,
+            tuple(data["dims"]),
+            tuple(data["shape"]),
+            data["batch_size"],
+            data["num_saves"],
+            data["max_positions"],
+        )
 
     def with_batch_size(self, batch_size: int) -> SweepSpec:
         _positive_int("batch_size", batch_size)

@@ -26,8 +26,7 @@ def damaged_dir(out_dir: pathlib.Path) -> pathlib.Path:
 
 def write_batch(out_dir: pathlib.Path, spec: SweepSpec, batch: int, data: dict) -> pathlib.Path:
     path = batch_path(out_dir, batch)
-    atomic_write(path, lambda f: np.savez(f, spec_hash=np.asarray(spec.hash),
-                                           batch=np.int64(batch), **data))
+    atomic_write(path, lambda f: np.savez(f, spec_hash=np.asarray(spec.hash), batch=np.int64(batch), **data))
     return path
 
 
@@ -117,8 +116,10 @@ def prepare_dir(out_dir: pathlib.Path, spec: SweepSpec, resume: bool, process_id
             old = None
         if old is not None and old.get("hash") != spec.hash:
             raise SweepSpecError(
-                "--out", f"{out_dir} holds another sweep (spec hash {old.get('hash')}, this one "
-                f"{spec.hash}; the spec or --batch-size changed); use another --out or --no-resume")
+                "--out",
+                f"{out_dir} holds another sweep (spec hash {old.get('hash')}, this one "
+                f"{spec.hash}; the spec or --batch-size changed); use another --out or --no-resume",
+            )
     if process_id == 0:
         doc = {"hash": spec.hash, "spec": spec.canonical()}
         atomic_write(spec_file, lambda f: f.write(json.dumps(doc, indent=1, allow_nan=True).encode()))
