@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 from test_contact_hertz import exact_hertz
 
-from jaxbearing._params import Lubricant
+from jaxbearing.geometry import Lubricant
 from jaxbearing.contact import (
     ASPERITY_MIDPOINT,
     asperity_load_fraction,

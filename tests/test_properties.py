@@ -32,7 +32,7 @@ from hypothesis import strategies as st
 import jaxbearing as jb
 import jaxbearing.run._simulate as simulate_module
 from jaxbearing.io import KEYS, SOLVER_ARGUMENTS, Rule, count, real
-from jaxbearing.io._validation import REFERENCE_VALUES
+from jaxbearing.io._schema import REFERENCE_VALUES
 
 EXAMPLES = int(os.environ.get("JAXBEARING_PROPERTY_EXAMPLES", "30"))
 EXAMPLE_LIMIT_S = 30

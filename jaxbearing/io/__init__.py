@@ -47,8 +47,10 @@ from ._files import (
     with_null_reasons,
     write_json,
 )
+from ._keys import format_value, type_name
 from ._lock import DirectoryInUse, DirectoryLock, acquire_lock
-from ._validation import KEY_BY_PATH, KEYS, format_value, type_name, validate_bearing
+from ._schema import KEY_BY_PATH, KEYS
+from ._validation import validate_bearing
 
 __all__ = [
     "FUNCTIONALS_FIELDS",

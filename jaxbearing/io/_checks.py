@@ -1,6 +1,6 @@
 """Range checks on concrete values: one-line `UserInputError`s naming parameter, value and range.
 
-The configuration schema (`_validation`) checks engineering-unit keys; this module checks the
+The configuration schema (`_schema`, checked by `_validation`) checks engineering-unit keys; this module checks the
 SI values of Python entry points (design variables, flange loads, solver arguments) the same
 way: a check runs only on concrete values (under `jax.jit`/`grad`/`vmap` the caller's concrete
 check has already run, outside the trace), and the first violating element is named.

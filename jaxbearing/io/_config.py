@@ -2,7 +2,7 @@
 
 A configuration file has one table per part of the bearing, with the unit in every key's name
 (`_mm`, `_um`, `_deg`, `_rpm`, `_GPa`, `_N`, ...); `jaxbearing config show` prints every key with
-its meaning, symbol and valid range. The schema and the ranges are `jaxbearing._validation.KEYS`.
+its meaning, symbol and valid range. The schema and the ranges are `jaxbearing.io.KEYS` (`_schema.py`).
 
     [bearing]            pitch_diameter_mm, radial_clearance_um, num_rollers, num_slices, ...
     [roller]             diameter_mm, length_mm, ..., end_radius_mm (inf = flat end)
@@ -41,17 +41,9 @@ import tomli_w
 
 from .._errors import ConfigError
 from ..geometry import Bearing, Cage, Flange, Lubricant, Material, OperatingPoint, Roller
-from ._validation import (
-    GRAVITY,
-    KEY_BY_PATH,
-    KEYS,
-    REFERENCE_VALUES,
-    Key,
-    check_values,
-    coerce,
-    format_value,
-    type_name,
-)
+from ._keys import GRAVITY, Key, format_value, type_name
+from ._schema import KEY_BY_PATH, KEYS, REFERENCE_VALUES
+from ._validation import check_values, coerce
 
 _HEADER = """\
 # jaxbearing configuration. Engineering units: the unit is part of every key's name.
@@ -389,7 +381,7 @@ def reference_config() -> Config:
 
 def reference_bearing() -> Bearing:
     """The embedded reference bearing of MODEL.md section 2, built from the reference values of
-    the configuration schema (the one place they are written down, `io/_validation.py`).
+    the configuration schema (the one place they are written down, `io/_schema.py`).
 
     Representative, not the source study's bearing: the paper's Table 1 is not available. The
     values are an aero-engine mainshaft roller bearing chosen so that the paper's stated values

@@ -33,8 +33,17 @@ from ._design import (
     seated_perturbation,
 )
 from ._ensemble import parallel_map, simulate_ensemble
+from ._initial import Perturbation, initial_state
 from ._plots import plot_run
 from ._progress import SolveProgress
+from ._result import (
+    RESULT_NAMES,
+    SimulationResult,
+    Solution,
+    result_code,
+    simulation_result,
+    smooth_functionals,
+)
 from ._settle import (
     SeedRun,
     SteadyResult,
@@ -45,20 +54,7 @@ from ._settle import (
     summarise,
     summarise_steady,
 )
-from ._simulate import (
-    RESULT_NAMES,
-    Perturbation,
-    SimulationResult,
-    Solution,
-    SolveArgs,
-    flange_functionals,
-    initial_state,
-    result_code,
-    scaled_field,
-    simulation_result,
-    smooth_functionals,
-    solve,
-)
+from ._simulate import SolveArgs, flange_functionals, scaled_field, solve
 from ._statistics import (
     Estimate,
     batch_means,

@@ -87,7 +87,8 @@ class _SimulateSeed:
     kwargs: dict
 
     def __call__(self, seed: int):
-        from ._simulate import Perturbation, simulate
+        from ._initial import Perturbation
+        from ._simulate import simulate
 
         base = self.kwargs.get("perturbation") or Perturbation()
         kwargs = dict(self.kwargs, perturbation=dataclasses.replace(base, seed=int(seed)))

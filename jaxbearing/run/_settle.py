@@ -32,7 +32,9 @@ from ..dynamics import Functionals, Params, Scaling, State, state_scales
 from ..geometry import Bearing, OperatingPoint, kinematic_cage_speed, rad_s_to_rpm
 from ..io import require
 from ._compile_cache import checks_without_host_callbacks
-from ._simulate import Perturbation, SolveArgs, _diffeqsolve, _save, initial_state, result_code
+from ._initial import Perturbation, initial_state
+from ._result import result_code
+from ._simulate import SolveArgs, _diffeqsolve, _save
 from ._simulate import simulate as _simulate_fixed
 from ._statistics import steady_statistics
 from ._step_control import raceway_normal_norm
