@@ -17,7 +17,6 @@ import numpy as np
 import pytest
 from test_contact_hertz import exact_hertz
 
-from jaxbearing.geometry import Lubricant
 from jaxbearing.contact import (
     ASPERITY_MIDPOINT,
     asperity_load_fraction,
@@ -33,6 +32,7 @@ from jaxbearing.contact import (
     traction_coefficient,
     viscosity_at_temperature,
 )
+from jaxbearing.geometry import Lubricant
 
 # representative steel contact in oil (the source paper's oil: 0.055 Pa s at 80 C,
 # alpha_p = 1.85e-8 1/Pa, beta_T = 0.0315 1/C)
