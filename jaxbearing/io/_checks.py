@@ -124,7 +124,14 @@ class Rule:
                 fail(_shown(value))
             return
         if self.kind == "count":
-            if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
+            if not is_concrete(value):  # a traced integer (e.g. the scatter seed under jit)
+                if getattr(value, "dtype", np.dtype(float)).kind not in "iu":
+                    fail(f"a traced {getattr(value, 'dtype', 'value')}")
+                return
+            integral = isinstance(value, numbers.Integral) or (
+                np.ndim(value) == 0 and getattr(value, "dtype", np.dtype(float)).kind in "iu"
+            )
+            if isinstance(value, (bool, np.bool_)) or not integral:
                 fail(_shown(value))
             if not self._in_range(np.asarray(int(value), dtype=float)):
                 fail(str(int(value)))
