@@ -57,6 +57,9 @@ X = np.array([1.0, 0.0, 0.0])  # numpy: importing must not start the JAX backend
 
 #: names of the four flanges along the last axis of every per-flange array (`FLANGE_ORDER`)
 FLANGE_NAMES = ("inner_left", "inner_right", "outer_left", "outer_right")
+#: clip [m] of the contact-height deviation inside the log-sum-exp integrands (finite at the
+#: unphysical states diffrax visits during step rejection; far beyond any real contact height)
+HEIGHT_DEVIATION_CLIP = 5e-3
 
 
 class Functionals(eqx.Module):
@@ -210,7 +213,7 @@ def _functional_rates(fl, fn: Functionals) -> Accumulators:
     q = fl.normal_force
     w_c = q / (q + fn.contact_load)
     # clipped so that states diffrax may visit during step rejection stay finite
-    dh = jnp.clip(fl.contact_height - fn.height_reference, -5e-3, 5e-3)
+    dh = jnp.clip(fl.contact_height - fn.height_reference, -HEIGHT_DEVIATION_CLIP, HEIGHT_DEVIATION_CLIP)
     return Accumulators(
         pv_power=w_c * (fl.pv / fn.pv_reference) ** fn.pv_exponent,
         height_max_power=w_c * jnp.exp(fn.height_sharpness * dh),

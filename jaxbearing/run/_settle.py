@@ -37,7 +37,7 @@ from ._result import result_code
 from ._simulate import SolveArgs, _diffeqsolve, _save
 from ._simulate import simulate as _simulate_fixed
 from ._statistics import steady_statistics
-from ._step_control import raceway_normal_norm
+from ._step_control import raceway_normal_norm, step_controller
 from ._summary import summarise as _summarise_fixed
 
 #: defaults of the settled run
@@ -64,9 +64,7 @@ def solve_from(params: Params, start: State, duration, *, num_saves: int, rtol, 
         ]
     )
     y0_scaled = scaling.scale_state(0.0, start)
-    controller = diffrax.PIDController(
-        rtol=rtol, atol=atol, pcoeff=0.3, icoeff=0.4, norm=raceway_normal_norm(y0_scaled), dtmin=1e-13
-    )
+    controller = step_controller(rtol, atol, raceway_normal_norm(y0_scaled))
     with checks_without_host_callbacks():  # the same integrator and error norm as `solve`
         sol = _diffeqsolve(y0_scaled, args, duration, saveat, controller, max_steps, None, False)
     hist, final = sol.ys

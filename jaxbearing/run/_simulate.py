@@ -43,7 +43,7 @@ from ._compile_cache import checks_without_host_callbacks
 from ._initial import Perturbation, initial_state
 from ._progress import SolveProgress
 from ._result import SimulationResult, Solution, result_code, simulation_result, smooth_functionals
-from ._step_control import RACEWAY_NORMAL_LOOSEN, raceway_normal_norm
+from ._step_control import DT0, RACEWAY_NORMAL_LOOSEN, raceway_normal_norm, step_controller
 
 
 class SolveArgs(eqx.Module):
@@ -111,7 +111,7 @@ def _diffeqsolve(y0_scaled, args, duration, saveat, controller, max_steps, adjoi
         diffrax.Tsit5(),
         t0=0.0,
         t1=duration,
-        dt0=1e-7,
+        dt0=DT0,
         y0=y0_scaled,
         args=args,
         saveat=saveat,
@@ -179,7 +179,7 @@ def solve(
     else:
         saveat = diffrax.SaveAt(t1=True, fn=_save_functionals)
     norm = error_norm if error_norm is not None else raceway_normal_norm(y0_scaled, raceway_loosen)
-    controller = diffrax.PIDController(rtol=rtol, atol=atol, pcoeff=0.3, icoeff=0.4, norm=norm, dtmin=1e-13)
+    controller = step_controller(rtol, atol, norm)
     with checks_without_host_callbacks():  # cacheable program (`_compile_cache`)
         sol = _diffeqsolve(y0_scaled, args, duration, saveat, controller, max_steps, adjoint, progress)
     if num_saves:

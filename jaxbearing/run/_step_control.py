@@ -21,6 +21,7 @@ rtol.
 
 from __future__ import annotations
 
+import diffrax
 import equinox as eqx
 import jax
 import jax.numpy as jnp
@@ -35,6 +36,22 @@ from ..dynamics import State
 #: flange statistics within the reference's confidence interval; 100 still controls the radial
 #: coordinates to 10 % of their deviation.
 RACEWAY_NORMAL_LOOSEN = 100.0
+
+#: PID step-size controller coefficients (diffrax `PIDController`: proportional 0.3, integral
+#: 0.4, the values diffrax's documentation suggests for non-stiff problems).
+PID_PCOEFF, PID_ICOEFF = 0.3, 0.4
+#: smallest step [s]: below it the solve stops with `dt_min_reached` (non-finite dynamics).
+DT_MIN = 1e-13
+#: first step tried [s] (diffrax's automatic first step stalls at the quasi-static start).
+DT0 = 1e-7
+
+
+def step_controller(rtol, atol, norm) -> diffrax.PIDController:
+    """The step-size controller of every solve: PID with `PID_PCOEFF`, `PID_ICOEFF`, `DT_MIN`
+    and the error `norm` (e.g. `raceway_normal_norm(y0)`)."""
+    return diffrax.PIDController(
+        rtol=rtol, atol=atol, pcoeff=PID_PCOEFF, icoeff=PID_ICOEFF, norm=norm, dtmin=DT_MIN
+    )
 
 
 def raceway_normal_weights(state: State, loosen) -> State:
