@@ -101,3 +101,23 @@ def test_gradients_finite_at_rest():
         assert all(np.all(np.isfinite(np.asarray(x))) for x in g)
     jac = jax.jacfwd(lambda v: roller_drag(B, v, 0.0)[0])(jnp.zeros(3))
     np.testing.assert_array_equal(np.asarray(jac), 0.0)  # |v| v has zero slope at rest
+
+
+def test_no_oil_means_no_drag_and_finite_gradients():
+    """f_oil = 0 (allowed by the configuration, [0, 1]) is a dry cavity: zero drag force and
+    torques, not 0/0 (the kinematic viscosity eta_mix/rho_mix = eta_0/rho_oil is taken from the
+    oil), with finite derivatives with respect to f_oil."""
+    import equinox as eqx
+    import jax
+    import jax.numpy as jnp
+
+    import jaxbearing as jb
+    from jaxbearing.forces import cage_drag_torque, roller_drag
+
+    def total(f_oil):
+        b = eqx.tree_at(lambda b: b.lubricant.oil_fraction, jb.reference_bearing(), f_oil)
+        force, torque = roller_drag(b, jnp.array([0.0, 40.0, 3.0]), -1.0e4)
+        return jnp.sum(jnp.abs(force)) + jnp.abs(torque) + jnp.abs(cage_drag_torque(b, 900.0))
+
+    assert float(total(0.0)) == 0.0
+    assert bool(jnp.isfinite(jax.grad(total)(0.0)))

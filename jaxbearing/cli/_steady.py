@@ -1,13 +1,16 @@
 """Settled runs on the command line: the `--settle` options of `simulate` and their table.
 
 `--settle auto|off|MS` turns `simulate` into a settled run (`jaxbearing.run.simulate_steady`):
-quasi-static start, settling (`auto`: until the revolution-mean cage speed changes by less
+skid start (`--start skid`, default: the speeds of steady running, then projective steps of the
+cage speed while settling; `--start quasi-static`: kinematic speeds), settling (`auto`: until the revolution-mean cage speed changes by less
 than `--settle-tolerance` between consecutive cage revolutions, at most `--settle-cap-ms`; MS: a
 fixed settling time; `off`: none), then a window of `--window-revs` revolutions for each of
 `--seeds` seeds. Every statistic is printed with its 95 % confidence interval.
 """
 
 from __future__ import annotations
+
+import numpy as np
 
 _ROWS = (
     ("flange_force_N", "flange force", "N", 1.0),
@@ -37,6 +40,11 @@ def add_arguments(p) -> None:
         help="relative change of the revolution-mean cage speed that counts as settled (default 1e-3)",
     )
     g.add_argument(
+        "--start",
+        default="skid",
+        help='"skid" (default: skid equilibrium, projective steps of the cage speed) or "quasi-static"',
+    )
+    g.add_argument(
         "--settle-cap-ms", type=float, default=300.0, help="longest settling time [ms] (default 300)"
     )
 
@@ -58,12 +66,19 @@ def options(args) -> dict | None:
     check_steady_options(
         settle, args.window_revs, args.seeds, args.settle_tolerance, args.settle_cap_ms, names
     )
+    from ..run import STARTS
+
+    if args.start not in STARTS:
+        from .._errors import UserInputError
+
+        raise UserInputError(f"--start = {args.start!r}: must be one of {', '.join(map(repr, STARTS))}")
     return dict(
         settle=settle if settle in ("auto", "off") else float(settle),
         window_revs=int(args.window_revs),
         seeds=int(args.seeds),
         tolerance=args.settle_tolerance,
         settle_cap_ms=args.settle_cap_ms,
+        start=args.start,
     )
 
 
@@ -114,6 +129,13 @@ def format_table(summaries: dict) -> str:
             f"{'-' if rho is None else format(rho * 1e3, '.3f')} mm; wall {s['wall_time_s']:.1f} s "
             f"(+ compile {s['compile_time_s']:.1f} s)"
         )
+        steps = [f"{j:+.1f}" for r in s.get("per_seed", []) for j in r.get("projective_steps_rpm", [])]
+        starts = [r.get("start_cage_speed_rpm") for r in s.get("per_seed", [])]
+        if s.get("start") == "skid" and starts:
+            lines.append(
+                f"[{e}] skid start: cage {np.nanmean(starts):.1f} rpm; projective steps of the cage speed "
+                f"[rpm]: {', '.join(steps) or 'none'}"
+            )
         if s["settle_mode"] == "auto" and not s["settled"]:
             lines.append(
                 f"[{e}] NOT SETTLED: the cage speed still changed by more than "

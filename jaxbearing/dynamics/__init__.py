@@ -6,7 +6,9 @@
   angles), `angular_momentum`, `kinetic_energy`;
 - the vector field: `physical_rates(t, state, params)` over every roller, the cage and the inner
   ring, with `contact_loads` (every contact of one state) and the smooth `Functionals`;
-- the start (MODEL.md 5): `quasi_static` (load distribution with centrifugal force).
+- the start (MODEL.md 5): `quasi_static` (load distribution with centrifugal force) and
+  `skid_equilibrium` (the speeds of steady running at those positions, issue 11) with the
+  `cage_time_constant` of the cage speed's slow approach to it.
 
 May import: `jaxbearing._errors`, `contact`, `geometry`, `io`, `flange`, `forces`.
 """
@@ -14,6 +16,7 @@ May import: `jaxbearing._errors`, `contact`, `geometry`, `io`, `flange`, `forces
 from ._field import FLANGE_NAMES, Functionals, Loads, Params, contact_loads, physical_rates
 from ._quasistatic import QuasiStatic, quasi_static
 from ._rigid_body import angular_momentum, axisymmetric_body_rates, kinetic_energy
+from ._skid import SkidEquilibrium, cage_time_constant, skid_equilibrium
 from ._state import (
     Accumulators,
     CageState,
@@ -37,14 +40,17 @@ __all__ = [
     "RingState",
     "RollerState",
     "Scaling",
+    "SkidEquilibrium",
     "State",
     "angular_momentum",
     "axisymmetric_body_rates",
+    "cage_time_constant",
     "contact_loads",
     "kinetic_energy",
     "physical_rates",
     "quasi_static",
     "radial_unit",
+    "skid_equilibrium",
     "state_scales",
     "tangential_unit",
 ]

@@ -82,6 +82,13 @@ def mixture_viscosity(bearing: Bearing) -> Scalar:
     return lub.oil_fraction * lub.viscosity
 
 
+def mixture_kinematic_viscosity(bearing: Bearing) -> Scalar:
+    """nu_mix = eta_mix / rho_mix = eta_0 / rho_oil [m^2/s]: the oil fraction cancels, so it is
+    taken from the oil directly (finite at f_oil = 0, where the mist has no drag at all)."""
+    lub = bearing.lubricant
+    return lub.viscosity / lub.density
+
+
 def _safe_power(x2: ArrayLike, p: float) -> Array:
     """(x2)^p for x2 >= 0 with a zero value *and zero gradient* at x2 = 0 (double `where`).
 
@@ -92,7 +99,7 @@ def _safe_power(x2: ArrayLike, p: float) -> Array:
     return jnp.where(pos, jnp.where(pos, x2, 1.0) ** p, 0.0)
 
 
-def _cylinder_wall_shear(omega, radius, rho, eta) -> Array:
+def _cylinder_wall_shear(omega, radius, rho, eta, nu) -> Array:
     """tau_w = 2 eta omega + 1/2 rho C_f U |U| of a cylinder spinning at omega (signed, along U).
 
     Laminar Couette stress plus Prandtl's turbulent flat-plate law over one circumference
@@ -100,17 +107,17 @@ def _cylinder_wall_shear(omega, radius, rho, eta) -> Array:
     """
     u = omega * radius
     turbulent = (
-        0.5 * rho * _PRANDTL_CF * (eta / (rho * 2 * jnp.pi * radius)) ** 0.2 * _safe_power(u * u, 0.4) * u
+        0.5 * rho * _PRANDTL_CF * (nu / (2 * jnp.pi * radius)) ** 0.2 * _safe_power(u * u, 0.4) * u
     )
     return 2 * eta * omega + turbulent
 
 
-def _cylinder_torque(omega, radius, length, rho, eta) -> Array:
+def _cylinder_torque(omega, radius, length, rho, eta, nu) -> Array:
     """Skin-friction torque tau_w (2 pi R l) R on a spinning cylindrical surface (opposes omega)."""
-    return -_cylinder_wall_shear(omega, radius, rho, eta) * 2 * jnp.pi * radius**2 * length
+    return -_cylinder_wall_shear(omega, radius, rho, eta, nu) * 2 * jnp.pi * radius**2 * length
 
 
-def _disk_torque(omega, outer_radius, inner_radius, rho, eta) -> Array:
+def _disk_torque(omega, outer_radius, inner_radius, rho, eta, nu) -> Array:
     """Torque on an annulus (R_i..R_o) spinning about its axis, both faces (opposes omega).
 
     M = -(32/3 eta (R_o^3 - R_i^3) omega + 0.616 pi rho nu^(1/2) |omega|^(1/2) omega
@@ -118,7 +125,6 @@ def _disk_torque(omega, outer_radius, inner_radius, rho, eta) -> Array:
     difference, an approximation for the creeping term only) plus von Karman's laminar boundary
     layer, which is additive over radius and so exact for the annulus.
     """
-    nu = eta / rho
     creeping = 32.0 / 3.0 * eta * (outer_radius**3 - inner_radius**3) * omega
     boundary_layer = (
         _KARMAN_DISK
@@ -165,6 +171,7 @@ def roller_drag(
     """
     rho = mixture_density(bearing)
     eta = mixture_viscosity(bearing)
+    nu = mixture_kinematic_viscosity(bearing)
     d = bearing.roller.diameter
     length = bearing.roller.length
     v = jnp.asarray(roller_orbital_velocity)
@@ -172,7 +179,7 @@ def roller_drag(
     area = d * length
     if drag_coefficient is None:
         # C_d |v| = |v| + 10 (eta/(rho D))^(2/3) |v|^(1/3)
-        cd_speed = _safe_power(speed2, 0.5) + _WHITE_CD_COEFF * (eta / (rho * d)) ** (
+        cd_speed = _safe_power(speed2, 0.5) + _WHITE_CD_COEFF * (nu / d) ** (
             2.0 / 3.0
         ) * _safe_power(speed2, 1.0 / 6.0)
     else:
@@ -181,8 +188,8 @@ def roller_drag(
 
     omega = jnp.asarray(roller_spin_rate)
     radius = d / 2
-    torque = _cylinder_torque(omega, radius, length, rho, eta) + _disk_torque(
-        omega, radius, jnp.zeros_like(radius), rho, eta
+    torque = _cylinder_torque(omega, radius, length, rho, eta, nu) + _disk_torque(
+        omega, radius, jnp.zeros_like(radius), rho, eta, nu
     )
     return force, torque
 
@@ -196,11 +203,12 @@ def cage_drag_torque(bearing: Bearing, cage_speed: Float[Array, ""]) -> Scalar:
     """
     rho = mixture_density(bearing)
     eta = mixture_viscosity(bearing)
+    nu = mixture_kinematic_viscosity(bearing)
     cage = bearing.cage
     omega = jnp.asarray(cage_speed)
     r_o = cage.outer_diameter / 2
     r_i = cage.inner_diameter / 2
-    faces = _disk_torque(omega, r_o, r_i, rho, eta)
-    bore = _cylinder_torque(omega, r_i, cage.width, rho, eta)
-    outside = _cylinder_torque(omega, r_o, cage.width - 2 * cage.land_width, rho, eta)
+    faces = _disk_torque(omega, r_o, r_i, rho, eta, nu)
+    bore = _cylinder_torque(omega, r_i, cage.width, rho, eta, nu)
+    outside = _cylinder_torque(omega, r_o, cage.width - 2 * cage.land_width, rho, eta, nu)
     return faces + bore + outside

@@ -3,7 +3,8 @@
 - `solve` (pure, jit/vmap/grad-able diffrax integration of the scaled state), `simulate`
   (compiled, with wall times and a `SimulationResult`), `simulation_result`,
   `flange_functionals` (smooth peak PV and contact heights for gradients), `Perturbation`
-  (seeded initial roller scatter), `initial_state`, `smooth_functionals`, `result_code` and
+  (seeded initial roller scatter), `initial_state`, `skid_start` (the speeds of steady running,
+  issue 11; `STARTS`), `smooth_functionals`, `result_code` and
   `RESULT_NAMES` (the outcome code of a solve), `SolveProgress` (the text progress meter);
 - statistics: `contact_events`, `summarise`; of settled running with 95 % confidence
   intervals: `steady_statistics`, `revolution_statistics`, `confidence_intervals`,
@@ -33,7 +34,7 @@ from ._design import (
     seated_perturbation,
 )
 from ._ensemble import parallel_map, simulate_ensemble
-from ._initial import Perturbation, initial_state
+from ._initial import STARTS, Perturbation, SkidStart, initial_state, skid_start
 from ._plots import plot_run
 from ._progress import SolveProgress
 from ._result import (
@@ -67,6 +68,8 @@ from ._step_control import RACEWAY_NORMAL_LOOSEN, RacewayNormalNorm, raceway_nor
 from ._summary import contact_events
 
 __all__ = [
+    "STARTS",
+    "SkidStart",
     "RESULT_NAMES",
     "CACHE_ENV",
     "RACEWAY_NORMAL_LOOSEN",
@@ -97,6 +100,7 @@ __all__ = [
     "flange_functionals",
     "forward_jacobian",
     "initial_state",
+    "skid_start",
     "plot_run",
     "result_code",
     "revolution_statistics",

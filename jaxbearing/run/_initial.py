@@ -1,22 +1,30 @@
 """The initial state of a run: the quasi-static load distribution (`dynamics.quasi_static`) with
 pure-rolling speeds, plus a seeded `Perturbation` of the rollers' axial positions and skew (a
 perfectly symmetric bearing never skews in a deterministic model; real rollers start with
-manufacturing scatter)."""
+manufacturing scatter); or, `skid_start`, the same positions with the speeds of steady running
+(`dynamics.skid_equilibrium`: cage and roller speeds from the skid balance, rollers against the
+pocket side they are pushed to, cage centre at its land equilibrium), solved in one compiled
+call per bearing structure and never inside a vmap over cases."""
 
 from __future__ import annotations
 
 import dataclasses
 
+import equinox as eqx
 import jax
 import jax.numpy as jnp
 
 from ..dynamics import (
     Accumulators,
     CageState,
+    Params,
     RingState,
     RollerState,
+    SkidEquilibrium,
     State,
+    cage_time_constant,
     quasi_static,
+    skid_equilibrium,
     tangential_unit,
 )
 from ..geometry import Bearing, OperatingPoint, kinematic_cage_speed
@@ -29,6 +37,10 @@ class Perturbation:
     seed: int = 0
     axial: float = 0.02e-3  # [m]
     skew: float = 1e-4  # [rad]
+
+
+#: the starts a run may use
+STARTS = ("skid", "quasi-static")
 
 
 def initial_state(bearing: Bearing, op: OperatingPoint, perturbation: Perturbation | None) -> State:
@@ -65,3 +77,45 @@ def initial_state(bearing: Bearing, op: OperatingPoint, perturbation: Perturbati
     zeros = jnp.zeros((z, 4))
     acc = Accumulators(pv_power=zeros, height_max_power=zeros, height_min_power=zeros, contact_time=zeros)
     return State(rollers=rollers, cage=cage, inner_ring=ring, accumulators=acc)
+
+
+class SkidStart(eqx.Module):
+    """The skid start of a run: its state, the equilibrium's residuals, and the time constant
+    [s] of the cage speed's slow approach to steady running (`dynamics.cage_time_constant`)."""
+
+    state: State
+    equilibrium: SkidEquilibrium
+    time_constant: jax.Array
+
+
+def _skid(bearing, op, scatter):
+    pert = None if scatter is None else Perturbation(seed=scatter[0], axial=scatter[1], skew=scatter[2])
+    start = initial_state(bearing, op, pert)
+    params = Params(bearing=bearing, operating=op)
+    eq = skid_equilibrium(start, params, kinematic_cage_speed(bearing, op))
+    return SkidStart(state=eq.state, equilibrium=eq, time_constant=cage_time_constant(eq, params))
+
+
+_COMPILED: dict = {}
+
+
+def skid_start(bearing: Bearing, op: OperatingPoint, perturbation: Perturbation | None) -> SkidStart:
+    """`initial_state`'s positions with the speeds of steady running (module docstring).
+
+    Compiled once per bearing structure (seeds, speeds and loads reuse it); runs outside any
+    vmap (a vmapped bisection costs several times more per case)."""
+    scatter = (
+        None
+        if perturbation is None
+        else (
+            jnp.asarray(perturbation.seed, jnp.int32),
+            jnp.asarray(perturbation.axial, float),
+            jnp.asarray(perturbation.skew, float),
+        )
+    )
+    dyn = (bearing, op, scatter)
+    leaves, treedef = jax.tree_util.tree_flatten(dyn)
+    key = (treedef, tuple((jnp.shape(x), jnp.result_type(x)) for x in leaves))
+    if key not in _COMPILED:
+        _COMPILED[key] = jax.jit(_skid).lower(*dyn).compile()
+    return _COMPILED[key](*dyn)

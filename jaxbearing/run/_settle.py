@@ -11,6 +11,20 @@ measure over a window of whole revolutions (issue 11; docs/model.md 16).
   (relative) between two consecutive revolutions, at most `settle_cap_ms`. `settle=MS` runs a
   fixed MS ms first (declared settled by the user); `settle="off"` measures from the start
   (`settled` is then False: nothing was verified).
+* The start (`start="skid"`, the default): the skid equilibrium (`_initial.skid_start`: cage
+  and roller speeds of steady running, rollers against their pocket walls, cage on its land
+  equilibrium). A static balance cannot know the flange friction of rollers that skew and hit
+  the flanges once running (at the reference point it settles in during the first two
+  revolutions and lowers the cage speed by about 1 %, which the cage then follows with the
+  ~46 ms time constant of its slow mode). The settling phase therefore corrects the slow
+  variable by projective steps (Gear & Kevrekidis 2003, "Projective methods for stiff
+  differential equations", SIAM J. Sci. Comput. 24:1091; the coarse step of equation-free
+  computing): after every two revolutions the drift of the revolution-mean cage speed,
+  d omega/dt, measured by the dynamics themselves, moves the cage speed (and the rollers' orbit
+  and spin in proportion) by tau d omega/dt, tau = `dynamics.cage_time_constant` (the Newton
+  step of the linear slow mode onto its plateau), while the step exceeds `tolerance`; at most
+  `PROJECTIVE_STEPS` times. Settling is then detected as below, on revolutions after the last
+  step only. `start="quasi-static"`: kinematic speeds, no projective steps.
 * The window is `window_revs` further revolutions; its statistics and intervals come from
   `_statistics`. With `seeds = N` the whole run is repeated for N seeded initial scatters
   (`Perturbation.seed` = 0 .. N-1) one after another: on a 2-core CPU one solve already keeps
@@ -32,7 +46,7 @@ from ..dynamics import Functionals, Params, Scaling, State, state_scales
 from ..geometry import Bearing, OperatingPoint, kinematic_cage_speed, rad_s_to_rpm
 from ..io import require
 from ._compile_cache import checks_without_host_callbacks
-from ._initial import Perturbation, initial_state
+from ._initial import STARTS, Perturbation, initial_state, skid_start
 from ._result import result_code
 from ._simulate import SolveArgs, _diffeqsolve, _save
 from ._simulate import simulate as _simulate_fixed
@@ -45,6 +59,10 @@ SETTLE_TOLERANCE = 1e-3  # relative change of the revolution-mean cage speed
 SETTLE_CAP_MS = 300.0
 WINDOW_REVS = 8
 SAVES_PER_REV = 1320  # 5 us at the reference cage speed, as `simulate`'s default 4000 per 20 ms
+#: at most this many projective steps of the cage speed while settling from the skid start
+PROJECTIVE_STEPS = 4
+#: a projective step moves the cage speed by at most this fraction
+PROJECTIVE_CAP = 0.05
 
 
 def solve_from(params: Params, start: State, duration, *, num_saves: int, rtol, atol, max_steps: int):
@@ -101,6 +119,8 @@ class SeedRun:
     revolution_ends: list  # end time of every revolution run [s]
     status: str
     num_steps: int
+    projective_steps_rpm: list = dataclasses.field(default_factory=list)  # cage speed moves
+    start_cage_speed_rpm: float = float("nan")
 
 
 def check_steady_options(settle, window_revs, seeds, tolerance, cap_ms, names=None) -> None:
@@ -142,11 +162,40 @@ def _as_float(name, value):
         ) from None
 
 
-def _run_seed(params, start, *, settle, window_revs, tolerance, cap, rtol, atol, max_steps, saves, progress):
-    """Settle then measure one seed (module docstring)."""
+def _projected(state: State, jump) -> State:
+    """The state with the cage speed moved by `jump` [rad/s] along the slow mode: the rollers'
+    orbit rates move with it and their angular velocities scale in proportion."""
+    ratio = (state.cage.speed + jump) / state.cage.speed
+    rollers = dataclasses.replace(
+        state.rollers,
+        azimuth_rate=state.rollers.azimuth_rate + jump,
+        angular_velocity=state.rollers.angular_velocity * ratio,
+    )
+    cage = dataclasses.replace(state.cage, speed=state.cage.speed + jump)
+    return dataclasses.replace(state, rollers=rollers, cage=cage)
+
+
+def _run_seed(
+    params,
+    start,
+    *,
+    settle,
+    window_revs,
+    tolerance,
+    cap,
+    rtol,
+    atol,
+    max_steps,
+    saves,
+    progress,
+    time_constant=None,
+):
+    """Settle then measure one seed (module docstring); `time_constant` [s] (skid start) turns
+    on the projective steps of the cage speed."""
     compiled = _compiled(params, start, saves, max_steps)
     state, t, steps = start, 0.0, 0
-    speeds, ends, windows, edges = [], [], [], []
+    speeds, ends, windows, edges, jumps = [], [], [], [], []
+    since_jump = 0  # revolutions run since the last projective step
     settled, settle_time, status = settle == "off", 0.0, "ok"
     fixed = None if isinstance(settle, str) else float(settle) * 1e-3
     measuring = settle == "off" or fixed == 0.0
@@ -180,16 +229,29 @@ def _run_seed(params, start, *, settle, window_revs, tolerance, cap, rtol, atol,
                 edges.append(t)
                 break
             continue
+        since_jump += 1
+        if time_constant is not None and since_jump >= 2 and len(jumps) < PROJECTIVE_STEPS:
+            # d omega/dt between the centres of the last two revolutions, in rpm/s
+            drift = (speeds[-1] - speeds[-2]) / (0.5 * (ends[-1] - (ends[-3] if len(ends) > 2 else 0.0)))
+            bound = PROJECTIVE_CAP * abs(speeds[-1])
+            jump = float(np.clip(time_constant * drift, -bound, bound))
+            if abs(jump) > tolerance * abs(speeds[-1]) and (fixed is None or t < fixed - 1e-12):
+                jumps.append(jump)
+                state = _projected(state, jump * math.pi / 30)
+                since_jump = 0
+                if progress:
+                    print(f"  projective step: cage speed {jump:+.2f} rpm", flush=True)
+                continue
         if fixed is not None:
             done = t >= fixed - 1e-12
         else:
-            done = len(speeds) >= 2 and abs(speeds[-1] - speeds[-2]) <= tolerance * abs(speeds[-1])
+            done = since_jump >= 2 and abs(speeds[-1] - speeds[-2]) <= tolerance * abs(speeds[-1])
         if done:
             settled, settle_time, measuring = True, t, True
         elif t >= cap:
             settled, settle_time, measuring = False, t, True
     window = {k: np.concatenate([w[k] for w in windows]) for k in windows[0]} if windows else {}
-    return window, np.asarray(edges), settle_time, settled, speeds, ends, status, steps
+    return window, np.asarray(edges), settle_time, settled, speeds, ends, status, steps, jumps
 
 
 @dataclasses.dataclass
@@ -234,7 +296,7 @@ def simulate_steady(
     seeds: int = 1,
     tolerance: float = SETTLE_TOLERANCE,
     settle_cap_ms: float = SETTLE_CAP_MS,
-    start: str = "quasi-static",
+    start: str = "skid",
     rtol: float = 1e-3,
     atol: float = 1e-6,
     max_steps: int = 2_000_000,
@@ -244,20 +306,25 @@ def simulate_steady(
     progress: bool = False,
 ) -> SteadyResult:
     """Settle (module docstring), then measure `window_revs` cage revolutions, for each of
-    `seeds` seeded initial scatters, each from the quasi-static start of `simulate` (kinematic
-    speeds; `start`, reserved for the skid start of issue 11, which is not finished)."""
+    `seeds` seeded initial scatters, each from `start`: "skid" (default; the skid equilibrium and
+    projective steps of the cage speed while settling) or "quasi-static" (kinematic speeds)."""
     from ..io import validate_bearing
 
     validate_bearing(bearing, op)
     check_steady_options(settle, window_revs, seeds, tolerance, settle_cap_ms)
-    if start != "quasi-static":
+    if start not in STARTS:
         from .._errors import UserInputError
 
-        raise UserInputError(f'start = {start!r}: must be "quasi-static" (the skid start is not finished)')
+        raise UserInputError(f"start = {start!r}: must be one of {', '.join(map(repr, STARTS))}")
     params = Params(bearing=bearing, operating=op, functionals=functionals)
     runs, wall0, compile_time = [], time.perf_counter(), 0.0
     for seed in range(int(seeds)):
-        y0 = initial_state(bearing, op, dataclasses.replace(perturbation, seed=perturbation.seed + seed))
+        pert = dataclasses.replace(perturbation, seed=perturbation.seed + seed)
+        if start == "skid":  # its compilation and solve count in the wall time
+            skid = skid_start(bearing, op, pert)
+            y0, tau = skid.state, float(skid.time_constant)
+        else:
+            y0, tau = initial_state(bearing, op, pert), None
         c0 = time.perf_counter()
         _compiled(params, y0, int(saves_per_rev), int(max_steps))
         compile_time += time.perf_counter() - c0
@@ -275,8 +342,11 @@ def simulate_steady(
             max_steps=int(max_steps),
             saves=int(saves_per_rev),
             progress=progress,
+            time_constant=tau,
         )
-        runs.append(SeedRun(perturbation.seed + seed, *out))
+        runs.append(
+            SeedRun(perturbation.seed + seed, *out, start_cage_speed_rpm=float(rad_s_to_rpm(y0.cage.speed)))
+        )
     wall = time.perf_counter() - wall0 - compile_time
     return SteadyResult(
         runs=runs,
@@ -320,6 +390,8 @@ def summarise_steady(result: SteadyResult, threshold: float = 1.0) -> dict:
                 "num_steps": r.num_steps,
                 "revolution_end_ms": [t * 1e3 for t in r.revolution_ends],
                 "revolution_cage_speed_rpm": r.revolution_speeds_rpm,
+                "start_cage_speed_rpm": r.start_cage_speed_rpm,
+                "projective_steps_rpm": r.projective_steps_rpm,
             }
             for r in runs
         ],
