@@ -106,9 +106,7 @@ def _cylinder_wall_shear(omega, radius, rho, eta, nu) -> Array:
     (see the module docstring); C_f U^2 = 0.074 (eta / (rho 2 pi R))^(1/5) |U|^(4/5) U.
     """
     u = omega * radius
-    turbulent = (
-        0.5 * rho * _PRANDTL_CF * (nu / (2 * jnp.pi * radius)) ** 0.2 * _safe_power(u * u, 0.4) * u
-    )
+    turbulent = 0.5 * rho * _PRANDTL_CF * (nu / (2 * jnp.pi * radius)) ** 0.2 * _safe_power(u * u, 0.4) * u
     return 2 * eta * omega + turbulent
 
 
@@ -179,9 +177,9 @@ def roller_drag(
     area = d * length
     if drag_coefficient is None:
         # C_d |v| = |v| + 10 (eta/(rho D))^(2/3) |v|^(1/3)
-        cd_speed = _safe_power(speed2, 0.5) + _WHITE_CD_COEFF * (nu / d) ** (
-            2.0 / 3.0
-        ) * _safe_power(speed2, 1.0 / 6.0)
+        cd_speed = _safe_power(speed2, 0.5) + _WHITE_CD_COEFF * (nu / d) ** (2.0 / 3.0) * _safe_power(
+            speed2, 1.0 / 6.0
+        )
     else:
         cd_speed = drag_coefficient * _safe_power(speed2, 0.5)
     force = -0.5 * rho * area * cd_speed * v
