@@ -27,14 +27,19 @@ Hence d_plane - d_cone = g e(Q) with
 
 s_c = rho sin(psi) the circumferential offset of Q from the roller's azimuth plane. At the
 contact point this is `face_error` = sin(theta_f) (rho_C - (C - c_r) . e_rad), computed from the
-exact position. For the interference delta = max over the end body of d: on the inner ring
-(g = +1) d_plane >= d_cone everywhere, so 0 <= delta_plane - delta_cone <= e(C) with C the
-plane's contact point (delta_cone >= d_cone(C) = d_plane(C) - e(C)); on the outer ring (g = -1)
-0 <= delta_cone - delta_plane <= e(C*) at the cone's contact point C*, which lies within the
-end's curvature radius times the normal's turn sin(theta_f) |psi| of C (e(C*) = e(C) to first
-order). Reference bearing: rho ~ 40 mm, theta_f = 1.6 deg gives e = 0.35 um at s_c = 1 mm and
-3.1 um at 3 mm (tests/test_flange_lubrication.py checks the identity and the bound against an
-independent cone distance).
+exact position. For the interference delta = max over the end body of d: the end surface is
+(locally) a union of balls, the sphere of radius R_end centred at O on the arc, the balls of
+radius R_cor centred on the corner circle on the corner, and along the normal ray from a ball
+centre Q either distance grows at exactly unit rate (the ray stays in Q's meridian half-plane,
+where the cone is a straight line), so delta = max_Q d(Q) + R. Hence on the arc (while the
+cone's contact stays on the cap) delta_plane - delta_cone = g e(O) EXACTLY, O = C - R_end n,
+and e(O)/e(C) = rho_C (1 + cos psi_C) / (rho_O (1 + cos psi_O)) ~ 1 -/+ R_end sin(theta_f)/rho
+(within 6 % on the reference bearing, the offsets s_c of O and C being equal since n has no
+circumferential component). On the corner, 0 <= g (delta_plane - delta_cone) <= e(Q) with Q the
+plane's ball centre (g = +1) or the cone's (g = -1), both within R_cor of C. Reference bearing:
+rho ~ 40 mm, theta_f = 1.6 deg gives e ~ 0.35 um at s_c = 1 mm and 2.7 um at 2.8 mm (a skew
+of 60 mrad, the largest offset of the corner circle); tests/test_flange_lubrication.py checks
+the identity at C and the interference against an independently maximised cone distance.
 """
 
 from __future__ import annotations
