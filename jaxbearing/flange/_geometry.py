@@ -7,7 +7,7 @@ above the raceway, its position on the end face and the principal radii of the a
 surface. It is shared by the dynamic contact (`roller_flange_contact`) and the static design
 zone (`design_zone`).
 
-Error of the tangent plane (docs/model.md 5.5). Write a point Q in cylindrical coordinates
+Error of the tangent plane (docs/model.md 5.2). Write a point Q in cylindrical coordinates
 about the ring axis: axial x, radius rho, azimuth psi measured from the roller's azimuth e_rad.
 The tangent plane at the roller's azimuth gives the signed distance into the flange
 

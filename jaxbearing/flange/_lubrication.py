@@ -1,5 +1,5 @@
 """Lubrication of the roller-end/flange contact: entrainment, EHL film, film parameter and the
-friction coefficient (docs/model.md 5.4; the laws are `jaxbearing.contact`'s `_film`).
+friction coefficient (docs/model.md 5.1; the laws are `jaxbearing.contact`'s `_film`).
 
 Kinematics. Hamrock & Dowson's film depends on the mean entrainment velocity of the two surfaces
 RELATIVE TO THE CONTACT (1977; Hamrock, Schmid & Jacobson, Fundamentals of Fluid Film

@@ -142,7 +142,7 @@ class Bearing(eqx.Module):
     num_rollers: int = eqx.field(static=True)  # Z
     num_slices: int = eqx.field(static=True, default=31)  # N_s (odd)
     #: roller-end/flange friction law (static: it selects the compiled law): "dry" = constant
-    #: `flange_traction`; "mixed" = film-dependent mixed-lubrication traction (docs/model.md 5)
+    #: `flange_traction`; "mixed" = film-dependent mixed-lubrication traction (docs/model.md 5.1)
     flange_lubrication: str = eqx.field(static=True, default="dry")
 
     # -- derived geometry ----------------------------------------------------------------

@@ -268,7 +268,7 @@ KEYS: tuple[Key, ...] = (
         attr="flange_lubrication",
         note=(
             "dry = constant flange_traction (the source paper); mixed = film-dependent "
-            "mixed-lubrication traction from the Hamrock-Dowson film (docs/model.md 5.4)"
+            "mixed-lubrication traction from the Hamrock-Dowson film (docs/model.md 5.1)"
         ),
     ),
     make_key(

@@ -12,7 +12,7 @@ with normal force above `threshold`: the minimum film h_min (min, p05, median), 
 (share of contact time with Lambda < 1, boundary lubrication), `top_edge_contact_share` (share
 of contact time with the contact point above the flange height: computed on a flange that is
 not there) and the largest tangent-plane error at a contact, `flange_face_error_max_m`
-(docs/model.md 5.5). Histories without these keys (older runs) give None.
+(docs/model.md 5.2). Histories without these keys (older runs) give None.
 """
 
 from __future__ import annotations
