@@ -53,8 +53,16 @@ def test_both_ends_write_summary_histories_plots(both_run, capsys):
             assert key in block
         for key in SUMMARY_STATS:
             assert set(block[key]) == {"max", "mean", "median", "min"}
+        # lubricated flange contact (issue 14): film statistics over contact time
+        assert set(block["film_parameter"]) == {"mean", "median", "p05", "min"}
+        assert set(block["flange_min_film_m"]) == {"min", "p05", "median"}
+        assert block["flange_min_film_m"]["min"] > 0 and block["film_parameter"]["p05"] > 0
+        for key in ("lambda_below_one_share", "top_edge_contact_share"):
+            assert 0.0 <= block[key] <= 1.0
         h = np.load(out / f"histories_{end}.npz")
         assert h["flange_force"].shape[1:] == (26, 4)
+        for key in ("flange_min_film", "flange_central_film", "flange_film_parameter", "flange_top_edge"):
+            assert h[key].shape == h["flange_force"].shape
     for png in ("flange_boxplots.png", "contact_positions.png", "cage_speed.png"):
         assert (out / png).stat().st_size > 10_000
     # arc ends press less on the flange than corners (the paper's headline result)

@@ -132,6 +132,8 @@ FIELD_KEYS = [k for k in KEYS if k.attr is not None]
 def _config_value_invalid(key):
     """Invalid values of one key in its configuration unit, with the reference values for the
     keys its range depends on."""
+    if key.kind is str:  # a choice: anything else
+        return st.text(max_size=8).filter(lambda v: v not in key.choices)
     if key.kind is int:
         options = [st.integers(min_value=-1000, max_value=int(key.lo.value(REFERENCE_VALUES)) - 1)]
         if key.hi is not None:
@@ -158,7 +160,7 @@ def _with_value(bearing, op, key, value):
     si = value if key.kind is int else key.to_si(value)
     if key.attr.startswith("op."):
         return bearing, eqx.tree_at(lambda o: getattr(o, key.attr[3:]), op, si)
-    if key.kind is int:
+    if key.kind in (int, str):  # static fields
         return dataclasses.replace(bearing, **{key.attr: si}), op
     parts = key.attr.split(".")
 

@@ -99,6 +99,7 @@ BAD_SPECS = [
     ('"operating.speed_rpm" = [-100.0]', "operating.speed_rpm", "out of range"),
     ('"bearing.num_rollers" = [20, 26]', "bearing.num_rollers", "changes array shapes"),
     ('"simulation.max_steps" = [10, 20]', "simulation.max_steps", "static"),
+    ('"bearing.flange_lubrication" = ["dry", "mixed"]', "bearing.flange_lubrication", "static"),
     ('end = ["arc", "flat"]', "end", "not a roller end type"),
     ('"operating.speed_rpm" = [1e4, 1e4]', "operating.speed_rpm", "appears twice"),
 ]

@@ -54,7 +54,8 @@ FLOAT_KEYS = [k for k in KEYS if k.kind is float]
 INT_KEYS = [k for k in KEYS if k.kind is int]
 BOOL_KEYS = [k for k in KEYS if k.kind is bool]
 #: float keys where a negative value is physically meaningful (written out by hand, not read
-#: from the schema): Poisson ratio of auxetic materials and the traction curve coefficients.
+#: from the schema): Poisson ratio of auxetic materials, the traction curve coefficients and
+#: temperatures in C.
 NEGATIVE_OK = {
     "materials.ring.poisson_ratio",
     "materials.roller.poisson_ratio",
@@ -62,6 +63,8 @@ NEGATIVE_OK = {
     "lubricant.traction_a",
     "lubricant.traction_b_s_m",
     "lubricant.traction_d",
+    "lubricant.reference_temperature_C",
+    "lubricant.inlet_temperature_C",
 }
 
 

@@ -168,7 +168,23 @@ def format_table(summaries: dict) -> str:
             f"(kinematic {s['kinematic_cage_speed_rpm']:.1f}, slip {s['cage_slip']:.2%}); "
             f"{s['num_steps']} steps, wall {s['wall_time_s']:.1f} s (+ compile {s['compile_time_s']:.1f} s)"
         )
+        lines.append(_film_line(e, s))
     return "\n".join(lines)
+
+
+def _film_line(end: str, s: dict) -> str:
+    """One line of film statistics over contact time (`jaxbearing.run.film_statistics`)."""
+
+    def num(v, k=1.0, fmt=".3g"):
+        return "-" if v is None or not math.isfinite(v) else format(v * k, fmt)
+
+    film, lam = s.get("flange_min_film_m", {}), s.get("film_parameter", {})
+    return (
+        f"[{end}] flange film: h_min min {num(film.get('min'), 1e6)} um; Lambda median "
+        f"{num(lam.get('median'))}, p05 {num(lam.get('p05'))}; Lambda < 1 "
+        f"{num(s.get('lambda_below_one_share'), 100, '.1f')} % of contact time; top-edge contact "
+        f"{num(s.get('top_edge_contact_share'), 100, '.1f')} %"
+    )
 
 
 def write_outputs(out_dir: pathlib.Path, results: dict) -> None:

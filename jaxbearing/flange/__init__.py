@@ -4,6 +4,8 @@
   azimuth, extreme point of the end body, interference, contact height, principal radii);
 - the contact: `roller_flange_contact` (one roller, one flange), `all_flange_contacts` (every
   roller against the four flanges, shape (Z, 4)), `FlangeContact`;
+- its lubrication: `contact_point_velocity`, `flange_film` (entrainment, Hamrock-Dowson film,
+  Lambda), `FlangeFilm`, `flange_friction_coefficient` (dry or mixed, `FLANGE_LUBRICATION_MODES`);
 - the static design zone of an aligned roller: `design_zone`, `design_zone_grid`, `DesignZone`,
   `zone_margins`, `MARGIN_NAMES`;
 - the design variables R_end, theta_f, Delta_bf: `DesignVariables`, `with_design`, and the one
@@ -19,21 +21,33 @@ from ._checks import DEFAULT_FLANGE_LOAD, check_design
 from ._contact import FLANGE_ORDER, FlangeContact, all_flange_contacts, roller_flange_contact
 from ._design import DesignVariables, with_design
 from ._geometry import FlangeGeometry, flange_effective_modulus, flange_geometry
+from ._lubrication import (
+    FLANGE_LUBRICATION_MODES,
+    FlangeFilm,
+    contact_point_velocity,
+    flange_film,
+    flange_friction_coefficient,
+)
 from ._zone import MARGIN_NAMES, DesignZone, design_zone, design_zone_grid, zone_margins
 
 __all__ = [
     "DEFAULT_FLANGE_LOAD",
+    "FLANGE_LUBRICATION_MODES",
     "FLANGE_ORDER",
     "MARGIN_NAMES",
     "DesignVariables",
     "DesignZone",
     "FlangeContact",
+    "FlangeFilm",
     "FlangeGeometry",
     "all_flange_contacts",
     "check_design",
+    "contact_point_velocity",
     "design_zone",
     "design_zone_grid",
     "flange_effective_modulus",
+    "flange_film",
+    "flange_friction_coefficient",
     "flange_geometry",
     "roller_flange_contact",
     "with_design",

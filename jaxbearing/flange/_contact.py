@@ -61,6 +61,7 @@ from ..contact import (
 )
 from ..geometry import Bearing
 from ._geometry import flange_effective_modulus, flange_geometry
+from ._lubrication import contact_point_velocity, flange_film, flange_friction_coefficient
 
 Scalar = Float[Array, ""]
 Vec3 = Float[Array, "3"]
@@ -94,6 +95,13 @@ class FlangeContact(eqx.Module):
     force_on_ring: Float[Array, "*batch 3"]  # -F
     moment_on_ring: Float[Array, "*batch 3"]  # (C - c_r) x (-F)
     ellipse_semi_axes: Float[Array, "*batch 2"]  # (along t / the end meridian, along the parallel)
+    entrainment_speed: Float[Array, "*batch"]  # |u_e|, mean surface speed relative to C
+    min_film: Float[Array, "*batch"]  # h_min, Hamrock-Dowson minimum film [m]
+    central_film: Float[Array, "*batch"]  # h_c, Hamrock-Dowson central film [m]
+    film_parameter: Float[Array, "*batch"]  # Lambda = h_min / sigma
+    friction_coefficient: Float[Array, "*batch"]  # mu of the friction force (dry or mixed)
+    top_edge: Float[Array, "*batch"]  # 1 where C lies above the flange height H_rf, else 0
+    face_error: Float[Array, "*batch"]  # tangent-plane error at C, sin(theta_f) rho (1 - cos psi)
 
 
 def roller_flange_contact(
@@ -130,7 +138,17 @@ def roller_flange_contact(
     `jaxbearing.contact`): principal radii R_end, R_end on the arc; R_cor across the corner and
     rho_c / sin(alpha) along it on the corner torus, blended C1 across the limited circle
     (`end_principal_curvatures`). Q = K delta^1.5 (softplus of width PENETRATION_WIDTH),
-    p_max = 3Q/(2 pi a b), friction F_t = -mu_f Q u / sqrt(|u|^2 + u_eps^2), PV = p_max |u|.
+    p_max = 3Q/(2 pi a b), friction F_t = -mu Q u / sqrt(|u|^2 + u_eps^2), PV = p_max |u|.
+
+    Lubrication (`_lubrication`): entrainment velocity u_e = P_t((v_1(C) + v_2(C))/2 - v_C)
+    with the contact point's velocity v_C = v + Omega X x (C - p) (Omega: the roller's azimuth
+    rate), Hamrock-Dowson h_min and h_c with the end's principal radii along and across u_e,
+    Lambda = h_min / sigma. mu = mu_f (`bearing.flange_lubrication == "dry"`, the default) or
+    the mixed law f_a(Lambda) mu_f + (1 - f_a) kappa(|u|) ("mixed").
+
+    Top edge: `top_edge` = 1 where the exact radial height of C above the raceway,
+    g(|C - c_r|_YZ - R_r), exceeds the flange height H_rf: the contact is then computed on the
+    plane continued beyond a flange that is not there (reported, not corrected).
 
     Forces: on the roller F = -Q n + F_t with moment (C - p) x F about its centre; on the ring
     -F with moment (C - c_r) x (-F) about the ring centre.
@@ -163,7 +181,10 @@ def roller_flange_contact(
     p_max = point_contact_peak_pressure(q, g.radius_meridian, g.radius_parallel, e_prime)
     semi = jnp.stack(point_contact_ellipse(q, g.radius_meridian, g.radius_parallel, e_prime))
 
-    f_t = -bearing.flange_traction * q * smooth_direction(u, SLIDING_EPS)
+    v_c = contact_point_velocity(p, roller_velocity, c_r, ring_velocity, c)
+    film = flange_film(bearing, g, q, v_roller, v_ring, v_c, e_prime)
+    mu = flange_friction_coefficient(bearing, film.film_parameter, u)
+    f_t = -mu * q * smooth_direction(u, SLIDING_EPS)
     force = -q * n + f_t
     return FlangeContact(
         interference=g.interference,
@@ -184,6 +205,13 @@ def roller_flange_contact(
         force_on_ring=-force,
         moment_on_ring=jnp.cross(c - c_r, -force),
         ellipse_semi_axes=semi,
+        entrainment_speed=film.entrainment_speed,
+        min_film=film.min_film,
+        central_film=film.central_film,
+        film_parameter=film.film_parameter,
+        friction_coefficient=mu,
+        top_edge=jnp.where(g.cone_height > bearing.flange.height, 1.0, 0.0),
+        face_error=g.face_error,
     )
 
 

@@ -6,6 +6,40 @@
 above the raceway, its position on the end face and the principal radii of the active end
 surface. It is shared by the dynamic contact (`roller_flange_contact`) and the static design
 zone (`design_zone`).
+
+Error of the tangent plane (docs/model.md 5.2). Write a point Q in cylindrical coordinates
+about the ring axis: axial x, radius rho, azimuth psi measured from the roller's azimuth e_rad.
+The tangent plane at the roller's azimuth gives the signed distance into the flange
+
+    d_plane(Q) = s cos(theta_f) (x - s W_r/2) - g sin(theta_f) (rho cos(psi) - R_r),
+
+while the flange cone itself, a surface of revolution whose generator in the meridian half-plane
+through Q is a straight line with unit normal (s cos(theta_f), -g sin(theta_f)) in (x, rho),
+gives EXACTLY (distance to a line in that half-plane, valid while the foot of the perpendicular
+lies on the face)
+
+    d_cone(Q)  = s cos(theta_f) (x - s W_r/2) - g sin(theta_f) (rho - R_r).
+
+Hence d_plane - d_cone = g e(Q) with
+
+    e(Q) = sin(theta_f) rho (1 - cos(psi)) = sin(theta_f) s_c^2 / (rho (1 + cos(psi)))
+         <= sin(theta_f) s_c^2 / rho     (|psi| <= pi/2),   ~ sin(theta_f) s_c^2 / (2 rho),
+
+s_c = rho sin(psi) the circumferential offset of Q from the roller's azimuth plane. At the
+contact point this is `face_error` = sin(theta_f) (rho_C - (C - c_r) . e_rad), computed from the
+exact position. For the interference delta = max over the end body of d: the end surface is
+(locally) a union of balls, the sphere of radius R_end centred at O on the arc, the balls of
+radius R_cor centred on the corner circle on the corner, and along the normal ray from a ball
+centre Q either distance grows at exactly unit rate (the ray stays in Q's meridian half-plane,
+where the cone is a straight line), so delta = max_Q d(Q) + R. Hence on the arc (while the
+cone's contact stays on the cap) delta_plane - delta_cone = g e(O) EXACTLY, O = C - R_end n,
+and e(O)/e(C) = rho_C (1 + cos psi_C) / (rho_O (1 + cos psi_O)) ~ 1 -/+ R_end sin(theta_f)/rho
+(within 6 % on the reference bearing, the offsets s_c of O and C being equal since n has no
+circumferential component). On the corner, 0 <= g (delta_plane - delta_cone) <= e(Q) with Q the
+plane's ball centre (g = +1) or the cone's (g = -1), both within R_cor of C. Reference bearing:
+rho ~ 40 mm, theta_f = 1.6 deg gives e ~ 0.35 um at s_c = 1 mm and 2.7 um at 2.8 mm (a skew
+of 60 mrad, the largest offset of the corner circle); tests/test_flange_lubrication.py checks
+the identity at C and the interference against an independently maximised cone distance.
 """
 
 from __future__ import annotations
@@ -36,6 +70,10 @@ class FlangeGeometry(eqx.Module):
     on_arc: Scalar
     radius_meridian: Scalar  # principal radius of the end across the corner / along t
     radius_parallel: Scalar  # principal radius along the parallel circle
+    meridian_direction: Vec3  # unit tangent of the end's meridian at C (0 if alpha = 0)
+    circumferential_offset: Scalar  # s_c = (C - c_r) . e_tan, offset of C from the azimuth plane
+    face_error: Scalar  # e = sin(theta_f) (rho_C - (C - c_r) . e_rad) >= 0 (module docstring)
+    cone_height: Scalar  # g (rho_C - R_r): exact radial height of C above the raceway
 
 
 def unit(x: Array) -> Array:
@@ -79,6 +117,14 @@ def flange_geometry(
     y_loc = jnp.cross(z_loc, x_end)
     yz = jnp.stack([jnp.dot(offset, y_loc), jnp.dot(offset, z_loc)])
     k_m, k_p, w = end_principal_curvatures(roller, sin_a)
+    # meridian tangent at C: the end surface's normal there is n, its parallel circle runs
+    # along x_end x r_hat (perpendicular to n), the meridian along n x (x_end x r_hat)
+    meridian = jnp.cross(n, jnp.cross(x_end, r_hat))
+    # exact cylindrical position of C about the ring axis (tangent-plane error, top edge)
+    rel = (c - c_r) * jnp.array([0.0, 1.0, 1.0])
+    rho_c = safe_norm(rel)
+    along = jnp.dot(rel, e_rad)
+    e_tan = jnp.cross(_AXIS, e_rad)
     return FlangeGeometry(
         normal=n,
         interference=delta,
@@ -89,6 +135,10 @@ def flange_geometry(
         on_arc=w,
         radius_meridian=1.0 / k_m,
         radius_parallel=1.0 / k_p,
+        meridian_direction=meridian,
+        circumferential_offset=jnp.dot(rel, e_tan),
+        face_error=jnp.sin(theta) * (rho_c - along),
+        cone_height=ring_sign * (rho_c - raceway_radius),
     )
 
 

@@ -78,6 +78,8 @@ class Flange(eqx.Module):
     contact_height_limit: Scalar = _field()  # h_up, upper limit of the contact height
     layback_angle: Scalar = _field()  # theta_f [rad]
     axial_clearance: Scalar = _field()  # Delta_bf = flange spacing - L_b1
+    # sigma = sqrt(s_end^2 + s_flange^2), composite rms roughness of roller end and flange [m]
+    roughness: Scalar = eqx.field(converter=_f, default=0.2e-6)
 
 
 class Cage(eqx.Module):
@@ -103,9 +105,10 @@ class Lubricant(eqx.Module):
     """Lubricant, oil-air mixture in the cavity, and the traction curve of rolling contacts.
 
     Traction curve (MODEL.md 4.2): kappa(du) = (A + B du) exp(-C du) + D, with kappa(0) = A + D.
+    Viscosity at the flange inlet: eta_0 exp(-beta_T (T_in - T_0)) (`contact.viscosity_at_temperature`).
     """
 
-    viscosity: Scalar = _field()  # eta_0 [Pa s]
+    viscosity: Scalar = _field()  # eta_0 [Pa s] at reference_temperature
     pressure_viscosity: Scalar = _field()  # alpha_p [1/Pa]
     temperature_viscosity: Scalar = _field()  # beta_T [1/K]
     density: Scalar = _field()  # rho_oil [kg/m^3]
@@ -114,6 +117,8 @@ class Lubricant(eqx.Module):
     traction_b: Scalar = _field()  # B [s/m]
     traction_c: Scalar = _field()  # C [s/m]
     traction_d: Scalar = _field()  # D [-]
+    reference_temperature: Scalar = eqx.field(converter=_f, default=80.0)  # T_0 of eta_0 [C]
+    inlet_temperature: Scalar = eqx.field(converter=_f, default=80.0)  # T_in at the flange [C]
 
 
 class Bearing(eqx.Module):
@@ -136,6 +141,9 @@ class Bearing(eqx.Module):
     lubricant: Lubricant
     num_rollers: int = eqx.field(static=True)  # Z
     num_slices: int = eqx.field(static=True, default=31)  # N_s (odd)
+    #: roller-end/flange friction law (static: it selects the compiled law): "dry" = constant
+    #: `flange_traction`; "mixed" = film-dependent mixed-lubrication traction (docs/model.md 5.1)
+    flange_lubrication: str = eqx.field(static=True, default="dry")
 
     # -- derived geometry ----------------------------------------------------------------
     @property

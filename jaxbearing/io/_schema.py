@@ -24,6 +24,7 @@ Schema (ranges; "(" open, "[" closed; symbols as in docs/MODEL.md and the source
 | bearing.num_slices | N_s | odd integer in [3, 200] |
 | bearing.inner_ring_mass_kg | m_i | (0, 1e5] |
 | bearing.flange_traction, pocket_friction | mu_f, mu_p | [0, 1] |
+| bearing.flange_lubrication | | "dry" (constant mu_f) or "mixed" (film-dependent) |
 | roller.diameter_mm | D | (0, pitch_diameter_mm/2) |
 | roller.corner_radius_mm | R_cor | (0, diameter_mm/2) |
 | roller.length_mm | L_b1 | (2 corner_radius_mm, 10 diameter_mm] |
@@ -35,6 +36,7 @@ Schema (ranges; "(" open, "[" closed; symbols as in docs/MODEL.md and the source
 | flange.contact_height_limit_mm | h_up | (relief_height_mm, height_mm] |
 | flange.layback_angle_deg | theta_f | (0, 10] |
 | flange.axial_clearance_mm | Delta_bf | [0, length_mm) |
+| flange.roughness_um | sigma (composite rms, end and flange) | [0, 10] |
 | cage.inner_diameter_mm | | (inner raceway diameter, pitch_diameter_mm) |
 | cage.outer_diameter_mm | | (pitch_diameter_mm, outer raceway diameter - guiding_clearance_mm] |
 | cage.width_mm | | (length_mm + pocket_clearance_mm, 3 length_mm] |
@@ -46,6 +48,7 @@ Schema (ranges; "(" open, "[" closed; symbols as in docs/MODEL.md and the source
 | lubricant.viscosity_Pa_s | eta_0 | (0, 100] |
 | lubricant.pressure_viscosity_1_Pa | alpha_p | [0, 1e-6] |
 | lubricant.temperature_viscosity_1_C | beta_T | [0, 1] |
+| lubricant.reference_temperature_C, inlet_temperature_C | T_0, T_in | [-60, 300] |
 | lubricant.density_kg_m3 | rho_oil | (0, 2000] |
 | lubricant.oil_fraction | f_oil | [0, 1] |
 | lubricant.traction_a, traction_d | A, D | [-1, 1] |
@@ -255,6 +258,20 @@ KEYS: tuple[Key, ...] = (
         attr="flange_traction",
     ),
     make_key(
+        "bearing.flange_lubrication",
+        str,
+        "dry",
+        "",
+        "",
+        "roller-flange friction law",
+        choices=("dry", "mixed"),
+        attr="flange_lubrication",
+        note=(
+            "dry = constant flange_traction (the source paper); mixed = film-dependent "
+            "mixed-lubrication traction from the Hamrock-Dowson film (docs/model.md 5.1)"
+        ),
+    ),
+    make_key(
         "bearing.pocket_friction",
         float,
         0.10,
@@ -393,6 +410,18 @@ KEYS: tuple[Key, ...] = (
         relative_bound("length_mm", (_L,), lambda lb: lb, False),
         attr="flange.axial_clearance",
     ),
+    make_key(
+        "flange.roughness_um",
+        float,
+        0.2,
+        "um",
+        "sigma",
+        "composite rms roughness of roller end and flange face",
+        constant_bound(0, True),
+        constant_bound(10, True),
+        attr="flange.roughness",
+        note="sigma = sqrt(s_end^2 + s_flange^2); 0.2 um: ground end and flange",
+    ),
     # [cage]
     make_key(
         "cage.inner_diameter_mm",
@@ -478,7 +507,7 @@ KEYS: tuple[Key, ...] = (
         0.055,
         "Pa s",
         "eta_0",
-        "dynamic viscosity at the operating temperature",
+        "dynamic viscosity at reference_temperature_C",
         constant_bound(0, False),
         constant_bound(100, True),
         attr="lubricant.viscosity",
@@ -504,6 +533,29 @@ KEYS: tuple[Key, ...] = (
         constant_bound(0, True),
         constant_bound(1, True),
         attr="lubricant.temperature_viscosity",
+    ),
+    make_key(
+        "lubricant.reference_temperature_C",
+        float,
+        80.0,
+        "C",
+        "T_0",
+        "temperature at which viscosity_Pa_s is given",
+        constant_bound(-60, True),
+        constant_bound(300, True),
+        attr="lubricant.reference_temperature",
+    ),
+    make_key(
+        "lubricant.inlet_temperature_C",
+        float,
+        80.0,
+        "C",
+        "T_in",
+        "oil temperature at the roller-flange contact inlet",
+        constant_bound(-60, True),
+        constant_bound(300, True),
+        attr="lubricant.inlet_temperature",
+        note="eta = viscosity_Pa_s exp(-temperature_viscosity_1_C (T_in - T_0)) in the flange film",
     ),
     make_key(
         "lubricant.density_kg_m3",

@@ -140,14 +140,15 @@ def validate_bearing(bearing, op=None, *, traced: str = "error") -> None:
     # a key is checked when neither it nor a key its range reads is traced
     keys = [k for k in keys if k.path not in skipped]
     checked = [k.path for k in keys if not set(k.deps) & skipped]
-    arrays = {k.path: np.asarray(leaves[k.path]) for k in keys if k.kind is not int}
+    # counts and choices (static pytree fields) are one Python value for the whole batch
+    arrays = {k.path: np.asarray(leaves[k.path]) for k in keys if k.kind not in (int, str)}
     shape = np.broadcast_shapes(*(a.shape for a in arrays.values())) if arrays else ()
     if op is not None and not _traced(op.gravity):
         _check_gravity(np.broadcast_to(np.asarray(op.gravity, dtype=float), shape), shape)
     for idx in np.ndindex(shape):
         values = dict(REFERENCE_VALUES)
         for k in keys:
-            if k.kind is int:
+            if k.kind in (int, str):
                 values[k.path] = coerce(k, leaves[k.path])
             elif k.kind is bool:  # gravity
                 values[k.path] = bool(np.broadcast_to(arrays[k.path], shape)[idx] > 0)

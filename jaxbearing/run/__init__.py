@@ -6,7 +6,8 @@
   (seeded initial roller scatter), `initial_state`, `skid_start` (the speeds of steady running,
   issue 11; `STARTS`), `smooth_functionals`, `result_code` and
   `RESULT_NAMES` (the outcome code of a solve), `SolveProgress` (the text progress meter);
-- statistics: `contact_events`, `summarise`; of settled running with 95 % confidence
+- statistics: `contact_events`, `summarise`, `film_statistics` (film over contact time,
+  `FILM_KEYS`); of settled running with 95 % confidence
   intervals: `steady_statistics`, `revolution_statistics`, `confidence_intervals`,
   `batch_means`, `student_t_interval`, `Estimate`;
 - settled running: `simulate_steady` (settling detection over cage revolutions, a window,
@@ -65,11 +66,12 @@ from ._statistics import (
     student_t_interval,
 )
 from ._step_control import RACEWAY_NORMAL_LOOSEN, RacewayNormalNorm, raceway_normal_norm
-from ._summary import contact_events
+from ._summary import FILM_KEYS, contact_events, film_statistics
 
 __all__ = [
     "STARTS",
     "SkidStart",
+    "FILM_KEYS",
     "RESULT_NAMES",
     "CACHE_ENV",
     "RACEWAY_NORMAL_LOOSEN",
@@ -95,6 +97,7 @@ __all__ = [
     "check_steady_options",
     "confidence_intervals",
     "contact_events",
+    "film_statistics",
     "design_jacobian",
     "design_metrics",
     "flange_functionals",

@@ -38,7 +38,7 @@ import numpy as np
 from scipy import stats as _sp_stats
 
 from ..geometry import kinematic_cage_speed, limited_circle_radius, rad_s_to_rpm
-from ._summary import _EVENT_QUANTITIES, contact_events
+from ._summary import _EVENT_QUANTITIES, FILM_KEYS, contact_events, film_statistics
 
 CONFIDENCE = 0.95
 
@@ -136,6 +136,7 @@ def revolution_statistics(
         "corner_contact_share.events",
         "contact_radius_m.p99",
         "flange_contact_events_per_rev",
+        *FILM_KEYS,
     ):
         out[name] = np.full(nrev, np.nan)
     kin_rpm = float(rad_s_to_rpm(kinematic_speed))
@@ -154,6 +155,8 @@ def revolution_statistics(
         if touching.any():
             out["corner_contact_share.time"][i] = np.mean(beyond[touching])
             out["contact_radius_m.p99"][i] = np.percentile(w["contact_radius"][touching], 99.0)
+        for key, value in film_statistics(w, threshold).items():
+            out[key][i] = value
         sel = rev_of_event == i
         out["flange_contact_events_per_rev"][i] = np.sum(sel)
         if sel.any():

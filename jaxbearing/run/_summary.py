@@ -4,6 +4,15 @@ A contact event is a maximal run of saved samples in which one roller presses on
 (normal force above `threshold`). Each event contributes its peak force, peak pressure, peak PV,
 its sliding speed, contact height and contact radius at the instant of peak force, and whether
 that instant lies on the arc. Statistics are max / mean / median / min over events.
+
+Film statistics (`film_statistics`) are taken over CONTACT TIME instead: over every saved sample
+(uniform in time) in which a roller presses on a flange, i.e. each (sample, roller, flange)
+with normal force above `threshold`: the minimum film h_min (min, p05, median), the central film
+(min, median), the film parameter Lambda (mean, median, p05, min), `lambda_below_one_share`
+(share of contact time with Lambda < 1, boundary lubrication), `top_edge_contact_share` (share
+of contact time with the contact point above the flange height: computed on a flange that is
+not there) and the largest tangent-plane error at a contact, `flange_face_error_max_m`
+(docs/model.md 5.2). Histories without these keys (older runs) give None.
 """
 
 from __future__ import annotations
@@ -54,6 +63,57 @@ def contact_events(histories: dict, threshold: float = 1.0) -> dict[str, np.ndar
     return {k: np.asarray(v) for k, v in out.items()}
 
 
+#: film statistics over contact time: summary key -> (history key, reductions)
+FILM_QUANTITIES = {
+    "flange_min_film_m": ("flange_min_film", ("min", "p05", "median")),
+    "flange_central_film_m": ("flange_central_film", ("min", "median")),
+    "film_parameter": ("flange_film_parameter", ("mean", "median", "p05", "min")),
+}
+_REDUCE = {
+    "min": np.min,
+    "max": np.max,
+    "mean": np.mean,
+    "median": np.median,
+    "p05": lambda v: np.percentile(v, 5.0),
+}
+#: scalar film statistics over contact time (share of contact samples, or the largest value)
+FILM_SCALARS = ("lambda_below_one_share", "top_edge_contact_share", "flange_face_error_max_m")
+#: every key of `film_statistics`
+FILM_KEYS = tuple(f"{k}.{r}" for k, (_, reds) in FILM_QUANTITIES.items() for r in reds) + FILM_SCALARS
+
+
+def film_statistics(histories: dict, threshold: float = 1.0) -> dict[str, float]:
+    """Film statistics over contact time (module docstring), flat: "flange_min_film_m.min",
+    ..., "lambda_below_one_share", "top_edge_contact_share", "flange_face_error_max_m". NaN
+    where there is no contact sample or the histories lack the quantity."""
+    out = dict.fromkeys(FILM_KEYS, np.nan)
+    q = np.asarray(histories["flange_force"])
+    touching = q > threshold
+    if not touching.any():
+        return out
+
+    def at_contact(key):
+        return np.asarray(histories[key])[touching] if key in histories else None
+
+    for name, (hk, reds) in FILM_QUANTITIES.items():
+        v = at_contact(hk)
+        if v is not None:
+            for r in reds:
+                out[f"{name}.{r}"] = float(_REDUCE[r](v))
+    lam, top, err = (at_contact(k) for k in ("flange_film_parameter", "flange_top_edge", "flange_face_error"))
+    if lam is not None:
+        out["lambda_below_one_share"] = float(np.mean(lam < 1.0))
+    if top is not None:
+        out["top_edge_contact_share"] = float(np.mean(top > 0.5))
+    if err is not None:
+        out["flange_face_error_max_m"] = float(np.max(err))
+    return out
+
+
+def _none_if_nan(x: float):
+    return None if not np.isfinite(x) else float(x)
+
+
 def _stats(values: np.ndarray) -> dict:
     if values.size == 0:
         return {"max": None, "mean": None, "median": None, "min": None}
@@ -90,4 +150,9 @@ def summarise(result, threshold: float = 1.0) -> dict:
     }
     for key in _EVENT_QUANTITIES:
         block[key] = _stats(events[key])
+    film = film_statistics(h, threshold)
+    for name, (_, reds) in FILM_QUANTITIES.items():
+        block[name] = {r: _none_if_nan(film[f"{name}.{r}"]) for r in reds}
+    for name in FILM_SCALARS:
+        block[name] = _none_if_nan(film[name])
     return block

@@ -23,7 +23,7 @@ Every axis key is a dotted configuration key (`jaxbearing config show`) or `end`
 built through `Config.replace`, i.e. re-validated, before anything is computed; a bad spec
 raises `SweepSpecError` (a `UserInputError`: one line naming the axis). Keys that change array
 shapes (`bearing.num_rollers`, `bearing.num_slices`) or the compiled program
-(`simulation.max_steps`, `simulation.progress`) cannot be axes: run one sweep per value.
+(`bearing.flange_lubrication`, `simulation.max_steps`, `simulation.progress`) cannot be axes: run one sweep per value.
 `simulation.duration_ms`, `simulation.rtol` and `simulation.atol` can (they are traced). Without
 an `end` axis the base's `simulation.end` decides; "both" (the reference) adds the axis
 `end = ["arc", "corner"]`.
@@ -69,6 +69,7 @@ FORMAT_VERSION = 1
 _STATIC_KEYS = {
     "bearing.num_rollers": "it changes array shapes (static); run one sweep per value",
     "bearing.num_slices": "it changes array shapes (static); run one sweep per value",
+    "bearing.flange_lubrication": "it selects the compiled flange friction law (static); run one sweep per value",
     "simulation.max_steps": "it is a static argument of the compiled solve; set it in [base.simulation]",
     "simulation.progress": "progress is not a model parameter",
     "simulation.end": 'use the special axis "end" = ["arc", "corner"]',
