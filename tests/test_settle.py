@@ -127,3 +127,13 @@ def test_halving_rtol_moves_settled_pv_and_slip_less_than_their_intervals():
         ref, fine = get(runs[0]), get(runs[1])
         half = 0.5 * (ref["ci95_high"] - ref["ci95_low"])
         assert abs(fine["value"] - ref["value"]) < half, (ref, fine)
+
+
+def test_demo_paper_table_shows_settled_estimates_with_intervals():
+    from jaxbearing.cli._demo import paper_table
+
+    est = {"value": 1.5e9, "ci95_low": 1.2e9, "ci95_high": 1.8e9, "n": 4}
+    summaries = {e: {"flange_pressure_Pa": {"max": est}} for e in ("arc", "corner")}
+    table = paper_table(summaries)
+    assert "1.5 [1.2, 1.8]" in table and "about 4.8" in table
+    assert "0.35" in paper_table({"arc": {"flange_pressure_Pa": {"max": 0.35e9}}})
