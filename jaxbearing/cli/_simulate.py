@@ -24,7 +24,7 @@ def register(sub) -> None:
         help="integrate the bearing dynamics and report roller-end/flange contacts",
         description="Integrate the whole-bearing dynamics and report the roller-end/flange contact "
         "statistics (paper Figure 7 quantities), cage speed and slip: with --settle, from the skid "
-        "start until settled, then over a window of cage revolutions with 95 %% confidence intervals; "
+        "start until settled, then over a window of cage revolutions with 95 % confidence intervals; "
         "without it, one fixed-duration run from the quasi-static start.",
     )
     p.add_argument("--config", help="TOML configuration (default: embedded reference bearing)")
