@@ -39,6 +39,23 @@ class Perturbation:
     skew: float = 1e-4  # [rad]
 
 
+def traced_scatter(perturbation: Perturbation | None):
+    """The perturbation as arrays (seed, axial, skew), so that seeds and amplitudes are traced
+    arguments of a compiled program and never force a recompilation; None stays None."""
+    if perturbation is None:
+        return None
+    return (
+        jnp.asarray(perturbation.seed, jnp.int32),
+        jnp.asarray(perturbation.axial, float),
+        jnp.asarray(perturbation.skew, float),
+    )
+
+
+def perturbation_of(scatter) -> Perturbation | None:
+    """Inverse of `traced_scatter` (inside the compiled program)."""
+    return None if scatter is None else Perturbation(seed=scatter[0], axial=scatter[1], skew=scatter[2])
+
+
 #: the starts a run may use
 STARTS = ("skid", "quasi-static")
 
@@ -89,8 +106,7 @@ class SkidStart(eqx.Module):
 
 
 def _skid(bearing, op, scatter):
-    pert = None if scatter is None else Perturbation(seed=scatter[0], axial=scatter[1], skew=scatter[2])
-    start = initial_state(bearing, op, pert)
+    start = initial_state(bearing, op, perturbation_of(scatter))
     params = Params(bearing=bearing, operating=op)
     eq = skid_equilibrium(start, params, kinematic_cage_speed(bearing, op))
     return SkidStart(state=eq.state, equilibrium=eq, time_constant=cage_time_constant(eq, params))
@@ -104,15 +120,7 @@ def skid_start(bearing: Bearing, op: OperatingPoint, perturbation: Perturbation 
 
     Compiled once per bearing structure (seeds, speeds and loads reuse it); runs outside any
     vmap (a vmapped bisection costs several times more per case)."""
-    scatter = (
-        None
-        if perturbation is None
-        else (
-            jnp.asarray(perturbation.seed, jnp.int32),
-            jnp.asarray(perturbation.axial, float),
-            jnp.asarray(perturbation.skew, float),
-        )
-    )
+    scatter = traced_scatter(perturbation)
     dyn = (bearing, op, scatter)
     leaves, treedef = jax.tree_util.tree_flatten(dyn)
     key = (treedef, tuple((jnp.shape(x), jnp.result_type(x)) for x in leaves))

@@ -40,7 +40,7 @@ from ..dynamics import (
 from ..geometry import Bearing, OperatingPoint, kinematic_cage_speed
 from ..io import SIMULATE_NUM_SAVES, check_solve_inputs
 from ._compile_cache import checks_without_host_callbacks
-from ._initial import Perturbation, initial_state
+from ._initial import Perturbation, initial_state, perturbation_of, traced_scatter
 from ._progress import SolveProgress
 from ._result import SimulationResult, Solution, result_code, simulation_result, smooth_functionals
 from ._step_control import DT0, RACEWAY_NORMAL_LOOSEN, raceway_normal_norm, step_controller
@@ -223,15 +223,7 @@ def _compiled_solve(bearing, op, duration, rtol, atol, static: tuple):
     arguments, so arc and corner ends, other speeds, loads, tolerances and seeds of the initial
     scatter reuse one compilation (the scatter's seed and amplitudes are traced)."""
     num_saves, max_steps, progress, perturbation, functionals = static
-    scatter = (
-        None
-        if perturbation is None
-        else (
-            jnp.asarray(perturbation.seed, jnp.int32),
-            jnp.asarray(perturbation.axial, float),
-            jnp.asarray(perturbation.skew, float),
-        )
-    )
+    scatter = traced_scatter(perturbation)
     dyn = (bearing, op, duration, rtol, atol, scatter)
     static = (num_saves, max_steps, progress, perturbation is None, functionals)
     leaves, treedef = jax.tree_util.tree_flatten(dyn)
@@ -239,7 +231,7 @@ def _compiled_solve(bearing, op, duration, rtol, atol, static: tuple):
     if key not in _COMPILED:
 
         def run(b, o, d, r, a, sc):
-            pert = None if sc is None else Perturbation(seed=sc[0], axial=sc[1], skew=sc[2])
+            pert = perturbation_of(sc)
             return solve(
                 b,
                 o,
