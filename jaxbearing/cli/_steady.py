@@ -16,6 +16,7 @@ _ROWS = (
     ("flange_force_N", "flange force", "N", 1.0),
     ("flange_pressure_Pa", "peak pressure", "GPa", 1e-9),
     ("flange_sliding_velocity_m_s", "sliding velocity", "m/s", 1.0),
+    ("flange_roller_surface_speed_m_s", "surface speed (paper)", "m/s", 1.0),
     ("flange_pv_Pa_m_s", "PV", "GPa m/s", 1e-9),
     ("contact_height_m", "contact height", "mm", 1e3),
     ("contact_radius_m", "contact radius", "mm", 1e3),
