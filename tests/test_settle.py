@@ -30,6 +30,7 @@ EVENT_STATS = (
         ("--settle", "soon", "--settle"),
         ("--settle", "-5", "--settle"),
         ("--start", "warm", "--start"),
+        ("--workers", "0", "--workers"),
     ],
 )
 def test_bad_steady_options_one_line(option, value, name, capsys):

@@ -41,6 +41,12 @@ def add_arguments(p) -> None:
         help="relative change of the revolution-mean cage speed that counts as settled (default 1e-3)",
     )
     g.add_argument(
+        "--workers",
+        type=float,
+        default=None,
+        help="processes for the seeds (default: one per CPU, at most --seeds)",
+    )
+    g.add_argument(
         "--start",
         default="skid",
         help='"skid" (default: skid equilibrium, projective steps of the cage speed) or "quasi-static"',
@@ -67,7 +73,11 @@ def options(args) -> dict | None:
     check_steady_options(
         settle, args.window_revs, args.seeds, args.settle_tolerance, args.settle_cap_ms, names
     )
-    from ..run import STARTS
+    from ..io import require
+    from ..run import STARTS, available_cpus
+
+    workers = available_cpus() if args.workers is None else args.workers
+    require("--workers", workers, lambda v: (v >= 1) & (v == np.round(v)), "an integer >= 1")
 
     if args.start not in STARTS:
         from .._errors import UserInputError
@@ -80,6 +90,7 @@ def options(args) -> dict | None:
         tolerance=args.settle_tolerance,
         settle_cap_ms=args.settle_cap_ms,
         start=args.start,
+        workers=int(workers),
     )
 
 

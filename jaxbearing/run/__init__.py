@@ -34,7 +34,7 @@ from ._design import (
     forward_jacobian,
     seated_perturbation,
 )
-from ._ensemble import parallel_map, simulate_ensemble
+from ._ensemble import available_cpus, parallel_map, simulate_ensemble
 from ._initial import STARTS, Perturbation, SkidStart, initial_state, skid_start
 from ._plots import plot_run
 from ._progress import SolveProgress
@@ -69,6 +69,7 @@ from ._step_control import RACEWAY_NORMAL_LOOSEN, RacewayNormalNorm, raceway_nor
 from ._summary import FILM_KEYS, contact_events, film_statistics
 
 __all__ = [
+    "available_cpus",
     "STARTS",
     "SkidStart",
     "FILM_KEYS",

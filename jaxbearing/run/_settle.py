@@ -27,8 +27,9 @@ measure over a window of whole revolutions (issue 11; docs/model.md 16).
   step only. `start="quasi-static"`: kinematic speeds, no projective steps.
 * The window is `window_revs` further revolutions; its statistics and intervals come from
   `_statistics`. With `seeds = N` the whole run is repeated for N seeded initial scatters
-  (`Perturbation.seed` = 0 .. N-1) one after another: on a 2-core CPU one solve already keeps
-  both cores busy and a vmapped batch is slower per case (README, Performance).
+  (`Perturbation.seed` = 0 .. N-1), with `workers` > 1 one process per core (`parallel_map`: 1.52x the throughput of
+  one case at a time on 2 cores, benchmarks/results/bench_ensemble.json; a vmapped batch is slower
+  per case than one at a time, README, Performance).
 """
 
 from __future__ import annotations
@@ -46,6 +47,7 @@ from ..dynamics import Functionals, Params, Scaling, State, state_scales
 from ..geometry import Bearing, OperatingPoint, kinematic_cage_speed, rad_s_to_rpm
 from ..io import require
 from ._compile_cache import checks_without_host_callbacks
+from ._ensemble import parallel_map
 from ._initial import STARTS, Perturbation, initial_state, skid_start
 from ._result import result_code
 from ._simulate import SolveArgs, _diffeqsolve, _save
@@ -287,6 +289,20 @@ class SteadyResult:
         return self.runs[0].window
 
 
+@dataclasses.dataclass(frozen=True)
+class _SteadySeed:
+    """Picklable settled run of one seed (for `parallel_map`)."""
+
+    bearing: Bearing
+    op: OperatingPoint
+    kwargs: dict
+
+    def __call__(self, perturbation: Perturbation) -> SteadyResult:
+        return simulate_steady(
+            self.bearing, self.op, seeds=1, perturbation=perturbation, workers=1, **self.kwargs
+        )
+
+
 def simulate_steady(
     bearing: Bearing,
     op: OperatingPoint,
@@ -304,10 +320,15 @@ def simulate_steady(
     perturbation: Perturbation = Perturbation(),
     functionals: Functionals = Functionals(),
     progress: bool = False,
+    workers: int = 1,
 ) -> SteadyResult:
     """Settle (module docstring), then measure `window_revs` cage revolutions, for each of
     `seeds` seeded initial scatters, each from `start`: "skid" (default; the skid equilibrium and
-    projective steps of the cage speed while settling) or "quasi-static" (kinematic speeds)."""
+    projective steps of the cage speed while settling) or "quasi-static" (kinematic speeds).
+
+    `workers` > 1 runs the seeds in that many processes (`parallel_map`, started with `spawn`: a
+    script calling this needs the `if __name__ == "__main__":` guard); `jaxbearing simulate`
+    uses one per CPU. Default 1: one after another, in this process."""
     from ..io import validate_bearing
 
     validate_bearing(bearing, op)
@@ -316,6 +337,31 @@ def simulate_steady(
         from .._errors import UserInputError
 
         raise UserInputError(f"start = {start!r}: must be one of {', '.join(map(repr, STARTS))}")
+    kwargs = dict(
+        settle=settle,
+        window_revs=window_revs,
+        tolerance=tolerance,
+        settle_cap_ms=settle_cap_ms,
+        start=start,
+        rtol=rtol,
+        atol=atol,
+        max_steps=max_steps,
+        saves_per_rev=saves_per_rev,
+        functionals=functionals,
+        progress=progress,
+    )
+    workers = min(int(seeds), int(workers))
+    if int(seeds) > 1 and workers > 1:
+        wall0 = time.perf_counter()
+        seeds_run = [dataclasses.replace(perturbation, seed=perturbation.seed + k) for k in range(int(seeds))]
+        outs = parallel_map(_SteadySeed(bearing, op, kwargs), seeds_run, workers=workers)
+        return dataclasses.replace(
+            outs[0],
+            runs=[o.runs[0] for o in outs],
+            # the pool's wall time less its longest compilation (the workers compile side by side)
+            wall_time_s=time.perf_counter() - wall0 - max(o.compile_time_s for o in outs),
+            compile_time_s=max(o.compile_time_s for o in outs),
+        )
     params = Params(bearing=bearing, operating=op, functionals=functionals)
     runs, wall0, compile_time = [], time.perf_counter(), 0.0
     for seed in range(int(seeds)):
