@@ -70,6 +70,7 @@ from .run import (  # noqa: E402
     simulate,
     simulate_steady,
     solve,
+    steady_design_metrics,
     summarise,
     summarise_steady,
 )
@@ -126,6 +127,7 @@ __all__ = [
     "SteadyResult",
     "simulate",
     "simulate_steady",
+    "steady_design_metrics",
     "solve",
     "summarise",
     "summarise_steady",

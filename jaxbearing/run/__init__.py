@@ -11,7 +11,8 @@
   intervals: `steady_statistics`, `revolution_statistics`, `confidence_intervals`,
   `batch_means`, `student_t_interval`, `Estimate`;
 - settled running: `simulate_steady` (settling detection over cage revolutions, a window,
-  seeds), `summarise_steady`, `solve_from` (continue from any state), `check_steady_options`;
+  seeds), `summarise_steady`, `steady_design_metrics` (the steady-running design objective:
+  mean and p95 PV over contact time, corner share and margin, static margins), `solve_from` (continue from any state), `check_steady_options`;
 - design metrics through the dynamics: `design_metrics`, `design_jacobian`, `DesignMetrics`,
   `seated_perturbation`, `forward_jacobian`;
 - `plot_run`: the figures of one run;
@@ -65,6 +66,7 @@ from ._statistics import (
     steady_statistics,
     student_t_interval,
 )
+from ._steady_design import CORNER_MARGIN, SteadyDesignMetrics, steady_design_metrics
 from ._step_control import RACEWAY_NORMAL_LOOSEN, RacewayNormalNorm, raceway_normal_norm
 from ._summary import FILM_KEYS, contact_events, film_statistics
 
@@ -112,6 +114,9 @@ __all__ = [
     "seated_perturbation",
     "simulate",
     "simulate_steady",
+    "steady_design_metrics",
+    "SteadyDesignMetrics",
+    "CORNER_MARGIN",
     "simulation_result",
     "smooth_functionals",
     "solve",

@@ -136,6 +136,8 @@ def revolution_statistics(
         "corner_contact_share.events",
         "contact_radius_m.p99",
         "flange_contact_events_per_rev",
+        "flange_pv_contact_time_Pa_m_s.mean",
+        "flange_pv_contact_time_Pa_m_s.p95",
         *FILM_KEYS,
     ):
         out[name] = np.full(nrev, np.nan)
@@ -154,6 +156,10 @@ def revolution_statistics(
         beyond = w["contact_radius"] > rho_lim
         if touching.any():
             out["corner_contact_share.time"][i] = np.mean(beyond[touching])
+            # PV over contact time (every touching flange sample, equally spaced in time)
+            pv = np.asarray(w["flange_pv"])[touching]
+            out["flange_pv_contact_time_Pa_m_s.mean"][i] = np.mean(pv)
+            out["flange_pv_contact_time_Pa_m_s.p95"][i] = np.percentile(pv, 95.0)
             out["contact_radius_m.p99"][i] = np.percentile(w["contact_radius"][touching], 99.0)
         for key, value in film_statistics(w, threshold).items():
             out[key][i] = value

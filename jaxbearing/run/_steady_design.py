@@ -1,0 +1,130 @@
+"""The steady-running design objective (issue 13, item 1): what a design does in settled running.
+
+For a design (R_end, theta_f, Delta_bf; `flange.DesignVariables`) at one operating point,
+`steady_design_metrics` runs the bearing from the skid start until settled, measures a window of
+cage revolutions for an ensemble of seeds (`simulate_steady`) and returns, each with its 95 %
+confidence interval (Student-t over the seeds' batch means, `_statistics`):
+
+- `mean_pv`: the mean flange PV over contact time (every touching flange sample, equally spaced in
+  time: the time average wear integrates), per cage revolution;
+- `p95_pv`: its 95th percentile over contact time (the tail measure);
+- `corner_contact_share`: the share of contact time whose contact point lies beyond the limited
+  circle (on the corner torus);
+- `corner_margin` [m]: the dynamic corner-contact margin rho_lim - p99(contact radius) - `margin`,
+  positive when 99 % of the contact time stays inside the limited circle by `margin` (the
+  dynamic counterpart of the static `limited_circle` margin: skewing rollers ride out towards the
+  corner, the paper's Figure 13b);
+
+beside the four static design-zone margins of `flange.zone_margins` (relief, height,
+limited circle, clearance; positive when satisfied) and the full settled summary.
+
+It is a measurement, not a differentiable function: the gradient of a long impacting trajectory
+is not a design signal (`_design`, docs/model.md 14), and the estimator of the gradient of these
+ensemble statistics (issue 13, item 2) is not built yet. Continuation between nearby designs
+(each design starting from its neighbour's settled state) is not built yet either: every call
+settles from its own skid start.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from ..flange import (
+    DEFAULT_FLANGE_LOAD,
+    MARGIN_NAMES,
+    DesignVariables,
+    check_design,
+    with_design,
+    zone_margins,
+)
+from ..geometry import Bearing, OperatingPoint
+from ..io import require
+from ._settle import simulate_steady, summarise_steady
+
+#: default dynamic corner margin [m]: 99 % of the contact time this far inside the limited circle
+CORNER_MARGIN = 0.05e-3
+
+
+@dataclasses.dataclass
+class SteadyDesignMetrics:
+    """The steady-running objective of one design (module docstring). Estimates are dicts
+    {"value", "ci95_low", "ci95_high", "n"}; `static_margins` [m] by `MARGIN_NAMES`."""
+
+    design: dict
+    mean_pv: dict
+    p95_pv: dict
+    corner_contact_share: dict
+    corner_margin: dict
+    static_margins: dict
+    settled: bool
+    seeds: list
+    summary: dict
+
+    def as_dict(self) -> dict:
+        return dataclasses.asdict(self)
+
+
+def steady_design_metrics(
+    bearing: Bearing,
+    op: OperatingPoint,
+    design: DesignVariables,
+    *,
+    seeds: int = 4,
+    window_revs: int = 4,
+    settle="auto",
+    corner_margin: float = CORNER_MARGIN,
+    flange_load: float = DEFAULT_FLANGE_LOAD,
+    first_seed: int = 0,
+    **steady_kwargs,
+) -> SteadyDesignMetrics:
+    """Settled flange statistics of `design` over `seeds` seeds (module docstring); further
+    keyword arguments go to `simulate_steady` (`workers`, `rtol`, `tolerance`, ...).
+    `first_seed` selects the seeds (first_seed .. first_seed + seeds - 1): a verification uses
+    seeds a search never saw."""
+    check_design(bearing, design)
+    require("corner_margin", corner_margin, lambda v: np.isfinite(v) & (v >= 0), ">= 0 m")
+    require("first_seed", first_seed, lambda v: (v >= 0) & (v == np.round(v)), "an integer >= 0")
+    b = with_design(bearing, design.end_radius, design.layback_angle, design.axial_clearance)
+    from ._initial import Perturbation
+
+    pert = steady_kwargs.pop("perturbation", Perturbation())
+    pert = dataclasses.replace(pert, seed=int(first_seed))
+    result = simulate_steady(
+        b, op, settle=settle, window_revs=window_revs, seeds=seeds, perturbation=pert, **steady_kwargs
+    )
+    s = summarise_steady(result)
+    none = {"value": None, "ci95_low": None, "ci95_high": None, "n": 0}
+    pv = s.get("flange_pv_contact_time_Pa_m_s", {})
+    p99 = s.get("contact_radius_m", {}).get("p99", none)
+    rho_lim = s.get("limited_circle_radius_m")
+
+    def shifted(est):  # rho_lim - margin - est (the interval flips)
+        if est.get("value") is None or rho_lim is None:
+            return dict(none)
+        top = rho_lim - corner_margin
+        lo, hi = est.get("ci95_low"), est.get("ci95_high")
+        return {
+            "value": top - est["value"],
+            "ci95_low": None if hi is None else top - hi,
+            "ci95_high": None if lo is None else top - lo,
+            "n": est.get("n", 0),
+        }
+
+    margins = np.asarray(zone_margins(b, design, flange_load=flange_load))
+    return SteadyDesignMetrics(
+        design={
+            "end_radius_m": float(design.end_radius),
+            "layback_angle_rad": float(design.layback_angle),
+            "axial_clearance_m": float(design.axial_clearance),
+        },
+        mean_pv=pv.get("mean", dict(none)),
+        p95_pv=pv.get("p95", dict(none)),
+        corner_contact_share=s.get("corner_contact_share", {}).get("time", dict(none)),
+        corner_margin=shifted(p99),
+        static_margins={name: float(m) for name, m in zip(MARGIN_NAMES, margins)},
+        settled=bool(s["settled"]),
+        seeds=list(s["seeds"]),
+        summary=s,
+    )

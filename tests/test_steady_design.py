@@ -1,0 +1,44 @@
+"""The steady-running design objective (issue 13, item 1) at a reduced size: 11 slices per
+raceway, a fixed 0.5 ms settling time, a 2-revolution window, 2 seeds."""
+
+import dataclasses
+import math
+
+import pytest
+
+import jaxbearing as jb
+from jaxbearing import UserInputError
+from jaxbearing.flange import MARGIN_NAMES, DesignVariables
+
+
+@pytest.fixture(scope="module")
+def small():
+    return dataclasses.replace(jb.reference_bearing(), num_slices=11), jb.reference_operating_point()
+
+
+def test_steady_design_metrics_report_intervals_and_margins(small):
+    b, op = small
+    design = DesignVariables(end_radius=0.08, layback_angle=1.6 * math.pi / 180, axial_clearance=0.15e-3)
+    m = jb.steady_design_metrics(b, op, design, seeds=2, window_revs=2, settle="0.5", first_seed=5)
+    assert m.seeds == [5, 6] and m.settled
+    for est in (m.mean_pv, m.p95_pv, m.corner_contact_share, m.corner_margin):
+        assert est["ci95_low"] <= est["value"] <= est["ci95_high"] and est["n"] == 2
+    assert 0 < m.mean_pv["value"] < m.p95_pv["value"]
+    # the arc end at R_end 80 mm keeps its contacts inside the limited circle
+    assert m.corner_contact_share["value"] == 0.0 and m.corner_margin["value"] > 0
+    rho_lim = m.summary["limited_circle_radius_m"]
+    p99 = m.summary["contact_radius_m"]["p99"]["value"]
+    assert m.corner_margin["value"] == pytest.approx(rho_lim - jb.run.CORNER_MARGIN - p99)
+    assert set(m.static_margins) == set(MARGIN_NAMES)
+    assert m.design["axial_clearance_m"] == pytest.approx(0.15e-3)
+
+
+def test_bad_design_or_margin_is_one_line(small):
+    b, op = small
+    with pytest.raises(UserInputError, match="design.end_radius"):
+        jb.steady_design_metrics(
+            b, op, DesignVariables(end_radius=1e-3, layback_angle=0.03, axial_clearance=1e-4)
+        )
+    good = DesignVariables(end_radius=0.08, layback_angle=0.03, axial_clearance=1e-4)
+    with pytest.raises(UserInputError, match="corner_margin"):
+        jb.steady_design_metrics(b, op, good, corner_margin=-1.0)
