@@ -108,13 +108,16 @@ def test_slip_trend_with_load(reference_run):
 def test_tolerance_halving_convergence(reference_run):
     """Halving rtol and atol changes the reported statistics by less than the stated amounts.
 
-    Bounds: cage speed 0.1 %, median contact height 0.5 %, median peak pressure 3 %, mean
-    sliding velocity 5 %, smooth peak PV 15 %. The *maximum* peak pressure over the events of a
-    4 ms start-up transient is not asserted: it is the largest of a few impacts, whose timing
-    moves with the step sequence (measured this session: 8 % apart between rtol 1e-3 and 5e-4
-    while the median moved 0.7 %); maxima need settled running and their confidence intervals
-    (`simulate(..., settle=...)`). Event counts and means over events are more sensitive (an
-    event is a threshold crossing) and are not asserted.
+    Bounds: cage speed 0.1 %, median contact height 0.5 %, mean sliding velocity 5 %, smooth
+    peak PV 15 %. Peak-pressure statistics over the few impact events of a 4 ms start-up
+    transient are not asserted: their timing moves with the step sequence (between rtol 1e-3 and
+    5e-4 the maximum moved 8 % and the median 0.7 % in one environment, the median 7.0 % with
+    jax 0.10.2 on the same code), so they are a property of the chaotic transient, not of the
+    solver's accuracy. Statistics of settled running and their convergence under halving rtol
+    are asserted against their confidence intervals in
+    `tests/test_settle.py::test_halving_rtol_moves_settled_pv_and_slip_less_than_their_intervals`
+    (slow). Event counts and means over events are more sensitive (an event is a threshold
+    crossing) and are not asserted.
     """
     _, a = reference_run
     res_b, b = _run(rtol=5e-4, atol=5e-7)
@@ -122,7 +125,6 @@ def test_tolerance_halving_convergence(reference_run):
     rel = lambda x, y: abs(x - y) / abs(y)  # noqa: E731
     assert rel(a["cage_speed_rpm"], b["cage_speed_rpm"]) < 1e-3
     assert rel(a["contact_height_m"]["median"], b["contact_height_m"]["median"]) < 5e-3
-    assert rel(a["flange_pressure_Pa"]["median"], b["flange_pressure_Pa"]["median"]) < 0.03
     assert rel(a["flange_sliding_velocity_m_s"]["mean"], b["flange_sliding_velocity_m_s"]["mean"]) < 0.05
     assert rel(a["smooth_peak_pv_Pa_m_s"], b["smooth_peak_pv_Pa_m_s"]) < 0.15
 
