@@ -62,6 +62,8 @@ NEGATIVE_OK = {
     "lubricant.traction_a",
     "lubricant.traction_b_s_m",
     "lubricant.traction_d",
+    "operating.misalignment_mrad",  # a tilt either way about +Y
+    "operating.axial_load_N",  # either direction along X
 }
 
 
