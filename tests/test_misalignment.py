@@ -309,3 +309,11 @@ def test_python_built_operating_point_is_validated():
         validate_bearing(b, _op(misalignment=0.02))
     with pytest.raises(ConfigError, match=r"^operating.axial_load_N: 10.0 N needs"):
         validate_bearing(b, _op(axial_load=10.0))
+
+
+@pytest.mark.parametrize("value", [0.5, -1.0, math.nan])
+def test_switch_values_other_than_zero_and_one_are_rejected(value):
+    with pytest.raises(
+        ConfigError, match=r"^operating.inner_ring_tilt_freedom: .* is out of range: must be 1.0 \(true\)"
+    ):
+        validate_bearing(jb.reference_bearing(), _op(tilt_freedom=value))
