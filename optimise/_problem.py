@@ -215,7 +215,8 @@ def operating_envelope(
     loads_N: Sequence[float] | None = None,
 ) -> OperatingPoint:
     """Stacked operating points (leading axis) for every (speed, load) pair of the cartesian
-    product; None keeps the base value. Gravity is that of `base`."""
+    product; None keeps the base value. Gravity, misalignment, axial load and the ring
+    freedoms are those of `base`."""
     speeds = [float(base.inner_speed)] if not speeds_rpm else [rpm_to_rad_s(float(s)) for s in speeds_rpm]
     loads = [float(base.radial_load)] if not loads_N else [float(f) for f in loads_N]
     for s in speeds:
@@ -227,7 +228,13 @@ def operating_envelope(
     sp, ld = np.meshgrid(speeds, loads, indexing="ij")
     n = sp.size
     return OperatingPoint(
-        inner_speed=sp.ravel(), radial_load=ld.ravel(), gravity=np.full(n, float(base.gravity))
+        inner_speed=sp.ravel(),
+        radial_load=ld.ravel(),
+        gravity=np.full(n, float(base.gravity)),
+        misalignment=np.full(n, float(base.misalignment)),
+        axial_load=np.full(n, float(base.axial_load)),
+        axial_freedom=np.full(n, float(base.axial_freedom)),
+        tilt_freedom=np.full(n, float(base.tilt_freedom)),
     )
 
 

@@ -157,6 +157,8 @@ def _with_value(bearing, op, key, value):
     """(bearing, op) with the field of `key` set to `value` (config unit, converted to SI)."""
     if key.path == "operating.gravity":
         return bearing, dataclasses.replace(op, gravity=value)
+    if key.kind is bool:  # switches are 1.0 / 0.0 in the pytree
+        return bearing, eqx.tree_at(lambda o: getattr(o, key.attr[3:]), op, np.asarray(float(value)))
     si = value if key.kind is int else key.to_si(value)
     if key.attr.startswith("op."):
         return bearing, eqx.tree_at(lambda o: getattr(o, key.attr[3:]), op, si)
@@ -185,6 +187,8 @@ def bad_pytrees(draw, op_fields: bool = True):
                 st.sampled_from([math.nan, math.inf]),
             )
         )
+    elif key.kind is bool:  # a switch: anything but 0.0 and 1.0
+        value = draw(st.one_of(st.floats().filter(lambda x: x not in (0.0, 1.0)), st.just(math.nan)))
     else:
         value = draw(_config_value_invalid(key))
     bearing, op = _with_value(BEARING, OP, key, value)

@@ -65,6 +65,8 @@ NEGATIVE_OK = {
     "lubricant.traction_d",
     "lubricant.reference_temperature_C",
     "lubricant.inlet_temperature_C",
+    "operating.misalignment_mrad",  # a tilt either way about +Y
+    "operating.axial_load_N",  # either direction along X
 }
 
 

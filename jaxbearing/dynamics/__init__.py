@@ -13,7 +13,16 @@
 May import: `jaxbearing._errors`, `contact`, `geometry`, `io`, `flange`, `forces`.
 """
 
-from ._field import FLANGE_NAMES, Functionals, Loads, Params, contact_loads, physical_rates
+from ._field import (
+    FLANGE_NAMES,
+    Functionals,
+    Loads,
+    Params,
+    RingPose,
+    contact_loads,
+    inner_ring_pose,
+    physical_rates,
+)
 from ._quasistatic import QuasiStatic, quasi_static
 from ._rigid_body import angular_momentum, axisymmetric_body_rates, kinetic_energy
 from ._skid import SkidEquilibrium, cage_time_constant, skid_equilibrium
@@ -37,6 +46,7 @@ __all__ = [
     "Loads",
     "Params",
     "QuasiStatic",
+    "RingPose",
     "RingState",
     "RollerState",
     "Scaling",
@@ -46,6 +56,7 @@ __all__ = [
     "axisymmetric_body_rates",
     "cage_time_constant",
     "contact_loads",
+    "inner_ring_pose",
     "kinetic_energy",
     "physical_rates",
     "quasi_static",

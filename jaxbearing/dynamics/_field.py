@@ -2,13 +2,15 @@
 
 Bodies (MODEL.md 3): every roller (3-D translation, axis direction, angular velocity), the cage
 (radial translation, rotation) and the inner ring (radial translation; spin prescribed at
-omega_i, motor driven). The outer ring is fixed.
+omega_i, motor driven; optionally axial translation and tilt, docs/model.md "Misalignment").
+The outer ring is fixed.
 
 Forces on each roller (vectorised over rollers with `jax.vmap`, no Python loop):
   inner and outer raceway slices (`_raceway`), four roller-end/flange contacts (`flange`),
   the cage pocket (`_pocket`), oil-air drag (`_drag`) and gravity.
 On the cage: all pockets, the outer-ring guiding lands (`_cage_lands`), churning, gravity.
-On the inner ring: all inner raceway and flange reactions, the radial load F_r (+Z), gravity.
+On the inner ring: all inner raceway and flange reactions, the radial load F_r (+Z), the axial
+load F_a (+X), gravity.
 
 Equations of motion
 -------------------
@@ -20,7 +22,21 @@ Roller centre in cylindrical coordinates (paper Eq. 33, exact, no small angles):
 
 Roller attitude: axis e' = omega x e and Euler's equations with their gyroscopic terms (which
 the paper's Eq. 33 omits), in `_rigid_body.axisymmetric_body_rates`.
-Cage: m_c c'' = F_c (radial), I_p omega_c' = M_c.X. Inner ring: m_i c_i'' = F_i (radial).
+Cage: m_c c'' = F_c (radial), I_p omega_c' = M_c.X. Inner ring: m_i c_i'' = F_i (radial);
+with its switches on, m_i x_i'' = F_i.X + F_a and the tilt (psi_y, psi_z) below.
+
+Inner-ring pose: axis a = `geometry.ring_axis(psi_m + tilt_y, tilt_z)` (psi_m the imposed
+misalignment about +Y), centre (x_i, y_i, z_i), angular velocity omega_i a + omega_tilt
+(`geometry.ring_tilt_angular_velocity`). Every inner raceway slice and inner flange uses this
+axis and centre (`raceway_contact(..., ring_axis=a)`, `all_flange_contacts(...,
+inner_ring_axis=a)`). Tilt equations: the ring's angular momentum H = I_a omega_i a + I_t
+omega_perp with a' = (0, psi_z', -psi_y') and omega_perp = (0, psi_y', psi_z') to first order in
+the tilt (the misalignment is a few mrad), so dH/dt = M gives
+
+    I_t psi_y'' = M_perp.Y - I_a omega_i psi_z',     I_t psi_z'' = M_perp.Z + I_a omega_i psi_y',
+
+with M_perp = M - (M.a) a the contact moment about the ring centre less its part along the spin
+axis (taken by the drive, which prescribes omega_i), and (I_a, I_t) = `Bearing.inner_ring_inertia`.
 """
 
 from __future__ import annotations
@@ -41,7 +57,7 @@ from ..forces import (
     raceway_contact,
     roller_drag,
 )
-from ..geometry import Bearing, OperatingPoint
+from ..geometry import Bearing, OperatingPoint, ring_axis, ring_tilt_angular_velocity
 from ._rigid_body import axisymmetric_body_rates
 from ._state import (
     Accumulators,
@@ -89,6 +105,30 @@ class Loads(eqx.Module):
     pocket: PocketContact
 
 
+class RingPose(eqx.Module):
+    """The inner ring's pose and motion in inertial components (module docstring)."""
+
+    centre: Array  # (x_i, y_i, z_i) [m]
+    velocity: Array  # [m/s]
+    angular_velocity: Array  # omega_i a + omega_tilt [rad/s]
+    axis: Array  # unit axis a
+    tilt: Array  # attitude angles (psi_m + tilt_y, tilt_z) [rad]
+
+
+def inner_ring_pose(ring: RingState, op: OperatingPoint) -> RingPose:
+    """Centre, velocity, angular velocity and unit axis of the inner ring (module docstring);
+    aligned and axially centred, exactly (0, y, z), (0, v_y, v_z), omega_i X and X."""
+    tilt = jnp.stack([op.misalignment + ring.tilt[0], ring.tilt[1]])
+    a = ring_axis(tilt)
+    return RingPose(
+        centre=jnp.concatenate([ring.axial[None], ring.centre]),
+        velocity=jnp.concatenate([ring.axial_velocity[None], ring.velocity]),
+        angular_velocity=op.inner_speed * a + ring_tilt_angular_velocity(tilt, ring.tilt_rate),
+        axis=a,
+        tilt=tilt,
+    )
+
+
 def contact_loads(state: State, params: Params) -> Loads:
     """All contacts at a physical (unscaled) state."""
     b, op = params.bearing, params.operating
@@ -96,15 +136,21 @@ def contact_loads(state: State, params: Params) -> Loads:
     e = r.axis / jnp.linalg.norm(r.axis, axis=-1, keepdims=True)
     p, v, w = r.centre, r.velocity, r.angular_velocity
 
-    inner_c = jnp.concatenate([jnp.zeros(1), state.inner_ring.centre])
-    inner_v = jnp.concatenate([jnp.zeros(1), state.inner_ring.velocity])
-    inner_w = op.inner_speed * X
+    ring = inner_ring_pose(state.inner_ring, op)
+    inner_c, inner_v, inner_w, inner_a = ring.centre, ring.velocity, ring.angular_velocity, ring.axis
     zero = jnp.zeros(3)
 
+    def inner_raceway(p, e, v, w):
+        return raceway_contact(
+            b, 1.0, b.inner_raceway_radius, p, e, v, w, inner_c, inner_v, inner_w, ring_axis=inner_a
+        )
+
     raceway = jax.vmap(raceway_contact, in_axes=(None, None, None, 0, 0, 0, 0, None, None, None))
-    inner = raceway(b, 1.0, b.inner_raceway_radius, p, e, v, w, inner_c, inner_v, inner_w)
+    inner = jax.vmap(inner_raceway)(p, e, v, w)
     outer = raceway(b, -1.0, b.outer_raceway_radius, p, e, v, w, zero, zero, zero)
-    flange = all_flange_contacts(b, p, e, v, w, inner_c, inner_v, inner_w, zero, zero, zero)
+    flange = all_flange_contacts(
+        b, p, e, v, w, inner_c, inner_v, inner_w, zero, zero, zero, inner_ring_axis=inner_a
+    )
 
     cage = state.cage
     cage_c = jnp.concatenate([jnp.zeros(1), cage.centre])
@@ -195,16 +241,34 @@ def _cage_rates(cage: CageState, loads: Loads, params: Params) -> CageState:
 
 def _inner_ring_rates(ring: RingState, loads: Loads, params: Params) -> RingState:
     """Inner ring: radial motion under raceway and inner-flange forces, the applied radial load
-    and its weight (spin prescribed)."""
+    and its weight (spin prescribed); with the operating point's switches on, axial motion
+    under the same forces and the axial load, and tilt under their moments about the ring
+    centre with the gyroscopic coupling of the spin (module docstring)."""
     b, op, fl = params.bearing, params.operating, loads.flange
     inner_flanges = jnp.asarray([ring_sign > 0 for ring_sign, _ in FLANGE_ORDER])
     force = (
         jnp.sum(loads.inner.force_on_ring, axis=0)
         + jnp.sum(jnp.where(inner_flanges[None, :, None], fl.force_on_ring, 0.0), axis=(0, 1))
         + op.radial_load * jnp.array([0.0, 0.0, 1.0])
+        + op.axial_load * X
         + b.inner_ring_mass * _gravity(op)
     )
-    return RingState(centre=ring.velocity, velocity=force[1:] / b.inner_ring_mass)
+    moment = jnp.sum(loads.inner.moment_on_ring, axis=0) + jnp.sum(
+        jnp.where(inner_flanges[None, :, None], fl.moment_on_ring, 0.0), axis=(0, 1)
+    )
+    a = inner_ring_pose(ring, op).axis
+    m_perp = moment - jnp.dot(moment, a) * a
+    i_a, i_t = b.inner_ring_inertia[0], b.inner_ring_inertia[1]
+    gyro = i_a * op.inner_speed * jnp.stack([-ring.tilt_rate[1], ring.tilt_rate[0]])
+    f_ax, f_tilt = op.axial_freedom, op.tilt_freedom
+    return RingState(
+        centre=ring.velocity,
+        velocity=force[1:] / b.inner_ring_mass,
+        axial=f_ax * ring.axial_velocity,
+        axial_velocity=f_ax * force[0] / b.inner_ring_mass,
+        tilt=f_tilt * ring.tilt_rate,
+        tilt_rate=f_tilt * (m_perp[1:] + gyro) / i_t,
+    )
 
 
 def _functional_rates(fl, fn: Functionals) -> Accumulators:

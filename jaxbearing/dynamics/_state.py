@@ -73,10 +73,34 @@ class CageState(eqx.Module):
 
 
 class RingState(eqx.Module):
-    """Inner ring: radial position (y_i, z_i) and velocity; its spin is prescribed."""
+    """Inner ring: radial position (y_i, z_i) and velocity, axial position x_i and velocity, and
+    its tilt (psi_y, psi_z) with rates; its spin is prescribed.
 
-    centre: Float[Array, 2]
+    `tilt` is measured from the imposed misalignment psi_m (`OperatingPoint.misalignment`): the
+    ring's attitude angles are (psi_m + tilt[0], tilt[1]) (`geometry.ring_axis`: psi_y about +Y,
+    then psi_z about the ring's Z axis). The axial and tilt coordinates move only when the
+    operating point's `axial_freedom` / `tilt_freedom` switch is on; otherwise they stay at 0.
+    """
+
+    centre: Float[Array, 2]  # (y_i, z_i) [m]
     velocity: Float[Array, 2]
+    axial: Float[Array, ""]  # x_i [m]
+    axial_velocity: Float[Array, ""]
+    tilt: Float[Array, 2]  # (psi_y - psi_m, psi_z) [rad]
+    tilt_rate: Float[Array, 2]  # (psi_y', psi_z') [rad/s]
+
+    @staticmethod
+    def aligned(centre, velocity) -> RingState:
+        """A ring at radial position `centre` with `velocity`, axially at 0 and untilted (beyond
+        the imposed misalignment), at rest in its axial and tilt coordinates."""
+        return RingState(
+            centre=centre,
+            velocity=velocity,
+            axial=jnp.zeros(()),
+            axial_velocity=jnp.zeros(()),
+            tilt=jnp.zeros(2),
+            tilt_rate=jnp.zeros(2),
+        )
 
 
 class Accumulators(eqx.Module):
@@ -106,7 +130,8 @@ def state_scales(num_rollers: int, pitch_radius: float) -> State:
 
     lengths 1 um, orbital angles 1 um of arc at the pitch radius, axis components 1 urad,
     linear velocities 1 mm/s, angular velocities 1 rad/s (orbit: 1 mm/s at the pitch radius),
-    accumulators large (they must not steer the step size).
+    inner-ring tilt 1 um of arc at the pitch radius and its rate 1 mm/s there, accumulators
+    large (they must not steer the step size).
     """
     ones = jnp.ones((num_rollers,))
     um, mm_s = 1e-6, 1e-3
@@ -127,7 +152,14 @@ def state_scales(num_rollers: int, pitch_radius: float) -> State:
             velocity=mm_s * jnp.ones(2),
             speed=jnp.asarray(mm_s / pitch_radius),
         ),
-        inner_ring=RingState(centre=um * jnp.ones(2), velocity=mm_s * jnp.ones(2)),
+        inner_ring=RingState(
+            centre=um * jnp.ones(2),
+            velocity=mm_s * jnp.ones(2),
+            axial=jnp.asarray(um),
+            axial_velocity=jnp.asarray(mm_s),
+            tilt=(um / pitch_radius) * jnp.ones(2),
+            tilt_rate=(mm_s / pitch_radius) * jnp.ones(2),
+        ),
         accumulators=Accumulators(
             pv_power=1e12 * jnp.ones((num_rollers, 4)),
             height_max_power=1e12 * jnp.ones((num_rollers, 4)),

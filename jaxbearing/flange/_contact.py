@@ -117,6 +117,7 @@ def roller_flange_contact(
     ring_velocity: Vec3,
     ring_angular_velocity: Vec3,
     *,
+    ring_axis: Vec3 | None = None,
     damping: ArrayLike = HUNT_CROSSLEY_ALPHA,
 ) -> FlangeContact:
     """Contact of one roller end with one ring flange (MODEL.md 4.1; the caller vmaps).
@@ -155,9 +156,13 @@ def roller_flange_contact(
 
     Arguments: `raceway_radius` R_r of the ring; `side` s = -1 or +1 (flange at -X or +X);
     `ring_sign` g = +1 inner ring, -1 outer ring; roller centre p, unit axis e (about +X),
-    velocity v and angular velocity w; ring centre c_r, velocity v_r, angular velocity w_r.
+    velocity v and angular velocity w; ring centre c_r, velocity v_r, angular velocity w_r;
+    `ring_axis` a, the ring's unit axis (default X; a tilted inner ring: `geometry.ring_axis`),
+    along which the flange faces sit (`flange_geometry`).
     """
-    g = flange_geometry(bearing, raceway_radius, side, ring_sign, roller_centre, roller_axis, ring_centre)
+    g = flange_geometry(
+        bearing, raceway_radius, side, ring_sign, roller_centre, roller_axis, ring_centre, ring_axis
+    )
     n = g.normal
     c = g.contact_point
     p = jnp.asarray(roller_centre)
@@ -231,31 +236,39 @@ def all_flange_contacts(
     outer_ring_centre: Vec3,
     outer_ring_velocity: Vec3,
     outer_ring_angular_velocity: Vec3,
+    inner_ring_axis: Vec3 | None = None,
+    outer_ring_axis: Vec3 | None = None,
 ) -> FlangeContact:
     """Every roller against every flange: a FlangeContact with leading shape (Z, 4).
 
-    Flange order along axis 1 (`FLANGE_ORDER`): inner -X, inner +X, outer -X, outer +X.
+    Flange order along axis 1 (`FLANGE_ORDER`): inner -X, inner +X, outer -X, outer +X
+    (-X/+X: the side along each ring's own axis, X unless `inner_ring_axis` /
+    `outer_ring_axis` is given).
     Lifted with `jax.vmap` over flanges and rollers (no Python loop over rollers).
     """
     ring_sign = jnp.array([f[0] for f in FLANGE_ORDER])
     side = jnp.array([f[1] for f in FLANGE_ORDER])
     radius = jnp.stack([bearing.inner_raceway_radius] * 2 + [bearing.outer_raceway_radius] * 2)
-    inner = (inner_ring_centre, inner_ring_velocity, inner_ring_angular_velocity)
-    outer = (outer_ring_centre, outer_ring_velocity, outer_ring_angular_velocity)
+    x_axis = jnp.array([1.0, 0.0, 0.0])
+    inner_a = x_axis if inner_ring_axis is None else inner_ring_axis
+    outer_a = x_axis if outer_ring_axis is None else outer_ring_axis
+    inner = (inner_ring_centre, inner_ring_velocity, inner_ring_angular_velocity, inner_a)
+    outer = (outer_ring_centre, outer_ring_velocity, outer_ring_angular_velocity, outer_a)
     inner, outer = ([jnp.asarray(x) for x in ring] for ring in (inner, outer))
-    c_r, v_r, w_r = (jnp.stack([i, i, o, o]) for i, o in zip(inner, outer))
+    c_r, v_r, w_r, a_r = (jnp.stack([i, i, o, o]) for i, o in zip(inner, outer))
 
-    def one(rad, sd, sg, c, vr, wr, p, e, v, w):
-        return roller_flange_contact(bearing, rad, sd, sg, p, e, v, w, c, vr, wr)
+    def one(rad, sd, sg, c, vr, wr, ar, p, e, v, w):
+        return roller_flange_contact(bearing, rad, sd, sg, p, e, v, w, c, vr, wr, ring_axis=ar)
 
-    per_roller = jax.vmap(one, in_axes=(0, 0, 0, 0, 0, 0, None, None, None, None))
-    return jax.vmap(per_roller, in_axes=(None,) * 6 + (0, 0, 0, 0))(
+    per_roller = jax.vmap(one, in_axes=(0,) * 7 + (None,) * 4)
+    return jax.vmap(per_roller, in_axes=(None,) * 7 + (0, 0, 0, 0))(
         radius,
         side,
         ring_sign,
         c_r,
         v_r,
         w_r,
+        a_r,
         roller_centre,
         roller_axis,
         roller_velocity,

@@ -90,18 +90,30 @@ def flange_geometry(
     roller_centre: Vec3,
     roller_axis: Vec3,
     ring_centre: Vec3,
+    ring_axis: Vec3 | None = None,
 ) -> FlangeGeometry:
     """Flange tangent plane, interference, contact point and principal radii (pose only);
-    shared by `roller_flange_contact` and `jaxbearing.design_zone`."""
+    shared by `roller_flange_contact` and `jaxbearing.design_zone`.
+
+    The ring's axis is the unit vector `ring_axis` a (default X: the outer ring, an aligned
+    inner ring). The flange faces are cones of revolution about a at +-W_r/2 along a from the
+    ring centre c_r, so for a tilted or axially displaced ring every ring direction follows a:
+    e_rad = unit((p - c_r) - ((p - c_r).a) a) (the roller's radial direction from the ring
+    axis), P0 = c_r + s (W_r/2) a + R_r e_rad, n = s cos(theta_f) a - g sin(theta_f) e_rad
+    (module docstring of `_contact` with X -> a). With a = X these are exactly the aligned
+    formulas.
+    """
     roller = bearing.roller
     theta = bearing.flange.layback_angle
     p = jnp.asarray(roller_centre)
     c_r = jnp.asarray(ring_centre)
-    # radial direction of the roller's azimuth (Y, Z components only)
-    e_rad = unit((p - c_r) * jnp.array([0.0, 1.0, 1.0]))
+    a = _AXIS if ring_axis is None else jnp.asarray(ring_axis)
+    # radial direction of the roller's azimuth from the ring axis
+    rel = p - c_r
+    e_rad = unit(rel - jnp.dot(rel, a) * a)
     # flange tangent plane
-    p0 = c_r + side * (bearing.raceway_width / 2) * _AXIS + raceway_radius * e_rad
-    n = side * jnp.cos(theta) * _AXIS - ring_sign * jnp.sin(theta) * e_rad
+    p0 = c_r + side * (bearing.raceway_width / 2) * a + raceway_radius * e_rad
+    n = side * jnp.cos(theta) * a - ring_sign * jnp.sin(theta) * e_rad
     # end frame: outward axis x = s e, radial direction r of the contact
     x_end = side * unit(jnp.asarray(roller_axis))
     cos_a = jnp.dot(n, x_end)

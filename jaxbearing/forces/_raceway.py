@@ -12,8 +12,23 @@ outside it, tangent to the straight part and reaching c_crown at |xi| = L_we/2
 
 Geometry (exact in the roller pose, no small-angle assumption for tilt or skew). With the
 slice centre q_j = p + xi_j e on the roller axis (roller centre p, unit axis e), the ring centre
-c_r and the ring axis X, the radial offset of q_j from the ring axis is
-rho_j = (q_j - c_r) - ((q_j - c_r).X) X, its length d_j = |rho_j| and direction n_j = rho_j/d_j.
+c_r and the unit ring axis a (X for the outer ring; the inner ring's axis tilted by the
+misalignment, `geometry.ring_axis`), the radial offset of q_j from the ring axis is
+rho_j = (q_j - c_r) - ((q_j - c_r).a) a, its length d_j = |rho_j| and direction n_j = rho_j/d_j.
+The raceway is the cylinder |rho| = R_race about the (possibly tilted) ring axis, so a tilted
+ring is handled by the same formula: no small-angle assumption for the ring either.
+
+Tilted ring, closed form (the unit test's oracle): an aligned roller (e = X) at azimuth theta,
+centre p = r e_rad(theta), against an inner ring through the origin tilted by psi about +Y,
+a = (cos psi, 0, -sin psi). Then q_j.a = xi_j cos psi - r cos theta sin psi and
+
+    d_j^2 = |q_j|^2 - (q_j.a)^2 = r^2 + 2 r xi_j cos theta sin psi cos psi + O(psi^2),
+
+so d_j = r + xi_j cos theta sin psi + O(psi^2) and the inner interference falls linearly along
+the roller with slope d(delta_j)/d(xi_j) = -sin psi cos theta: the tilt projected onto the
+roller's azimuth (full at theta = 0 and pi, zero at +-pi/2); the support factor
+sqrt(1 - (e.n_j)^2), e.n_j = cos theta sin psi + O(psi^2), only shifts every slice by the same
+O(r_roller psi^2).
 The disc's extent towards the raceway along n_j is its support function
 r(xi_j) sqrt(1 - (e.n_j)^2), so the interference is
 
@@ -171,21 +186,26 @@ def raceway_slice_geometry(
     roller_centre: Float[Array, 3],
     roller_axis: Float[Array, 3],
     ring_centre: Float[Array, 3],
+    *,
+    ring_axis: Float[Array, 3] | None = None,
 ) -> tuple[Float[Array, " N_s"], Float[Array, "N_s 3"], Float[Array, "N_s 3"]]:
     """(interference, contact_points, normals) of the N_s slices (module docstring):
 
-        delta_j = r(xi_j) sqrt(1 - (e.n_j)^2) + g (R_race - |rho_j|),   r(xi) = D/2 - c(xi).
+        delta_j = r(xi_j) sqrt(1 - (e.n_j)^2) + g (R_race - |rho_j|),   r(xi) = D/2 - c(xi),
+        rho_j = (q_j - c_r) - ((q_j - c_r).a) a.
 
-    `ring_sign` g = +1 inner ring, -1 outer ring; `raceway_radius` R_race; the ring axis is X
-    through `ring_centre`. `roller_axis` must be a unit vector.
+    `ring_sign` g = +1 inner ring, -1 outer ring; `raceway_radius` R_race; the ring axis is the
+    unit vector `ring_axis` a (default X) through `ring_centre`. `roller_axis` must be a unit
+    vector.
     """
     _check_ring_sign(ring_sign)
     g = jnp.asarray(ring_sign, dtype=float)
     e = roller_axis
+    a = _AXIS if ring_axis is None else ring_axis
     xi = slice_positions(bearing)
     q = roller_centre + xi[:, None] * e  # slice centres on the roller axis
     rel = q - ring_centre
-    rho = rel - rel[:, :1] * _AXIS  # radial offset from the ring axis
+    rho = rel - (rel @ a)[:, None] * a  # radial offset from the ring axis
     fallback_n = jnp.broadcast_to(jnp.array([0.0, 0.0, 1.0]), rho.shape)
     dist, n_r = _safe_unit(rho, fallback_n)
 
@@ -232,6 +252,7 @@ def raceway_contact(
     ring_velocity: Float[Array, 3],
     ring_angular_velocity: Float[Array, 3],
     *,
+    ring_axis: Float[Array, 3] | None = None,
     damping: ArrayLike = HUNT_CROSSLEY_ALPHA,
     penetration_width: float = PENETRATION_WIDTH,
     speed_eps: float = SLIDING_EPS,
@@ -239,13 +260,14 @@ def raceway_contact(
     """Sliced roller-raceway contact with Hunt-Crossley damping and traction (module docstring).
 
     Arguments are inertial-frame 3-vectors: roller centre p, unit axis e, velocity v_b, angular
-    velocity w_b; ring centre c_r (ring axis along X), velocity v_r, angular velocity w_r.
+    velocity w_b; ring centre c_r, velocity v_r, angular velocity w_r, unit ring axis
+    `ring_axis` a (default X).
     `damping` is the Hunt-Crossley alpha [s/m]: N_j = q_j s(1 + 1.5 alpha d(delta_j)/dt).
     Vectorised over slices; vmap it over rollers.
     """
     _check_ring_sign(ring_sign)
     delta, x, n = raceway_slice_geometry(
-        bearing, ring_sign, raceway_radius, roller_centre, roller_axis, ring_centre
+        bearing, ring_sign, raceway_radius, roller_centre, roller_axis, ring_centre, ring_axis=ring_axis
     )
     q_el = slice_loads_from_interference(bearing, delta, penetration_width)
 

@@ -2,7 +2,7 @@
 
 Owns: `Bearing` and its parts (`Roller`, `Flange`, `Cage`, `Material`, `Lubricant`), the
 `OperatingPoint`, the reference bearing (MODEL.md 2), unit conversions, the mass properties
-derived from geometry, and the shape of the roller end (corner torus and spherical cap, MODEL.md
+derived from geometry, the inner ring's tilted axis (`ring_axis`), and the shape of the roller end (corner torus and spherical cap, MODEL.md
 4.1: support function, limited circle, arc protrusion, principal curvatures).
 
 The end body lives here rather than in `jaxbearing.flange` because the roller's mass properties
@@ -11,7 +11,7 @@ need it (the arc cap changes the volume), and mass properties sit below every co
 May import: `jaxbearing._errors`. Nothing above it.
 """
 
-from ._inertia import cage_mass_properties, roller_mass_properties
+from ._inertia import cage_mass_properties, inner_ring_inertia, roller_mass_properties
 from ._params import (
     Bearing,
     Cage,
@@ -24,6 +24,7 @@ from ._params import (
     rad_s_to_rpm,
     rpm_to_rad_s,
 )
+from ._ring import ring_axis, ring_tilt_angular_velocity
 from ._roller_end import (
     LIMITED_CIRCLE_BAND,
     SIN_ALPHA_FLOOR,
@@ -54,9 +55,12 @@ __all__ = [
     "end_curvature",
     "end_principal_curvatures",
     "end_support",
+    "inner_ring_inertia",
     "kinematic_cage_speed",
     "limited_circle_radius",
     "rad_s_to_rpm",
+    "ring_axis",
+    "ring_tilt_angular_velocity",
     "roller_mass_properties",
     "rpm_to_rad_s",
     "sag",

@@ -79,3 +79,24 @@ def cage_mass_properties(bearing: Bearing) -> tuple[Array, Array, Array]:
         (do2 + di2) / 16 + pocket_length**2 / 12
     )
     return m, i_polar, i_trans
+
+
+def inner_ring_inertia(bearing: Bearing) -> tuple[Array, Array]:
+    """(axial, transverse) inertia of the inner ring about its centre [kg m^2].
+
+    The ring's effective mass m_i (`Bearing.inner_ring_mass`, which includes the shaft) is taken
+    as a thin-walled cylinder of radius R_i (the inner raceway radius) and width
+    W_r = L_b1 + Delta_bf (the flange spacing):
+
+        I_axial = m_i R_i^2,        I_transverse = m_i (R_i^2 / 2 + W_r^2 / 12)
+
+    (thin cylindrical shell about its axis and about a diameter through its centre; Gere &
+    Goodno, Mechanics of Materials, App. E; the limit of the hollow cylinder's
+    m (R_1^2 + R_2^2)/4 + m L^2/12 as R_1, R_2 -> R_i). Every real ring and shaft has its
+    material at radii <= R_i, so these are upper bounds of the ring's inertia for its mass; they
+    enter only the tilt degrees of freedom (off by default).
+    """
+    m = bearing.inner_ring_mass
+    r = bearing.inner_raceway_radius
+    w = bearing.raceway_width
+    return m * r**2, m * (r**2 / 2 + w**2 / 12)

@@ -190,6 +190,14 @@ class Bearing(eqx.Module):
         _, i_p, i_t = cage_mass_properties(self)
         return jnp.stack([i_p, i_t])
 
+    @property
+    def inner_ring_inertia(self) -> Array:
+        """(I_axial, I_transverse) of the inner ring about its centre [kg m^2]
+        (`_inertia.inner_ring_inertia`)."""
+        from ._inertia import inner_ring_inertia
+
+        return jnp.stack(inner_ring_inertia(self))
+
     def with_flat_ends(self) -> Bearing:
         """The same bearing with flat-end (corner) rollers."""
         return eqx.tree_at(lambda b: b.roller, self, self.roller.with_flat_ends())
@@ -197,11 +205,23 @@ class Bearing(eqx.Module):
 
 class OperatingPoint(eqx.Module):
     """Inner ring driven at `inner_speed`, radial `radial_load` on the inner ring along +Z
-    (the direction of gravity), outer ring fixed."""
+    (the direction of gravity), outer ring fixed.
+
+    Misalignment and inner-ring freedom (docs/model.md, "Misalignment"): the inner ring's axis
+    is tilted by `misalignment` psi_m about +Y (the radial axis perpendicular to the load), so
+    that it points along (cos psi_m, 0, -sin psi_m). `axial_load` F_a acts on the inner ring
+    along +X. `axial_freedom` and `tilt_freedom` are switches (1.0 on, 0.0 off; floats so that
+    they are traced data, not recompilation keys): with them off the ring's axial position and
+    its tilt stay at 0 and at psi_m. All four default to 0 (the aligned, radially loaded ring).
+    """
 
     inner_speed: Scalar = _field()  # omega_i [rad/s]
     radial_load: Scalar = _field()  # F_r [N]
     gravity: Scalar = _field()  # g [m/s^2], 0 switches gravity off
+    misalignment: Scalar = eqx.field(converter=_f, default=0.0)  # psi_m about +Y [rad]
+    axial_load: Scalar = eqx.field(converter=_f, default=0.0)  # F_a along +X [N]
+    axial_freedom: Scalar = eqx.field(converter=_f, default=0.0)  # 1: x_i free, 0: x_i = 0
+    tilt_freedom: Scalar = eqx.field(converter=_f, default=0.0)  # 1: tilt free, 0: tilt = psi_m
 
 
 def rpm_to_rad_s(rpm):

@@ -12,7 +12,8 @@ its meaning, symbol and valid range. The schema and the ranges are `jaxbearing.i
     [materials.roller]   (same)
     [materials.cage]     (same)
     [lubricant]          viscosity_Pa_s, ..., traction_a, traction_b_s_m, traction_c_s_m, traction_d
-    [operating]          speed_rpm, radial_load_N, gravity
+    [operating]          speed_rpm, radial_load_N, gravity, misalignment_mrad, axial_load_N,
+                         inner_ring_axial_freedom, inner_ring_tilt_freedom
     [simulation]         end, duration_ms, rtol, atol, max_steps, progress
 
 Missing keys take the reference value (docs/MODEL.md section 2); unknown keys and sections are
@@ -265,6 +266,10 @@ class Config:
             inner_speed=KEY_BY_PATH["operating.speed_rpm"].to_si(v["operating.speed_rpm"]),
             radial_load=v["operating.radial_load_N"],
             gravity=GRAVITY if v["operating.gravity"] else 0.0,
+            misalignment=KEY_BY_PATH["operating.misalignment_mrad"].to_si(v["operating.misalignment_mrad"]),
+            axial_load=v["operating.axial_load_N"],
+            axial_freedom=1.0 if v["operating.inner_ring_axial_freedom"] else 0.0,
+            tilt_freedom=1.0 if v["operating.inner_ring_tilt_freedom"] else 0.0,
         )
 
     @property

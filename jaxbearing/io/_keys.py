@@ -28,6 +28,7 @@ _UNITS: dict[str, tuple[Callable[[float], float], Callable[[float], float]]] = {
     "um": (lambda x: (x / 1000) * 1e-3, lambda x: x * 1e6),
     "GPa": (lambda x: x * 1e9, lambda x: x / 1e9),
     "deg": (math.radians, math.degrees),
+    "mrad": (lambda x: x * 1e-3, lambda x: x * 1e3),
     "rpm": (rpm_to_rad_s, rad_s_to_rpm),
 }
 

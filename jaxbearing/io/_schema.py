@@ -57,6 +57,9 @@ Schema (ranges; "(" open, "[" closed; symbols as in docs/MODEL.md and the source
 | operating.speed_rpm | n_i | [0, 100000] |
 | operating.radial_load_N | F_r | [0, 1e8] |
 | operating.gravity | g | true / false (9.81 m/s^2 along +Z) |
+| operating.misalignment_mrad | psi_m | [-10, 10] (inner-ring tilt about +Y) |
+| operating.axial_load_N | F_a | [-1e8, 1e8] (along +X); 0 unless inner_ring_axial_freedom |
+| operating.inner_ring_axial_freedom, inner_ring_tilt_freedom | | true / false |
 | simulation.end | | "arc", "corner" or "both" |
 | simulation.duration_ms | | (0, 10000] |
 | simulation.rtol, atol | | (0, 1) |
@@ -131,6 +134,18 @@ def _traction_bounded(v) -> str | None:
         f"{format_derived(peak)} at du = {format_derived(at)} m/s; it must stay within [-1, 1] "
         f"(A = {format_value(a)}, B = {format_value(b)} s/m, C = {format_value(c)} s/m, "
         f"D = {format_value(d)})"
+    )
+
+
+def _axial_load_held(v) -> str | None:
+    """An axial load needs the inner ring's axial freedom: a ring held axially carries it to
+    ground itself, so the load would silently do nothing."""
+    f = v["operating.axial_load_N"]
+    if f == 0.0 or v["operating.inner_ring_axial_freedom"]:
+        return None
+    return (
+        f"{format_value(f)} N needs operating.inner_ring_axial_freedom = true (the ring is held "
+        "axially, so the load would do nothing): must be 0 N while the axial freedom is off"
     )
 
 
@@ -662,6 +677,54 @@ KEYS: tuple[Key, ...] = (
         "g",
         "gravity on every body (9.81 m/s^2 along +Z)",
         attr="op.gravity",
+    ),
+    make_key(
+        "operating.misalignment_mrad",
+        float,
+        0.0,
+        "mrad",
+        "psi_m",
+        "imposed inner-ring misalignment: tilt of the ring axis about +Y (the radial axis "
+        "perpendicular to the radial load; > 0 turns the +X end towards -Z)",
+        constant_bound(-10, True),
+        constant_bound(10, True),
+        attr="op.misalignment",
+    ),
+    make_key(
+        "operating.inner_ring_axial_freedom",
+        bool,
+        False,
+        "",
+        "",
+        "inner ring free to move axially (located by the inner flanges through the rollers)",
+        attr="op.axial_freedom",
+    ),
+    make_key(
+        "operating.inner_ring_tilt_freedom",
+        bool,
+        False,
+        "",
+        "",
+        "inner ring free to tilt about Y and Z (misalignment_mrad is then its initial tilt)",
+        attr="op.tilt_freedom",
+    ),
+    make_key(
+        "operating.axial_load_N",
+        float,
+        0.0,
+        "N",
+        "F_a",
+        "axial load on the inner ring (+X)",
+        constant_bound(-1e8, True),
+        constant_bound(1e8, True),
+        attr="op.axial_load",
+        extras=(
+            Extra(
+                ("operating.inner_ring_axial_freedom",),
+                _axial_load_held,
+                "non-zero only with inner_ring_axial_freedom = true",
+            ),
+        ),
     ),
     # [simulation]
     make_key(

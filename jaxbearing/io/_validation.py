@@ -122,7 +122,8 @@ def validate_bearing(bearing, op=None, *, traced: str = "error") -> None:
     error, naming the configuration key (e.g. ``roller.end_radius_mm: 3.0 mm is out of range:
     must be in (diameter_mm/2 = 3.75, inf] mm``). Stacked (batched) pytrees are checked element
     by element. Gravity, a bool in configuration files, must here be finite and in [0, 100]
-    m/s^2.
+    m/s^2; the switches (`axial_freedom`, `tilt_freedom`, booleans in configuration files) must
+    be 1.0 (true) or 0.0 (false).
 
     Leaves must be concrete: under `jax.jit`/`grad`/`vmap` they are tracers, which raise
     TypeError (`traced="error"`, the default) or, with `traced="skip"` (what the model's entry
@@ -145,6 +146,9 @@ def validate_bearing(bearing, op=None, *, traced: str = "error") -> None:
     shape = np.broadcast_shapes(*(a.shape for a in arrays.values())) if arrays else ()
     if op is not None and not _traced(op.gravity):
         _check_gravity(np.broadcast_to(np.asarray(op.gravity, dtype=float), shape), shape)
+    for k in keys:  # switches (inner-ring freedoms): 1.0 (true) or 0.0 (false)
+        if k.kind is bool and k.path != "operating.gravity":
+            _check_switch(k.path, np.broadcast_to(arrays[k.path].astype(float), shape), shape)
     for idx in np.ndindex(shape):
         values = dict(REFERENCE_VALUES)
         for k in keys:
@@ -172,4 +176,14 @@ def _check_gravity(g: np.ndarray, shape: tuple) -> None:
             "operating.gravity",
             f"{where}{format_value(float(g[idx]))} m/s^2 is "
             "out of range: must be in [0, 100] m/s^2 (9.81 = on, 0 = off)",
+        )
+
+
+def _check_switch(path: str, v: np.ndarray, shape: tuple) -> None:
+    bad = ~((v == 0.0) | (v == 1.0))
+    if bad.any():
+        idx = tuple(int(i) for i in np.argwhere(bad)[0])
+        where = f"(batch element {idx}) " if shape else ""
+        raise ConfigError(
+            path, f"{where}{format_value(float(v[idx]))} is out of range: must be 1.0 (true) or 0.0 (false)"
         )

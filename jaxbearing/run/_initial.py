@@ -90,7 +90,8 @@ def initial_state(bearing: Bearing, op: OperatingPoint, perturbation: Perturbati
         angular_velocity=spin * axis,
     )
     cage = CageState(centre=jnp.zeros(2), angle=jnp.asarray(0.0), velocity=jnp.zeros(2), speed=omega_c)
-    ring = RingState(centre=qs.inner_ring_displacement, velocity=jnp.zeros(2))
+    # radial quasi-static position; axially at 0 and at the imposed misalignment, at rest
+    ring = RingState.aligned(qs.inner_ring_displacement, jnp.zeros(2))
     zeros = jnp.zeros((z, 4))
     acc = Accumulators(pv_power=zeros, height_max_power=zeros, height_min_power=zeros, contact_time=zeros)
     return State(rollers=rollers, cage=cage, inner_ring=ring, accumulators=acc)

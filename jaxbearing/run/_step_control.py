@@ -11,7 +11,8 @@ amplitude; issue 12). Its error estimate reaches the tolerance at steps of about
 the flange statistics do not depend on resolving its phase.
 
 `RacewayNormalNorm` is the max norm with the raceway-normal coordinates of every roller (radial
-position and velocity) and the inner ring's position and velocity weighted by 1/`loosen`:
+position and velocity) and the inner ring's radial position, tilt and their rates (the tilt
+moves the raceway normally, against the same slice stiffness) weighted by 1/`loosen`:
 their tolerances are `loosen` times looser, every other component (axial motion, skew and tilt
 of the axis, spin, orbit, cage) keeps the tolerance it had. With `loosen = 1` it is exactly the
 max norm. An explicit method still keeps the radial mode stable (its step cannot exceed the
@@ -56,7 +57,7 @@ def step_controller(rtol, atol, norm) -> diffrax.PIDController:
 
 def raceway_normal_weights(state: State, loosen) -> State:
     """Weights of the error norm: 1/`loosen` on roller radial position and velocity and on the
-    inner ring's centre and velocity, 1 elsewhere (same pytree as `state`)."""
+    inner ring's centre, tilt and their rates, 1 elsewhere (same pytree as `state`)."""
     w = jnp.asarray(1.0) / jnp.asarray(loosen, dtype=float)
     ones = jax.tree_util.tree_map(jnp.ones_like, state)
     loose = lambda x: w * jnp.ones_like(x)  # noqa: E731
@@ -66,6 +67,8 @@ def raceway_normal_weights(state: State, loosen) -> State:
             s.rollers.radial_velocity,
             s.inner_ring.centre,
             s.inner_ring.velocity,
+            s.inner_ring.tilt,
+            s.inner_ring.tilt_rate,
         ),
         ones,
         replace_fn=loose,
