@@ -28,12 +28,12 @@ no tangential stiffness):
 - each roller's equations depend only on its own unknowns given the cage: for a fixed cage,
   the spin equation is decreasing in s_j and the tangential equation decreasing in phi_j (the
   pocket wall pushes a roller back harder the further it goes in), so both are solved for all
-  rollers at once by bisection on brackets that contain the root (the spin between 0 and three
-  times the outer-raceway rolling spin, the offset across the pocket clearance plus a margin),
+  rollers at once by bisection on brackets that contain the root (the spin between 0 and 1.5
+  times the faster of the outer- and inner-raceway rolling spins, the offset across the pocket clearance plus a margin),
   alternately (block Gauss-Seidel; the coupling is the pocket friction moment);
 - the cage torque, with the rollers in equilibrium, decreases with the cage speed (a faster cage
   drives its rollers faster than the raceways roll them, the traction brakes them and they push
-  back on the pockets): the Illinois regula falsi on omega_c in [0.6, 1.02] x kinematic;
+  back on the pockets): the Illinois regula falsi on omega_c in [0.2, 1.02] x kinematic;
 - the cage centre: Newton's method on the 2-vector force balance with the rollers riding along
   with their pockets (smooth: the Ocvirk land film), the step capped inside the guiding
   clearance; cage speed and centre alternate twice.
@@ -63,7 +63,7 @@ _GAUSS_SEIDEL_ROUNDS = 3
 _SPEED_ITERATIONS = 30
 _SPEED_RTOL = 1e-10
 #: cage speed bracket, relative to the kinematic speed
-SPEED_BRACKET = (0.6, 1.02)
+SPEED_BRACKET = (0.2, 1.02)
 #: Newton steps on the cage centre, alternations of cage speed and centre
 _CENTRE_NEWTON = 12
 _ALTERNATIONS = 4
@@ -119,8 +119,13 @@ def _roller_balance(params: Params, base: State, omega_c, centre, offset0):
     z = base.rollers.azimuth.shape[0]
     n = _BISECTION_STEPS
     rolling_spin = -omega_c * b.pitch_diameter / b.roller.diameter  # pure rolling on the outer race
+    # pure rolling on the inner race (ring at omega_i, roller centre on the pitch circle)
+    inner_spin = (
+        -(params.operating.inner_speed - omega_c) * (b.pitch_diameter - b.roller.diameter) / b.roller.diameter
+    )
     half_range = (b.cage.pocket_clearance / 2 + 0.1 * b.roller.diameter) / (b.pitch_diameter / 2)
-    s_range = (3.0 * rolling_spin * jnp.ones(z), jnp.zeros(z))  # spin < 0: lo is the faster
+    # spin < 0: lo is the faster; the balance lies between the two rolling spins
+    s_range = (1.5 * jnp.minimum(rolling_spin, inner_spin) * jnp.ones(z), jnp.zeros(z))
     o_range = (-half_range * jnp.ones(z), half_range * jnp.ones(z))
 
     def step(k, carry):
