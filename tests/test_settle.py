@@ -150,3 +150,12 @@ def test_demo_paper_table_shows_settled_estimates_with_intervals():
     table = paper_table(summaries)
     assert "1.5 [1.2, 1.8]" in table and "about 4.8" in table
     assert "0.35" in paper_table({"arc": {"flange_pressure_Pa": {"max": 0.35e9}}})
+
+
+@pytest.mark.parametrize("kwargs, name", [({"start": "warm"}, "start"), ({"workers": 0}, "workers")])
+def test_bad_start_or_workers_in_python_one_line(kwargs, name):
+    import jaxbearing as jb
+    from jaxbearing import UserInputError
+
+    with pytest.raises(UserInputError, match=f"^{name} = "):
+        jb.simulate(jb.reference_bearing(), jb.reference_operating_point(), settle="auto", **kwargs)

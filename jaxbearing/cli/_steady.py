@@ -69,20 +69,22 @@ def options(args) -> dict | None:
         "seeds": "--seeds",
         "tolerance": "--settle-tolerance",
         "cap_ms": "--settle-cap-ms",
+        "start": "--start",
+        "workers": "--workers",
     }
-    check_steady_options(
-        settle, args.window_revs, args.seeds, args.settle_tolerance, args.settle_cap_ms, names
-    )
-    from ..io import require
-    from ..run import STARTS, available_cpus
+    from ..run import available_cpus
 
     workers = available_cpus() if args.workers is None else args.workers
-    require("--workers", workers, lambda v: (v >= 1) & (v == np.round(v)), "an integer >= 1")
-
-    if args.start not in STARTS:
-        from .._errors import UserInputError
-
-        raise UserInputError(f"--start = {args.start!r}: must be one of {', '.join(map(repr, STARTS))}")
+    check_steady_options(
+        settle,
+        args.window_revs,
+        args.seeds,
+        args.settle_tolerance,
+        args.settle_cap_ms,
+        names,
+        start=args.start,
+        workers=workers,
+    )
     return dict(
         settle=settle if settle in ("auto", "off") else float(settle),
         window_revs=int(args.window_revs),

@@ -130,7 +130,9 @@ class SeedRun:
     start_cage_speed_rpm: float = float("nan")
 
 
-def check_steady_options(settle, window_revs, seeds, tolerance, cap_ms, names=None) -> None:
+def check_steady_options(
+    settle, window_revs, seeds, tolerance, cap_ms, names=None, *, start="skid", workers=1
+) -> None:
     """One-line `UserInputError` naming the option for a bad value of the settled-run options."""
     n = {
         "settle": "settle",
@@ -138,8 +140,15 @@ def check_steady_options(settle, window_revs, seeds, tolerance, cap_ms, names=No
         "seeds": "seeds",
         "tolerance": "settle_tolerance",
         "cap_ms": "settle_cap_ms",
+        "start": "start",
+        "workers": "workers",
         **(names or {}),
     }
+    if start not in STARTS:
+        from .._errors import UserInputError
+
+        raise UserInputError(f"{n['start']} = {start!r}: must be one of {', '.join(map(repr, STARTS))}")
+    require(n["workers"], workers, lambda v: (v >= 1) & (v == np.round(v)), "an integer >= 1")
     if not (isinstance(settle, str) and settle in ("auto", "off")):
         require(
             n["settle"],
@@ -338,11 +347,7 @@ def simulate_steady(
     from ..io import validate_bearing
 
     validate_bearing(bearing, op)
-    check_steady_options(settle, window_revs, seeds, tolerance, settle_cap_ms)
-    if start not in STARTS:
-        from .._errors import UserInputError
-
-        raise UserInputError(f"start = {start!r}: must be one of {', '.join(map(repr, STARTS))}")
+    check_steady_options(settle, window_revs, seeds, tolerance, settle_cap_ms, start=start, workers=workers)
     kwargs = dict(
         settle=settle,
         window_revs=window_revs,
@@ -356,11 +361,11 @@ def simulate_steady(
         functionals=functionals,
         progress=progress,
     )
+    perturbations = [dataclasses.replace(perturbation, seed=perturbation.seed + k) for k in range(int(seeds))]
     workers = min(int(seeds), int(workers))
-    if int(seeds) > 1 and workers > 1:
+    if workers > 1:
         wall0 = time.perf_counter()
-        seeds_run = [dataclasses.replace(perturbation, seed=perturbation.seed + k) for k in range(int(seeds))]
-        outs = parallel_map(_SteadySeed(bearing, op, kwargs), seeds_run, workers=workers)
+        outs = parallel_map(_SteadySeed(bearing, op, kwargs), perturbations, workers=workers)
         return dataclasses.replace(
             outs[0],
             runs=[o.runs[0] for o in outs],
@@ -370,8 +375,7 @@ def simulate_steady(
         )
     params = Params(bearing=bearing, operating=op, functionals=functionals)
     runs, wall0, compile_time = [], time.perf_counter(), 0.0
-    for seed in range(int(seeds)):
-        pert = dataclasses.replace(perturbation, seed=perturbation.seed + seed)
+    for pert in perturbations:
         if start == "skid":  # its compilation and solve count in the wall time
             skid = skid_start(bearing, op, pert)
             y0, tau = skid.state, float(skid.time_constant)
@@ -381,7 +385,7 @@ def simulate_steady(
         _compiled(params, y0, int(saves_per_rev), int(max_steps))
         compile_time += time.perf_counter() - c0
         if progress:
-            print(f"seed {seed}: settling ({settle}), then {window_revs} revolutions", flush=True)
+            print(f"seed {pert.seed}: settling ({settle}), then {window_revs} revolutions", flush=True)
         out = _run_seed(
             params,
             y0,
@@ -396,9 +400,7 @@ def simulate_steady(
             progress=progress,
             time_constant=tau,
         )
-        runs.append(
-            SeedRun(perturbation.seed + seed, *out, start_cage_speed_rpm=float(rad_s_to_rpm(y0.cage.speed)))
-        )
+        runs.append(SeedRun(pert.seed, *out, start_cage_speed_rpm=float(rad_s_to_rpm(y0.cage.speed))))
     wall = time.perf_counter() - wall0 - compile_time
     return SteadyResult(
         runs=runs,

@@ -41,6 +41,7 @@ from ..flange import (
 )
 from ..geometry import Bearing, OperatingPoint
 from ..io import require
+from ._initial import Perturbation
 from ._settle import simulate_steady, summarise_steady
 
 #: default dynamic corner margin [m]: 99 % of the contact time this far inside the limited circle
@@ -87,8 +88,6 @@ def steady_design_metrics(
     require("corner_margin", corner_margin, lambda v: np.isfinite(v) & (v >= 0), ">= 0 m")
     require("first_seed", first_seed, lambda v: (v >= 0) & (v == np.round(v)), "an integer >= 0")
     b = with_design(bearing, design.end_radius, design.layback_angle, design.axial_clearance)
-    from ._initial import Perturbation
-
     pert = steady_kwargs.pop("perturbation", Perturbation())
     pert = dataclasses.replace(pert, seed=int(first_seed))
     result = simulate_steady(
