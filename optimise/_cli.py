@@ -1,5 +1,11 @@
 """`optimise` command line: `optimise run [...]`.
 
+Objectives: `--objective steady` (default; `_steady`: the mean flange PV of settled running,
+seeds, CIs, the dynamic corner margin, continuation, resume from DIR/checkpoint.pkl,
+verification on unseen seeds) and `--objective startup` (`_search`: the smooth peak PV of the
+first 0.3 ms from a seated start, the old transient objective: fast, but it measures how hard
+seated rollers are first driven onto their flanges, not how a design runs).
+
 Prints per-iteration progress (objective, smallest constraint margin and which, design of every
 start), the final design with its constraint status and the improvement over the starting
 design; writes DIR/result.json and DIR/search_paths.png (search paths over the design-zone
@@ -92,10 +98,37 @@ def build_parser() -> argparse.ArgumentParser:
         choices=("max", "mean"),
         help="robust objective: smooth worst case (max, default) or weighted mean",
     )
-    r.add_argument("--starts", type=int, help="number of parallel starts (default 4)")
-    r.add_argument("--iterations", type=int, help="iterations (default 20)")
+    r.add_argument(
+        "--objective",
+        help="steady (default): mean flange PV of settled running over seeds, verified on unseen "
+        "seeds; startup: the old transient objective (smooth peak PV of the first 0.3 ms)",
+    )
+    r.add_argument("--starts", type=int, help="number of starts (default 2 steady, 4 startup)")
+    r.add_argument("--iterations", type=int, help="iterations (default 6 steady, 20 startup)")
     r.add_argument("--learning-rate", type=float, help="Adam step size in scaled units (default 0.08)")
-    r.add_argument("--duration-ms", type=float, help="simulated time per evaluation [ms] (default 0.3)")
+    r.add_argument("--seeds", type=int, help="steady: seeds per evaluation (default 4)")
+    r.add_argument("--window-revs", type=int, help="steady: cage revolutions measured (default 2)")
+    r.add_argument("--settle", help="steady: auto (default) or a fixed settling time in ms before the window")
+    r.add_argument(
+        "--gradient-window-ms",
+        type=float,
+        help="steady: length of the short-window sensitivities [ms] (default 1.0)",
+    )
+    r.add_argument(
+        "--estimator",
+        help="steady: gradient estimator, frozen-load (default) or short-window forward mode",
+    )
+    r.add_argument(
+        "--corner-margin-mm",
+        type=float,
+        help="steady: p99 of the contact radius this far inside the limited circle (default 0.05)",
+    )
+    r.add_argument("--verify-seeds", type=int, help="steady: unseen seeds of the verification (default 4)")
+    r.add_argument("--no-verify", action="store_true", help="steady: skip the verification")
+    r.add_argument("--workers", type=int, help="steady: processes (default: one per CPU)")
+    r.add_argument(
+        "--duration-ms", type=float, help="startup: simulated time per evaluation [ms] (default 0.3)"
+    )
     r.add_argument("--rtol", type=float, help="solver rtol (default 1e-3)")
     r.add_argument("--atol", type=float, help="solver atol (default 1e-6)")
     r.add_argument("--out", default="optimise_out", help="output directory (default optimise_out)")
@@ -119,8 +152,17 @@ def _settings(args) -> dict:
         ("loads_N", _floats(args.loads_N, "--loads-N") if args.loads_N else None),
         ("weights", _floats(args.weights, "--weights") if args.weights else None),
         ("aggregate", args.aggregate),
+        ("objective", args.objective),
         ("starts", args.starts),
         ("iterations", args.iterations),
+        ("seeds", args.seeds),
+        ("window_revs", args.window_revs),
+        ("settle", args.settle),
+        ("gradient_window_ms", args.gradient_window_ms),
+        ("estimator", args.estimator),
+        ("corner_margin_mm", args.corner_margin_mm),
+        ("verify_seeds", args.verify_seeds),
+        ("workers", args.workers),
         ("learning_rate", args.learning_rate),
         ("duration_ms", args.duration_ms),
         ("rtol", args.rtol),
@@ -164,12 +206,40 @@ def problem_from_settings(bearing, op, s: dict):
         rtol=_positive(s, "rtol", 1e-3),
         atol=_positive(s, "atol", 1e-6),
     )
+    steady = objective_of(s) == "steady"
     options = dict(
-        num_starts=int(_positive(s, "starts", 4, int)),
-        num_iterations=int(_positive(s, "iterations", 20, int)),
+        num_starts=int(_positive(s, "starts", 2 if steady else 4, int)),
+        num_iterations=int(_positive(s, "iterations", 6 if steady else 20, int)),
         learning_rate=_positive(s, "learning_rate", 0.08),
     )
     return problem, options
+
+
+def objective_of(s: dict) -> str:
+    objective = s.get("objective", "steady")
+    if objective not in ("steady", "startup"):
+        raise UserInputError(f"objective = {objective!r}: must be 'steady' or 'startup'")
+    return objective
+
+
+def steady_settings_from(s: dict):
+    """SteadySettings from merged settings (engineering units)."""
+    from ._steady import SteadySettings
+
+    settle = s.get("settle", "auto")
+    if settle != "auto":
+        settle = _positive({"settle": settle}, "settle", 0.0, strict=False)
+    return SteadySettings(
+        seeds=int(_positive(s, "seeds", 4, int)),
+        window_revs=int(_positive(s, "window_revs", 2, int)),
+        settle=settle,
+        gradient_window=_positive(s, "gradient_window_ms", 1.0) * 1e-3,
+        estimator=s.get("estimator", "frozen"),
+        corner_margin=_positive(s, "corner_margin_mm", 0.05, strict=False) * 1e-3,
+        rtol=_positive(s, "rtol", 1e-3),
+        workers=int(_positive(s, "workers", 0, int, strict=False)),
+        verify_seeds=int(_positive(s, "verify_seeds", 4, int)),
+    )
 
 
 def _design_text(x) -> str:
@@ -207,6 +277,8 @@ def run(args) -> int:
     except OSError as exc:
         raise UserInputError(f"--out {args.out}: cannot create directory: {exc.strerror}") from None
 
+    if objective_of(s) == "steady":
+        return run_steady(args, problem, options, steady_settings_from(s), out)
     k = problem.num_operating_points
     print(
         f"optimise: {options['num_starts']} starts x {k} operating point(s), "
@@ -272,6 +344,148 @@ def run(args) -> int:
     )
     print(f"wrote {out / 'result.json'} and {plot_path}")
     return 0
+
+
+def run_steady(args, problem, options, settings, out) -> int:
+    """`optimise run --objective steady` (the default): `_steady.steady_search` with progress,
+    checkpoint and resume in `out`, verification, result.json and the search-path plot."""
+    import numpy as np
+
+    from jaxbearing.io import write_json
+
+    from ._plot import plot_search
+    from ._steady import CONSTRAINT_NAMES, steady_search
+
+    k = problem.num_operating_points
+    print(
+        f"optimise (steady running): {options['num_starts']} starts x {k} operating point(s), "
+        f"{options['num_iterations']} iterations; each evaluation {settings.seeds} seeds, settle "
+        f"{settings.settle}, {settings.window_revs}-revolution window, gradient from "
+        f"{2 * settings.seeds} windows of {settings.gradient_window * 1e3:g} ms; checkpoint in {out}"
+    )
+    sys.stdout.flush()
+
+    def progress(it, info):
+        if args.quiet:
+            return
+        best = info["best"]
+        print(
+            f"iter {it:3d}  best feasible {best:.4f} GPa m/s"
+            if np.isfinite(best)
+            else f"iter {it:3d}  best feasible   none yet"
+        )
+        for j in range(info["x"].shape[0]):
+            m = info["margins"][j]
+            w = int(np.argmin(m))
+            lo, hi = info["ci"][j]
+            g = info["gradient"][j]
+            print(
+                f"   start {j}: J {info['objective'][j]:7.4f} [{lo:.4f}, {hi:.4f}] GPa m/s  "
+                f"min margin {CONSTRAINT_NAMES[w]} {m[w] * 1e3:+.4f} mm  {_design_text(info['x'][j])}  "
+                f"dJ/du ({g[0]:+.3f}, {g[1]:+.3f}, {g[2]:+.3f})"
+            )
+        sys.stdout.flush()
+
+    res = steady_search(
+        problem, settings, directory=out, callback=progress, verify=not args.no_verify, **options
+    )
+    if res.resumed_from >= 0 and not args.quiet:
+        print(f"(resumed after iteration {res.resumed_from} from {out / 'checkpoint.pkl'})")
+    write_json(out / "result.json", _steady_result_json(problem, options, settings, res))
+    plot_path = out / "search_paths.png"
+    plot_search(problem, res, plot_path)
+    if res.status != "ok":
+        print(
+            "optimise: no feasible design within the bounds"
+            if res.status == "no_feasible_design_in_bounds"
+            else "optimise: no iterate satisfied every static and dynamic margin; try more --iterations",
+            file=sys.stderr,
+        )
+        print(f"wrote {out / 'result.json'} and {plot_path}")
+        return EXIT_INFEASIBLE
+    lo, hi = res.objective_ci
+    print(
+        f"final design: {_design_text(res.design)}  (start {res.best_start}, iteration {res.best_iteration})"
+    )
+    print(f"  steady mean PV {res.objective:.4f} [{lo:.4f}, {hi:.4f}] GPa m/s (search seeds)")
+    v = res.verification
+    if v:
+        for name in ("reference", "optimum"):
+            row = v[name] if "mean_pv_GPa_m_s" in v[name] else v[name]["per_operating_point"][0]
+            e, c = row["mean_pv_GPa_m_s"], row["corner_contact_share"]
+            print(
+                f"  verification {name:9s} mean PV {e['value']:.4f} [{e['ci95_low']:.4f}, "
+                f"{e['ci95_high']:.4f}] GPa m/s, corner share {c['value']:.3f} (seeds {v['seeds'][0]}-{v['seeds'][-1]})"
+            )
+        if "mean_pv_lower_disjoint" in v:
+            print(f"  verified lower mean PV with disjoint 95 % CIs: {v['mean_pv_lower_disjoint']}")
+    print(f"  {res.num_evaluations} settled ensembles, {res.wall_time_s:.1f} s wall")
+    print(f"wrote {out / 'result.json'} and {plot_path}")
+    return 0
+
+
+def _engineering(x):
+    if x is None:
+        return None
+    return {
+        "end_radius_mm": float(x[0]) * 1e3,
+        "layback_angle_deg": math.degrees(float(x[1])),
+        "axial_clearance_mm": float(x[2]) * 1e3,
+    }
+
+
+def _steady_result_json(problem, options, settings, res) -> dict:
+    import dataclasses
+
+    import numpy as np
+
+    from ._steady import CONSTRAINT_NAMES
+
+    h = res.history
+    x = np.asarray(h["x"]) if len(h["x"]) else np.zeros((0, 0, 3))
+    margins = np.asarray(h["margins"]) if len(h["margins"]) else np.zeros((0, 0, 5))
+    return {
+        "objective_kind": "steady",
+        "status": res.status,
+        "feasible": bool(res.feasible),
+        "design": _engineering(res.design),
+        "objective_GPa_m_s": {
+            "value": res.objective,
+            "ci95_low": None if res.objective_ci is None else res.objective_ci[0],
+            "ci95_high": None if res.objective_ci is None else res.objective_ci[1],
+        },
+        "start_design": _engineering(res.start_design),
+        "verification": res.verification,
+        "bounds": problem.bounds.engineering(),
+        "operating_points": [
+            {"speed_rpm": float(w) * 60 / (2 * math.pi), "load_N": float(f)}
+            for w, f in zip(
+                np.asarray(problem.operating.inner_speed), np.asarray(problem.operating.radial_load)
+            )
+        ],
+        "weights": [float(v) for v in np.asarray(problem.weights)],
+        "aggregate": problem.aggregate,
+        "settings": {
+            k: (v if not isinstance(v, float) else float(v)) for k, v in dataclasses.asdict(settings).items()
+        },
+        "search": dict(options),
+        "num_settled_ensembles": res.num_evaluations,
+        "simulated_ms": float(np.sum(h["simulated_ms"])) if len(h["simulated_ms"]) else 0.0,
+        "resumed_from_iteration": res.resumed_from,
+        "wall_time_s": res.wall_time_s,
+        "history": {
+            "objective_GPa_m_s": np.asarray(h["objective"]).tolist(),
+            "ci95_GPa_m_s": np.asarray(h["ci"]).tolist(),
+            "gradient_per_unit_box": np.asarray(h["gradient"]).tolist(),
+            "gradient_stderr": np.asarray(h["gradient_stderr"]).tolist(),
+            "end_radius_mm": (x[..., 0] * 1e3).tolist(),
+            "layback_angle_deg": np.degrees(x[..., 1]).tolist(),
+            "axial_clearance_mm": (x[..., 2] * 1e3).tolist(),
+            "margins_mm": {n: (margins[..., i] * 1e3).tolist() for i, n in enumerate(CONSTRAINT_NAMES)},
+            "wall_s": np.asarray(h["wall_s"]).tolist(),
+            "simulated_ms": np.asarray(h["simulated_ms"]).tolist(),
+        },
+    }
 
 
 def _result_json(problem, options, res) -> dict:

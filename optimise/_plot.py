@@ -12,7 +12,9 @@ def plot_search(problem, result, path) -> pathlib.Path:
     """Write a PNG of every start's path in (R_end, theta_f) over the feasibility map of the
     design zone (`jaxbearing.design_zone_grid`, at the final Delta_bf, or the start's when no
     feasible design was found): feasible region shaded, zero lines of each margin, starts as
-    circles, the final design as a star."""
+    circles, the final design as a star. For a steady search (five margins per iterate), the
+    dynamic corner margin's zero line too, dashed (`_steady`: the limited-circle margin equal to
+    the skew excursion measured at the final design plus the corner margin)."""
     from jaxbearing.io import pyplot
 
     plt = pyplot()
@@ -37,6 +39,16 @@ def plot_search(problem, result, path) -> pathlib.Path:
             ax.contour(rr, tt, m, levels=[0.0], colors=colour, linewidths=1.2)
             ax.plot([], [], color=colour, label=f"{label} margin = 0")
     h = result.history
+    margins = np.asarray(h.get("margins", [])) if h else np.zeros(0)
+    if margins.ndim == 3 and margins.shape[-1] == 5 and getattr(result, "best_iteration", -1) >= 0:
+        # steady search: the dynamic corner margin, with the skew excursion p99 - rho_c measured
+        # at the final design: limited-circle margin = excursion + corner margin
+        m = margins[result.best_iteration, result.best_start]
+        offset = m[2] - m[4]
+        lc = np.asarray(z.limited_circle_margin)
+        if lc.min() < offset < lc.max():
+            ax.contour(rr, tt, lc, levels=[offset], colors="tab:purple", linestyles="--", linewidths=1.2)
+            ax.plot([], [], color="tab:purple", ls="--", label="dynamic corner margin = 0 (measured skew)")
     if h:
         xs = np.asarray(h["x"])  # (I, S, 3)
         for s in range(xs.shape[1]):

@@ -171,7 +171,23 @@ OPTIMISE_TOML_KEYS = {
     "bounds": ("end_radius_mm", "layback_angle_deg", "axial_clearance_mm"),
     "constraints": ("min_clearance_mm", "flange_load_N"),
     "envelope": ("speeds_rpm", "loads_N", "weights", "aggregate", "temperature_GPa_m_s"),
-    "search": ("starts", "iterations", "learning_rate", "duration_ms", "rtol", "atol"),
+    "search": (
+        "objective",
+        "starts",
+        "iterations",
+        "learning_rate",
+        "duration_ms",
+        "rtol",
+        "atol",
+        "seeds",
+        "window_revs",
+        "settle",
+        "gradient_window_ms",
+        "estimator",
+        "corner_margin_mm",
+        "verify_seeds",
+        "workers",
+    ),
 }
 
 
@@ -183,7 +199,9 @@ def load_optimise_toml(path: str) -> dict:
         [constraints]  min_clearance_mm = 0.0, flange_load_N = 100
         [envelope]     speeds_rpm = [...], loads_N = [...], weights = [...],
                        aggregate = "max" | "mean", temperature_GPa_m_s = 0.1
-        [search]       starts, iterations, learning_rate, duration_ms, rtol, atol
+        [search]       objective = "steady" | "startup", starts, iterations, learning_rate,
+                       rtol; steady: seeds, window_revs, settle, gradient_window_ms, estimator,
+                       corner_margin_mm, verify_seeds, workers; startup: duration_ms, atol
 
     Returns a flat dict {key: value}; unknown sections or keys raise UserInputError."""
     try:

@@ -46,3 +46,13 @@ def test_sweep_spec_validates(path):
 def test_optimise_settings_parse():
     settings = load_optimise_toml(str(EXAMPLES / "optimise.toml"))
     assert settings["end_radius_mm"] == [60.0, 120.0]
+
+
+def test_optimise_example_builds_the_steady_settings():
+    from optimise._cli import objective_of, steady_settings_from
+
+    settings = load_optimise_toml(str(EXAMPLES / "optimise.toml"))
+    assert objective_of(settings) == "steady"
+    s = steady_settings_from(settings)
+    assert (s.seeds, s.window_revs, s.settle, s.estimator) == (4, 2, "auto", "frozen")
+    assert s.gradient_window == 1e-3 and s.corner_margin == 0.05e-3

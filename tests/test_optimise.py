@@ -146,6 +146,8 @@ def test_search_no_worse_than_grid(searched):
 def _cli_args(out):
     return [
         "run",
+        "--objective",
+        "startup",
         "--starts",
         str(STARTS),
         "--iterations",
@@ -174,7 +176,19 @@ def test_cli_end_to_end(tmp_path, capsys, searched):
 
 def test_cli_no_feasible_design_exits_nonzero(tmp_path, capsys):
     out = tmp_path / "none"
-    code = main(["run", "--end-radius-mm", "60,70", "--layback-deg", "1.0,1.1", "--out", str(out)])
+    code = main(
+        [
+            "run",
+            "--objective",
+            "startup",
+            "--end-radius-mm",
+            "60,70",
+            "--layback-deg",
+            "1.0,1.1",
+            "--out",
+            str(out),
+        ]
+    )
     assert code == EXIT_INFEASIBLE
     err = capsys.readouterr().err
     assert "no feasible design exists within the bounds" in err

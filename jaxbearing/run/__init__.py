@@ -12,7 +12,10 @@
   `batch_means`, `student_t_interval`, `Estimate`;
 - settled running: `simulate_steady` (settling detection over cage revolutions, a window,
   seeds), `summarise_steady`, `steady_design_metrics` (the steady-running design objective:
-  mean and p95 PV over contact time, corner share and margin, static margins), `solve_from` (continue from any state), `check_steady_options`;
+  mean and p95 PV over contact time, corner share and margin, static margins; continuation from
+  given states), `steady_gradient` (its gradient: ensemble of short-window forward-mode
+  sensitivities from settled states), `tangent_growth` (finite-time growth of the tangents),
+  `solve_from` / `prepare_from` (continue from any state), `check_steady_options`;
 - design metrics through the dynamics: `design_metrics`, `design_jacobian`, `DesignMetrics`,
   `seated_perturbation`, `forward_jacobian`;
 - `plot_run`: the figures of one run;
@@ -51,6 +54,7 @@ from ._settle import (
     SeedRun,
     SteadyResult,
     check_steady_options,
+    prepare_from,
     simulate,
     simulate_steady,
     solve_from,
@@ -67,10 +71,27 @@ from ._statistics import (
     student_t_interval,
 )
 from ._steady_design import CORNER_MARGIN, SteadyDesignMetrics, steady_design_metrics
+from ._steady_gradient import (
+    GRADIENT_WINDOW,
+    STEADY_FUNCTIONALS,
+    SteadyGradient,
+    frozen_load_gradient,
+    ratio_gradient,
+    steady_gradient,
+    tangent_growth,
+)
 from ._step_control import RACEWAY_NORMAL_LOOSEN, RacewayNormalNorm, raceway_normal_norm
 from ._summary import FILM_KEYS, contact_events, film_statistics
 
 __all__ = [
+    "GRADIENT_WINDOW",
+    "STEADY_FUNCTIONALS",
+    "SteadyGradient",
+    "frozen_load_gradient",
+    "ratio_gradient",
+    "steady_gradient",
+    "tangent_growth",
+    "prepare_from",
     "available_cpus",
     "STARTS",
     "SkidStart",

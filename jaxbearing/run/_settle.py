@@ -43,6 +43,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from .._errors import UserInputError
 from ..dynamics import Functionals, Params, Scaling, State, state_scales
 from ..geometry import Bearing, OperatingPoint, kinematic_cage_speed, rad_s_to_rpm
 from ..io import require
@@ -72,27 +73,38 @@ PROJECTIVE_CAP = 0.05
 PROJECTIVE_THRESHOLD = 0.25
 
 
-def solve_from(params: Params, start: State, duration, *, num_saves: int, rtol, atol, max_steps: int):
-    """Integrate from the physical state `start` over [0, duration]: (histories, final state,
-    diffrax result code, steps). Accumulators restart from zero. jit-able."""
+def prepare_from(params: Params, start: State, rtol, atol):
+    """What a solve from the physical state `start` needs: (scaling, solve arguments, scaled
+    start with the accumulators at zero, step controller), with `solve`'s error norm; the
+    scaling's nominal orbit runs at the start's own cage speed."""
     b = params.bearing
     zero_acc = jax.tree_util.tree_map(jnp.zeros_like, start.accumulators)
     start = State(rollers=start.rollers, cage=start.cage, inner_ring=start.inner_ring, accumulators=zero_acc)
     scaling = Scaling(
         nominal=start, scale=state_scales(b.num_rollers, b.pitch_diameter / 2), orbit_speed=start.cage.speed
     )
-    args = SolveArgs(params=params, scaling=scaling)
-    saveat = diffrax.SaveAt(
-        subs=[
-            diffrax.SubSaveAt(ts=jnp.linspace(0.0, duration, num_saves + 1)[:-1], fn=_save),
-            diffrax.SubSaveAt(t1=True),
-        ]
-    )
     y0_scaled = scaling.scale_state(0.0, start)
     controller = step_controller(rtol, atol, raceway_normal_norm(y0_scaled))
+    return scaling, SolveArgs(params=params, scaling=scaling), y0_scaled, controller
+
+
+def solve_from(
+    params: Params, start: State, duration, *, num_saves: int, rtol, atol, max_steps: int, adjoint=None
+):
+    """Integrate from the physical state `start` over [0, duration]: (histories, final state,
+    diffrax result code, steps). Accumulators restart from zero. jit-able; `adjoint` as in
+    `solve` (`diffrax.ForwardMode()` for forward-mode derivatives; `num_saves = 0` keeps only
+    the final state)."""
+    scaling, args, y0_scaled, controller = prepare_from(params, start, rtol, atol)
+    last = diffrax.SubSaveAt(t1=True)
+    if num_saves:
+        saves = diffrax.SubSaveAt(ts=jnp.linspace(0.0, duration, num_saves + 1)[:-1], fn=_save)
+        saveat = diffrax.SaveAt(subs=[saves, last])
+    else:
+        saveat = diffrax.SaveAt(subs=[last])
     with checks_without_host_callbacks():  # the same integrator and error norm as `solve`
-        sol = _diffeqsolve(y0_scaled, args, duration, saveat, controller, max_steps, None, False)
-    hist, final = sol.ys
+        sol = _diffeqsolve(y0_scaled, args, duration, saveat, controller, max_steps, adjoint, False)
+    hist, final = sol.ys if num_saves else ({}, sol.ys[0])
     final = scaling.unscale(duration, jax.tree_util.tree_map(lambda a: a[-1], final))
     return hist, final, result_code(sol.result), jnp.asarray(sol.stats["num_steps"])
 
@@ -127,6 +139,14 @@ class SeedRun:
     status: str
     num_steps: int
     projective_steps_rpm: list = dataclasses.field(default_factory=list)  # cage speed moves
+    #: per window revolution, (sum of int w (PV/PV_ref)^p dt, sum of int w dt) over every roller
+    #: and flange contact: the accumulators of `Params.functionals` (with p = 1 the smooth mean
+    #: PV over contact time is PV_ref times their ratio; `_steady_design`)
+    window_integrals: list = dataclasses.field(default_factory=list)
+    #: the states at the start of the window and at the end of the run (numpy leaves): states
+    #: of settled running (samples for `steady_gradient`, starts for a neighbouring design)
+    window_start_state: object = None
+    final_state: object = None
     start_cage_speed_rpm: float = float("nan")
 
 
@@ -210,7 +230,8 @@ def _run_seed(
     on the projective steps of the cage speed."""
     compiled = _compiled(params, start, saves, max_steps)
     state, t, steps = start, 0.0, 0
-    speeds, ends, windows, edges, jumps = [], [], [], [], []
+    speeds, ends, windows, edges, jumps, integrals = [], [], [], [], [], []
+    window_start = start
     since_jump = 0  # revolutions run since the last projective step
     settled, settle_time, status = settle == "off", 0.0, "ok"
     fixed = None if isinstance(settle, str) else float(settle) * 1e-3
@@ -219,6 +240,8 @@ def _run_seed(
         rev = 2 * math.pi / abs(float(state.cage.speed))
         if not measuring and fixed is not None:
             rev = min(rev, fixed - t)
+        if measuring and not windows:
+            window_start = state
         hist, final, code, n = compiled(params, state, jnp.asarray(rev), jnp.asarray(rtol), jnp.asarray(atol))
         hist = {k: np.asarray(v) for k, v in hist.items() if k != "accumulators"}
         steps += int(n)
@@ -241,6 +264,8 @@ def _run_seed(
         if measuring:
             windows.append(hist)
             edges.append(t - rev)
+            acc = final.accumulators  # integrals over this revolution (they restart per chunk)
+            integrals.append((float(jnp.sum(acc.pv_power)), float(jnp.sum(acc.contact_time))))
             if len(windows) == window_revs:
                 edges.append(t)
                 break
@@ -268,7 +293,20 @@ def _run_seed(
         elif t >= cap:
             settled, settle_time, measuring = False, t, True
     window = {k: np.concatenate([w[k] for w in windows]) for k in windows[0]} if windows else {}
-    return window, np.asarray(edges), settle_time, settled, speeds, ends, status, steps, jumps
+    host = [jax.tree_util.tree_map(np.asarray, x) for x in (window_start, state)]
+    return (
+        window,
+        np.asarray(edges),
+        settle_time,
+        settled,
+        speeds,
+        ends,
+        status,
+        steps,
+        jumps,
+        integrals,
+        *host,
+    )
 
 
 @dataclasses.dataclass
@@ -312,9 +350,16 @@ class _SteadySeed:
     op: OperatingPoint
     kwargs: dict
 
-    def __call__(self, perturbation: Perturbation) -> SteadyResult:
+    def __call__(self, item) -> SteadyResult:
+        perturbation, state = item
         return simulate_steady(
-            self.bearing, self.op, seeds=1, perturbation=perturbation, workers=1, **self.kwargs
+            self.bearing,
+            self.op,
+            seeds=1,
+            perturbation=perturbation,
+            workers=1,
+            initial_states=None if state is None else [state],
+            **self.kwargs,
         )
 
 
@@ -336,6 +381,7 @@ def simulate_steady(
     functionals: Functionals = Functionals(),
     progress: bool = False,
     workers: int = 1,
+    initial_states=None,
 ) -> SteadyResult:
     """Settle (module docstring), then measure `window_revs` cage revolutions, for each of
     `seeds` seeded initial scatters, each from `start`: "skid" (default; the skid equilibrium and
@@ -343,7 +389,12 @@ def simulate_steady(
 
     `workers` > 1 runs the seeds in that many processes (`parallel_map`, started with `spawn`: a
     script calling this needs the `if __name__ == "__main__":` guard); `jaxbearing simulate`
-    uses one per CPU. Default 1: one after another, in this process."""
+    uses one per CPU. Default 1: one after another, in this process.
+
+    `initial_states` (continuation): one `State` per seed (e.g. `SeedRun.final_state` of a
+    neighbouring design's settled run) to start from instead of `start`; settling then runs
+    without projective steps (the state is already near its plateau) and `start` is reported
+    as "continuation"."""
     from ..io import validate_bearing
 
     validate_bearing(bearing, op)
@@ -362,10 +413,19 @@ def simulate_steady(
         progress=progress,
     )
     perturbations = [dataclasses.replace(perturbation, seed=perturbation.seed + k) for k in range(int(seeds))]
+    if initial_states is not None:
+        initial_states = list(initial_states)
+        if len(initial_states) != int(seeds):
+            raise UserInputError(
+                f"initial_states: {len(initial_states)} given, expected one per seed ({int(seeds)})"
+            )
+    states = initial_states if initial_states is not None else [None] * len(perturbations)
     workers = min(int(seeds), int(workers))
     if workers > 1:
         wall0 = time.perf_counter()
-        outs = parallel_map(_SteadySeed(bearing, op, kwargs), perturbations, workers=workers)
+        outs = parallel_map(
+            _SteadySeed(bearing, op, kwargs), list(zip(perturbations, states)), workers=workers
+        )
         return dataclasses.replace(
             outs[0],
             runs=[o.runs[0] for o in outs],
@@ -375,8 +435,10 @@ def simulate_steady(
         )
     params = Params(bearing=bearing, operating=op, functionals=functionals)
     runs, wall0, compile_time = [], time.perf_counter(), 0.0
-    for pert in perturbations:
-        if start == "skid":  # its compilation and solve count in the wall time
+    for pert, given in zip(perturbations, states):
+        if given is not None:  # continuation from a given state
+            y0, tau = jax.tree_util.tree_map(jnp.asarray, given), None
+        elif start == "skid":  # its compilation and solve count in the wall time
             skid = skid_start(bearing, op, pert)
             y0, tau = skid.state, float(skid.time_constant)
         else:
@@ -408,7 +470,7 @@ def simulate_steady(
         window_revs=int(window_revs),
         tolerance=tolerance,
         cap=settle_cap_ms * 1e-3,
-        start=start,
+        start=start if initial_states is None else "continuation",
         wall_time_s=wall,
         compile_time_s=compile_time,
         bearing=bearing,

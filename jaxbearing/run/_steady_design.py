@@ -18,11 +18,19 @@ confidence interval (Student-t over the seeds' batch means, `_statistics`):
 beside the four static design-zone margins of `flange.zone_margins` (relief, height,
 limited circle, clearance; positive when satisfied) and the full settled summary.
 
+- `objective`: the smooth mean PV over contact time of `_steady_gradient` (the accumulators
+  int w PV dt / int w dt with the smooth contact indicator w = Q / (Q + 1 N), integrated inside
+  the solve over the window), per seed, with its Student-t interval over the seeds: the quantity
+  the optimiser minimises and whose gradient `steady_gradient` estimates (`mean_pv` is the same
+  average over the saved samples with the hard 1 N threshold);
+
 It is a measurement, not a differentiable function: the gradient of a long impacting trajectory
-is not a design signal (`_design`, docs/model.md 14), and the estimator of the gradient of these
-ensemble statistics (issue 13, item 2) is not built yet. Continuation between nearby designs
-(each design starting from its neighbour's settled state) is not built yet either: every call
-settles from its own skid start.
+is not a design signal (`_design`, docs/model.md 14); `steady_gradient` estimates the gradient
+of the ensemble average from the states this returns (`final_states`).
+
+Continuation. `initial_states` (one per seed, e.g. a neighbouring design's `final_states`)
+starts every seed from a settled state instead of the skid start, so a design close to the
+previous one settles in the minimum two revolutions instead of from the start.
 """
 
 from __future__ import annotations
@@ -43,6 +51,8 @@ from ..geometry import Bearing, OperatingPoint
 from ..io import require
 from ._initial import Perturbation
 from ._settle import simulate_steady, summarise_steady
+from ._statistics import student_t_interval
+from ._steady_gradient import STEADY_FUNCTIONALS
 
 #: default dynamic corner margin [m]: 99 % of the contact time this far inside the limited circle
 CORNER_MARGIN = 0.05e-3
@@ -54,6 +64,8 @@ class SteadyDesignMetrics:
     {"value", "ci95_low", "ci95_high", "n"}; `static_margins` [m] by `MARGIN_NAMES`."""
 
     design: dict
+    objective: dict
+    objective_per_seed: list
     mean_pv: dict
     p95_pv: dict
     corner_contact_share: dict
@@ -62,9 +74,18 @@ class SteadyDesignMetrics:
     settled: bool
     seeds: list
     summary: dict
+    #: the state at the end of every seed's run (numpy leaves), to continue from
+    final_states: list = dataclasses.field(default_factory=list, repr=False)
+    #: settled states of every seed (window start and end): samples for `steady_gradient`
+    sample_states: list = dataclasses.field(default_factory=list, repr=False)
 
     def as_dict(self) -> dict:
-        return dataclasses.asdict(self)
+        """Everything but the final states, as plain (JSON-able) values."""
+        return {
+            f.name: getattr(self, f.name)
+            for f in dataclasses.fields(self)
+            if f.name not in ("final_states", "sample_states")
+        }
 
 
 def steady_design_metrics(
@@ -78,20 +99,29 @@ def steady_design_metrics(
     corner_margin: float = CORNER_MARGIN,
     flange_load: float = DEFAULT_FLANGE_LOAD,
     first_seed: int = 0,
+    initial_states=None,
     **steady_kwargs,
 ) -> SteadyDesignMetrics:
     """Settled flange statistics of `design` over `seeds` seeds (module docstring); further
     keyword arguments go to `simulate_steady` (`workers`, `rtol`, `tolerance`, ...).
     `first_seed` selects the seeds (first_seed .. first_seed + seeds - 1): a verification uses
-    seeds a search never saw."""
+    seeds a search never saw. `initial_states`: continuation (module docstring)."""
     check_design(bearing, design)
     require("corner_margin", corner_margin, lambda v: np.isfinite(v) & (v >= 0), ">= 0 m")
     require("first_seed", first_seed, lambda v: (v >= 0) & (v == np.round(v)), "an integer >= 0")
     b = with_design(bearing, design.end_radius, design.layback_angle, design.axial_clearance)
     pert = steady_kwargs.pop("perturbation", Perturbation())
     pert = dataclasses.replace(pert, seed=int(first_seed))
+    steady_kwargs.setdefault("functionals", STEADY_FUNCTIONALS)
     result = simulate_steady(
-        b, op, settle=settle, window_revs=window_revs, seeds=seeds, perturbation=pert, **steady_kwargs
+        b,
+        op,
+        settle=settle,
+        window_revs=window_revs,
+        seeds=seeds,
+        perturbation=pert,
+        initial_states=initial_states,
+        **steady_kwargs,
     )
     s = summarise_steady(result)
     none = {"value": None, "ci95_low": None, "ci95_high": None, "n": 0}
@@ -111,6 +141,13 @@ def steady_design_metrics(
             "n": est.get("n", 0),
         }
 
+    pv_ref = float(steady_kwargs["functionals"].pv_reference)
+    per_seed = [
+        pv_ref * sum(a for a, _ in r.window_integrals) / sum(c for _, c in r.window_integrals)
+        if r.status == "ok" and r.window_integrals and sum(c for _, c in r.window_integrals) > 0
+        else np.nan
+        for r in result.runs
+    ]
     margins = np.asarray(zone_margins(b, design, flange_load=flange_load))
     return SteadyDesignMetrics(
         design={
@@ -118,6 +155,8 @@ def steady_design_metrics(
             "layback_angle_rad": float(design.layback_angle),
             "axial_clearance_m": float(design.axial_clearance),
         },
+        objective=student_t_interval(per_seed).as_dict(),
+        objective_per_seed=[float(v) for v in per_seed],
         mean_pv=pv.get("mean", dict(none)),
         p95_pv=pv.get("p95", dict(none)),
         corner_contact_share=s.get("corner_contact_share", {}).get("time", dict(none)),
@@ -126,4 +165,8 @@ def steady_design_metrics(
         settled=bool(s["settled"]),
         seeds=list(s["seeds"]),
         summary=s,
+        final_states=[r.final_state for r in result.runs],
+        sample_states=[
+            x for r in result.runs if r.status == "ok" for x in (r.window_start_state, r.final_state)
+        ],
     )

@@ -1,0 +1,267 @@
+"""Gradient estimators of the steady design objective against common-random-number central
+differences (issue 13, item 2): ``python benchmarks/bench_steady_gradient.py [--quick]``.
+
+Objective J(d): the smooth mean flange PV over contact time of settled running
+(`jaxbearing.run.steady_design_metrics(...).objective`), reference bearing, 20,000 rpm, 1000 N.
+
+At three designs (the reference R_end 80 mm / theta_f 1.6 deg; R_end 70 mm / 1.8 deg; R_end
+100 mm / 1.4 deg; Delta_bf 0.15 mm for all):
+
+1. settled states of `SEEDS` seeds: the reference from the skid start (settle auto), the other
+   designs continuing from the reference's settled states (settle auto), then a
+   `WINDOW_REVS`-revolution window: J with its Student-t CI;
+2. the truth: common-random-number central differences, per variable, steps of `FD_STEP` of its
+   range (R_end 60-120 mm, theta_f 1.0-2.0 deg, Delta_bf 0.10-0.30 mm, the optimiser's default
+   box): both designs d +- h e_i continue from the SAME settled states of d (the same seeds),
+   settle one cage revolution, measure the window; per seed (J+ - J-) / 2h, mean and standard
+   error over the seeds (paired). Significant where |FD| > 2 SE;
+3. the estimators, from the 2 x SEEDS settled states of d (window start and end of every seed):
+   the frozen-load estimator (`frozen_load_gradient`, 1 ms trajectories) and the short-window
+   forward-mode sensitivities (`steady_gradient`) at windows `WINDOWS`;
+4. the growth of the tangents from one settled state (`tangent_growth`, 2 ms): the finite-time
+   Lyapunov exponent (least-squares slope of log|tangent| over the window).
+
+Acceptance (issue 13): for each variable, the estimator agrees in sign with the FD wherever the
+FD is significant, and in magnitude within 30 %.
+
+Results go to benchmarks/results/bench_steady_gradient.json; every finished design is written
+at once (a killed run keeps it and resumes from it: the settled states of finished steps are
+kept in out/bench_steady_gradient/, which git ignores).
+"""
+
+from __future__ import annotations
+
+import math
+import pathlib
+import pickle
+import sys
+import time
+
+import numpy as np
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+import _common  # noqa: E402
+
+NAME = "bench_steady_gradient"
+MM, DEG = 1e-3, math.pi / 180
+DESIGNS = {
+    "reference": (80 * MM, 1.6 * DEG, 0.15 * MM),
+    "R70_t1.8": (70 * MM, 1.8 * DEG, 0.15 * MM),
+    "R100_t1.4": (100 * MM, 1.4 * DEG, 0.15 * MM),
+}
+RANGES = np.array([60 * MM, 1.0 * DEG, 0.2 * MM])  # widths of the optimiser's default box
+VARIABLES = ("end_radius", "layback_angle", "axial_clearance")
+FD_STEP = 0.04
+SEEDS = 8
+WINDOW_REVS = 2
+WINDOWS = (0.1e-3, 0.25e-3)
+FROZEN_WINDOW = 1.0e-3
+STATE_DIR = pathlib.Path(__file__).resolve().parents[1] / "out" / NAME
+WORKERS = 2
+
+
+def _cached(key: str, compute):
+    """compute() once; its result pickled in STATE_DIR (resume after a kill)."""
+    path = STATE_DIR / f"{key}.pkl"
+    if path.exists():
+        with open(path, "rb") as f:
+            return pickle.load(f)
+    value = compute()
+    STATE_DIR.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_suffix(".tmp")
+    with open(tmp, "wb") as f:
+        pickle.dump(value, f)
+    tmp.replace(path)
+    return value
+
+
+def _settled(bearing, op, x, seeds, window_revs, settle, states):
+    """(per-seed objective [Pa m/s], sample states, final states, wall s) of design x."""
+    import jaxbearing as jb
+    from jaxbearing.flange import DesignVariables
+
+    t0 = time.perf_counter()
+    m = jb.steady_design_metrics(
+        bearing,
+        op,
+        DesignVariables.from_array(np.asarray(x)),
+        seeds=seeds,
+        window_revs=window_revs,
+        settle=settle,
+        initial_states=states,
+        workers=WORKERS,
+    )
+    return dict(
+        per_seed=m.objective_per_seed,
+        objective=m.objective,
+        settled=m.settled,
+        samples=m.sample_states,
+        final=m.final_states,
+        wall_s=time.perf_counter() - t0,
+    )
+
+
+def _fd(base_x, i, h, bearing, op, states, key, seeds, settle, window_revs):
+    plus, minus = np.array(base_x), np.array(base_x)
+    plus[i] += h
+    minus[i] -= h
+    rp = _cached(
+        f"{key}_{VARIABLES[i]}_plus", lambda: _settled(bearing, op, plus, seeds, window_revs, settle, states)
+    )
+    rm = _cached(
+        f"{key}_{VARIABLES[i]}_minus",
+        lambda: _settled(bearing, op, minus, seeds, window_revs, settle, states),
+    )
+    d = (np.asarray(rp["per_seed"]) - np.asarray(rm["per_seed"])) / (2 * h)
+    d = d[np.isfinite(d)]
+    se = float(np.std(d, ddof=1) / np.sqrt(d.size)) if d.size > 1 else float("nan")
+    return dict(
+        value=float(np.mean(d)),
+        stderr=se,
+        significant=bool(abs(np.mean(d)) > 2 * se),
+        step=h,
+        seeds=int(d.size),
+        wall_s=rp["wall_s"] + rm["wall_s"],
+    )
+
+
+def _agreement(estimate, fd) -> dict:
+    if not fd["significant"]:
+        return dict(checked=False, sign=None, within_30pct=None, relative_error=None)
+    rel = abs(estimate - fd["value"]) / abs(fd["value"])
+    return dict(
+        checked=True,
+        sign=bool(np.sign(estimate) == np.sign(fd["value"])),
+        within_30pct=bool(rel <= 0.3),
+        relative_error=float(rel),
+    )
+
+
+def _ftle(ts, norms) -> float:
+    """Least-squares slope of log(norm) over the saves after the first (1/s), mean over the
+    three design directions."""
+    keep = ts > 0
+    return float(np.mean([np.polyfit(ts[keep], np.log(n[keep]), 1)[0] for n in norms]))
+
+
+def main(quick: bool = False) -> dict:
+    import jaxbearing as jb
+    from jaxbearing.flange import DesignVariables
+    from jaxbearing.run import frozen_load_gradient, steady_gradient, tangent_growth
+
+    bearing, op = jb.reference_bearing(), jb.reference_operating_point()
+    seeds = 2 if quick else SEEDS
+    designs = dict(list(DESIGNS.items())[:1]) if quick else DESIGNS
+    windows = WINDOWS[:1] if quick else WINDOWS
+    tag = "quick" if quick else "full"
+    t_start = time.perf_counter()
+    ref_x = np.array(DESIGNS["reference"])
+    ref = _cached(
+        f"{tag}_reference_base", lambda: _settled(bearing, op, ref_x, seeds, WINDOW_REVS, "auto", None)
+    )
+    out = {"benchmark": NAME, "quick": quick, "machine": _common.machine_info(), "designs": {}}
+    rows = []
+    for name, x in designs.items():
+        x = np.array(x)
+        _common.log(f"{NAME}: design {name}")
+        base = (
+            ref
+            if name == "reference"
+            else _cached(
+                f"{tag}_{name}_base",
+                lambda: _settled(bearing, op, x, seeds, WINDOW_REVS, "auto", ref["final"]),
+            )
+        )
+        d = DesignVariables.from_array(x)
+        b = d.apply(bearing)
+        rev_ms = 2 * math.pi / abs(float(np.asarray(base["final"][0].cage.speed))) * 1e3
+        fd = [
+            _fd(
+                x,
+                i,
+                FD_STEP * RANGES[i],
+                bearing,
+                op,
+                base["final"],
+                f"{tag}_{name}",
+                seeds,
+                rev_ms,
+                WINDOW_REVS,
+            )
+            for i in range(3)
+        ]
+        t0 = time.perf_counter()
+        frozen = frozen_load_gradient(b, op, d, base["samples"], window=FROZEN_WINDOW, workers=WORKERS)
+        frozen_wall = time.perf_counter() - t0
+        short = {}
+        for w in windows:
+            t0 = time.perf_counter()
+            g = steady_gradient(b, op, d, base["samples"], window=w, workers=WORKERS)
+            short[w] = (g, time.perf_counter() - t0)
+        t0 = time.perf_counter()
+        ts, norms = tangent_growth(b, op, d, base["samples"][0], 1.0e-3 if quick else 2.0e-3, num_saves=21)
+        growth_wall = time.perf_counter() - t0
+
+        def est(g, wall):
+            return dict(
+                value=g.value,
+                gradient=g.gradient.tolist(),
+                stderr=g.gradient_stderr.tolist(),
+                samples=g.num_samples,
+                wall_s=wall,
+                agreement={v: _agreement(g.gradient[i], fd[i]) for i, v in enumerate(VARIABLES)},
+            )
+
+        entry = dict(
+            design={
+                "end_radius_mm": x[0] / MM,
+                "layback_angle_deg": x[1] / DEG,
+                "axial_clearance_mm": x[2] / MM,
+            },
+            objective_Pa_m_s=base["objective"],
+            settled=base["settled"],
+            base_wall_s=base["wall_s"],
+            central_difference={v: fd[i] for i, v in enumerate(VARIABLES)},
+            frozen_load=est(frozen, frozen_wall) | {"window_s": FROZEN_WINDOW},
+            short_window={
+                f"{w * 1e3:g}_ms": est(g, wall) | {"window_s": w} for w, (g, wall) in short.items()
+            },
+            tangent_growth=dict(
+                t_s=ts.tolist(), norms=norms.tolist(), ftle_per_s=_ftle(ts, norms), wall_s=growth_wall
+            ),
+        )
+        out["designs"][name] = entry
+        for i, v in enumerate(VARIABLES):
+            f = fd[i]
+            rows.append(
+                [
+                    name,
+                    v,
+                    f"{f['value']:.3e} +- {f['stderr']:.1e}{'' if f['significant'] else ' (n.s.)'}",
+                    f"{frozen.gradient[i]:.3e} +- {frozen.gradient_stderr[i]:.1e}",
+                ]
+                + [f"{g.gradient[i]:.3e} +- {g.gradient_stderr[i]:.1e}" for g, _ in short.values()]
+            )
+        _common.write_json(NAME, out | {"partial": True})
+    checks = [
+        a for e in out["designs"].values() for a in e["frozen_load"]["agreement"].values() if a["checked"]
+    ]
+    out["frozen_load_acceptance"] = dict(
+        checked=len(checks),
+        sign=sum(bool(a["sign"]) for a in checks),
+        within_30pct=sum(bool(a["within_30pct"]) for a in checks),
+    )
+    out["wall_time_s"] = time.perf_counter() - t_start
+    out["table"] = _common.format_table(
+        "dJ/dx of the steady mean PV [Pa m/s per m or rad]: CRN central difference vs estimators",
+        ["design", "variable", f"CRN FD ({seeds} seeds)", "frozen load"]
+        + [f"short window {w * 1e3:g} ms" for w in windows],
+        rows,
+    )
+    print(out["table"])
+    _common.write_json(NAME, out)
+    return out
+
+
+if __name__ == "__main__":
+    main(quick="--quick" in sys.argv)

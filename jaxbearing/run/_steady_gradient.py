@@ -1,0 +1,356 @@
+"""The gradient of the steady-running design objective (issue 13, item 2; docs/model.md 17).
+
+Objective. The smooth mean flange PV over contact time of settled running,
+
+    J(d) = PV_ref sum_k A_k / sum_k C_k,   A_k = int sum_c w(Q_c) PV_c / PV_ref dt,
+                                           C_k = int sum_c w(Q_c) dt,
+
+summed over every roller-end/flange contact c, over the window of each sample k (seeds and
+revolutions), with the smooth contact indicator w(Q) = Q / (Q + Q_0), Q_0 = `CONTACT_LOAD`
+(`STEADY_FUNCTIONALS`: the accumulators of MODEL.md 6 with p = 1). It is the time average that
+flange wear integrates, weighted by contact time: a ratio estimator, so windows with more contact
+count more.
+
+Why not the derivative of one long trajectory. Roller-flange impacts make the tangent dynamics
+grow: a design perturbation moves impact times, and the tangent of the state grows like
+exp(lambda t) with a finite-time Lyapunov exponent lambda of the order of 1e3-1e4 1/s here
+(`tangent_growth`, measured in benchmarks/bench_steady_gradient.py). The derivative of a long
+window average is then dominated by a few impacts and its variance grows like exp(2 lambda T)
+(Lea, Allen & Haine 2000, "Sensitivity analysis of the climate of a chaotic system", Tellus
+52A: 523, the same failure for the Lorenz system); the design trend is in the ensemble average.
+
+Estimator (ensemble of short windows). From K states of settled running of design d (the seeds'
+states after settling and after the window: samples of the invariant measure), integrate a short
+window of length T (shorter than the time in which the tangents blow up) with forward-mode
+tangents in the three design variables (`diffrax.ForwardMode`, one solve carries the primal and
+three tangents), and differentiate the ratio estimator:
+
+    dJ/dd = PV_ref (sum_k dA_k sum_k C_k - sum_k A_k sum_k dC_k) / (sum_k C_k)^2.
+
+Its standard error is the jackknife over the K samples (Efron & Stein 1981). The estimator
+neglects the slow part of the response (how the distribution of settled states moves with the
+design, e.g. the cage speed or the skew amplitude): its bias against the derivative of the
+settled mean is measured against common-random-number central differences of settled runs
+in benchmarks/bench_steady_gradient.py, with the window length T and ensemble size K it
+was measured at (README, Design on steady running).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import diffrax
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from ..contact import LOAD_FLOOR
+from ..dynamics import Functionals, Params, State, contact_loads
+from ..flange import DesignVariables, with_design
+from ..geometry import Bearing, OperatingPoint
+from ._compile_cache import checks_without_host_callbacks
+from ._design import forward_jacobian
+from ._ensemble import parallel_map
+from ._result import result_code
+from ._settle import prepare_from, solve_from
+from ._simulate import _diffeqsolve
+
+#: Q_0 of the smooth contact indicator w(Q) = Q / (Q + Q_0) of the steady objective [N]: the
+#: force at which a flange sample counts half (the statistics' hard threshold is 1 N)
+CONTACT_LOAD = 1.0
+#: the accumulators of the steady objective: p = 1 (the time integral of PV over contact)
+STEADY_FUNCTIONALS = Functionals(pv_exponent=1.0, contact_load=CONTACT_LOAD)
+#: default window of the short-window sensitivities [s] (benchmarks/bench_steady_gradient.py)
+GRADIENT_WINDOW = 1.0e-3
+
+
+def _design_params(bearing: Bearing, op: OperatingPoint, x) -> Params:
+    b = with_design(bearing, x[0], x[1], x[2])
+    return Params(bearing=b, operating=op, functionals=STEADY_FUNCTIONALS)
+
+
+def window_integrals(bearing, op, start: State, x, duration, *, rtol, atol, max_steps, adjoint=None):
+    """(A, C, ok) over [0, duration] from `start` with design x = (R_end, theta_f, Delta_bf):
+    A = int sum_c w PV_c / PV_ref dt, C = int sum_c w dt (module docstring); ok = 1.0 where the
+    solve succeeded (a float, so forward mode carries it). Pure and jit-able."""
+    params = _design_params(bearing, op, x)
+    _, final, code, _ = solve_from(
+        params, start, duration, num_saves=0, rtol=rtol, atol=atol, max_steps=max_steps, adjoint=adjoint
+    )
+    acc = final.accumulators
+    return jnp.stack([jnp.sum(acc.pv_power), jnp.sum(acc.contact_time), (code == 0).astype(float)])
+
+
+_COMPILED: dict = {}
+
+
+def _compiled_jacobian(bearing, op, start, x, max_steps: int):
+    """(A, C, ok) and their forward-mode Jacobian in x, compiled once per structure."""
+    leaves, treedef = jax.tree_util.tree_flatten((bearing, op, start))
+    key = (treedef, tuple((jnp.shape(v), jnp.result_type(v)) for v in leaves), max_steps)
+    if key not in _COMPILED:
+
+        def run(b, o, s, x_, d, r, a):
+            def f(v):
+                return window_integrals(
+                    b, o, s, v, d, rtol=r, atol=a, max_steps=max_steps, adjoint=diffrax.ForwardMode()
+                )
+
+            return forward_jacobian(f, x_)
+
+        f0 = jnp.asarray(1.0)
+        _COMPILED[key] = jax.jit(run).lower(bearing, op, start, x, f0, f0, f0).compile()
+    return _COMPILED[key]
+
+
+@dataclasses.dataclass(frozen=True)
+class _WindowSample:
+    """Picklable short-window Jacobian of one start state (for `parallel_map`)."""
+
+    bearing: Bearing
+    op: OperatingPoint
+    x: np.ndarray
+    duration: float
+    rtol: float
+    atol: float
+    max_steps: int
+
+    def __call__(self, state) -> tuple[np.ndarray, np.ndarray]:
+        start = jax.tree_util.tree_map(jnp.asarray, state)
+        x = jnp.asarray(self.x)
+        run = _compiled_jacobian(self.bearing, self.op, start, x, self.max_steps)
+        val, jac = run(
+            self.bearing, self.op, start, x, *map(jnp.asarray, (self.duration, self.rtol, self.atol))
+        )
+        return np.asarray(val), np.asarray(jac)  # (3,), (3 variables, 3 outputs)
+
+
+@dataclasses.dataclass
+class SteadyGradient:
+    """The ensemble short-window estimate of J and dJ/d(R_end, theta_f, Delta_bf) (module
+    docstring). SI units: J [Pa m/s], gradient [Pa m/s per m, per rad, per m]."""
+
+    value: float
+    gradient: np.ndarray  # (3,)
+    gradient_stderr: np.ndarray  # (3,) jackknife
+    value_stderr: float
+    window_s: float
+    num_samples: int  # samples that succeeded
+    integrals: np.ndarray  # (K, 2): A_k, C_k
+    integral_jacobians: np.ndarray  # (K, 3, 2): dA_k/dx_i, dC_k/dx_i
+    ok: np.ndarray  # (K,) bool
+
+
+def ratio_gradient(a, c, da, dc, pv_reference: float):
+    """(J, dJ/dx) of J = PV_ref sum a / sum c from per-sample a (K,), c (K,), da, dc (K, n)."""
+    sa, sc = np.sum(a), np.sum(c)
+    return pv_reference * sa / sc, pv_reference * (np.sum(da, 0) * sc - sa * np.sum(dc, 0)) / sc**2
+
+
+def _jackknife_stderr(a, c, da, dc, pv_reference):
+    """Jackknife standard errors of (J, dJ/dx) of `ratio_gradient` over the K samples."""
+    k = len(a)
+    if k < 2:
+        return float("nan"), np.full(da.shape[1], np.nan)
+    keep = ~np.eye(k, dtype=bool)
+    loo = [ratio_gradient(a[m], c[m], da[m], dc[m], pv_reference) for m in keep]
+    vals = np.array([v for v, _ in loo])
+    grads = np.stack([g for _, g in loo])
+    f = (k - 1) / k
+    return float(np.sqrt(f * np.sum((vals - vals.mean()) ** 2))), np.sqrt(
+        f * np.sum((grads - grads.mean(0)) ** 2, axis=0)
+    )
+
+
+def steady_gradient(
+    bearing: Bearing,
+    op: OperatingPoint,
+    design: DesignVariables,
+    states,
+    *,
+    window: float = GRADIENT_WINDOW,
+    rtol: float = 1e-3,
+    atol: float = 1e-6,
+    max_steps: int = 200_000,
+    workers: int = 1,
+) -> SteadyGradient:
+    """The ensemble short-window estimate (module docstring) of the steady objective and its
+    gradient at `design`, from `states` (settled states of this design, e.g.
+    `SeedRun.final_state`), each integrated over `window` seconds with three forward-mode
+    tangents; `workers` processes share the samples."""
+    x = np.asarray(design.as_array(), dtype=float)
+    job = _WindowSample(bearing, op, x, float(window), float(rtol), float(atol), int(max_steps))
+    outs = parallel_map(job, list(states), workers=workers)
+    return _combine([(v[:2] if v[2] > 0.5 else np.full(2, np.nan), j[:, :2]) for v, j in outs], window)
+
+
+def _combine(outs, window) -> SteadyGradient:
+    """The ratio estimator and its jackknife from per-sample ((A, C), Jacobian (3, 2)); a
+    failed sample carries NaN and is left out."""
+    vals = np.stack([v for v, _ in outs])  # (K, 2): A, C
+    jacs = np.stack([j for _, j in outs])  # (K, 3 variables, 2 outputs)
+    ok = np.all(np.isfinite(vals), axis=1) & np.all(np.isfinite(jacs), axis=(1, 2))
+    a, c = vals[ok, 0], vals[ok, 1]
+    da, dc = jacs[ok, :, 0], jacs[ok, :, 1]
+    pv_ref = STEADY_FUNCTIONALS.pv_reference
+    if not ok.any() or np.sum(c) <= 0:
+        nan3 = np.full(3, np.nan)
+        return SteadyGradient(
+            float("nan"), nan3, nan3, float("nan"), float(window), int(ok.sum()), vals, jacs, ok
+        )
+    value, grad = ratio_gradient(a, c, da, dc, pv_ref)
+    value_se, grad_se = _jackknife_stderr(a, c, da, dc, pv_ref)
+    return SteadyGradient(
+        value=float(value),
+        gradient=grad,
+        gradient_stderr=grad_se,
+        value_stderr=value_se,
+        window_s=float(window),
+        num_samples=int(ok.sum()),
+        integrals=vals,
+        integral_jacobians=jacs,
+        ok=ok,
+    )
+
+
+def tangent_growth(
+    bearing: Bearing,
+    op: OperatingPoint,
+    design: DesignVariables,
+    start: State,
+    duration: float,
+    *,
+    num_saves: int = 50,
+    rtol: float = 1e-3,
+    atol: float = 1e-6,
+    max_steps: int = 400_000,
+):
+    """(t (num_saves,), tangent norms (3, num_saves)): the RMS over the scaled state (lengths in
+    um, velocities in mm/s, angular velocities in rad/s; `dynamics.state_scales`; accumulators
+    excluded) of the forward-mode tangent of the trajectory from `start` with respect to each
+    design variable, scaled by that variable (d/d ln x). The slope of log(norm) against t is the
+    finite-time Lyapunov exponent of the tangent dynamics along the design direction."""
+    x = jnp.asarray(design.as_array(), dtype=float)
+    ts = jnp.linspace(0.0, duration, num_saves)
+    start = jax.tree_util.tree_map(jnp.asarray, start)
+
+    def trajectory(v):
+        params = _design_params(bearing, op, v)
+        _, args, y0, controller = prepare_from(params, start, rtol, atol)
+        saveat = diffrax.SaveAt(ts=ts, fn=lambda t, y, a: dataclasses.replace(y, accumulators=None))
+        with checks_without_host_callbacks():
+            sol = _diffeqsolve(
+                y0, args, duration, saveat, controller, max_steps, diffrax.ForwardMode(), False
+            )
+        flat = jnp.concatenate(
+            [jnp.reshape(leaf, (num_saves, -1)) for leaf in jax.tree_util.tree_leaves(sol.ys)], 1
+        )
+        return flat, result_code(sol.result)
+
+    @jax.jit
+    def run(v):
+        def f(w):
+            flat, code = trajectory(w)
+            return flat, (code == 0).astype(float)
+
+        (flat, ok), (dflat, _) = forward_jacobian(f, v)
+        return jnp.sqrt(jnp.mean((dflat * v[:, None, None]) ** 2, axis=-1)), ok
+
+    norms, ok = run(x)
+    if float(ok) < 0.5:
+        raise RuntimeError("tangent_growth: the solve did not succeed")
+    return np.asarray(ts), np.asarray(norms)
+
+
+# -- the frozen-load estimator ---------------------------------------------------------------
+def trajectory_states(
+    bearing, op, start: State, duration: float, num_saves: int, *, rtol=1e-3, atol=1e-6, max_steps=400_000
+):
+    """The physical states at `num_saves` equally spaced times in (0, duration] of a plain
+    solve from `start` (a State with a leading time axis on every leaf)."""
+    params = Params(bearing=bearing, operating=op, functionals=STEADY_FUNCTIONALS)
+    scaling, args, y0, controller = prepare_from(
+        params, jax.tree_util.tree_map(jnp.asarray, start), rtol, atol
+    )
+    ts = jnp.linspace(0.0, duration, num_saves + 1)[1:]
+    saveat = diffrax.SaveAt(ts=ts, fn=lambda t, y, a: a.scaling.unscale(t, y))
+    with checks_without_host_callbacks():
+        sol = _diffeqsolve(y0, args, duration, saveat, controller, max_steps, None, False)
+    return sol.ys, result_code(sol.result)
+
+
+def frozen_load_integrands(bearing, op, x, state: State, reference_load):
+    """(sum_c w(Q0_c) PV_c(x) (Q0_c / Q_c(x))^(1/3), sum_c w(Q0_c)) over the flange contacts of
+    one state: the flange PV with design x at the loads Q0 = `reference_load` (Z, 4) the
+    dynamics gave (module docstring, frozen-load estimator). Hertz: p_max = c(radii) Q^(1/3),
+    so PV (Q0/Q)^(1/3) is the PV at load Q0 with the contact point, curvatures and sliding
+    velocity of design x."""
+    fl = contact_loads(state, _design_params(bearing, op, x)).flange
+    q0 = reference_load
+    on = (q0 > LOAD_FLOOR) & (fl.normal_force > LOAD_FLOOR)
+    safe_q = jnp.where(on, fl.normal_force, 1.0)
+    ratio = jnp.where(on, (jnp.where(on, q0, 1.0) / safe_q) ** (1.0 / 3.0), 0.0)
+    w = q0 / (q0 + STEADY_FUNCTIONALS.contact_load)
+    return jnp.stack([jnp.sum(w * fl.pv * ratio) / STEADY_FUNCTIONALS.pv_reference, jnp.sum(w)])
+
+
+@dataclasses.dataclass(frozen=True)
+class _FrozenSample:
+    """Picklable frozen-load integrals and Jacobians along one trajectory (`parallel_map`)."""
+
+    bearing: Bearing
+    op: OperatingPoint
+    x: np.ndarray
+    duration: float
+    num_saves: int
+    rtol: float
+
+    def __call__(self, state):
+        x = jnp.asarray(self.x)
+        states, code = _trajectory_jit(self.bearing, self.op, state, self.duration, self.num_saves, self.rtol)
+        if int(code) != 0:
+            return np.full(2, np.nan), np.full((3, 2), np.nan)
+        val, jac = _frozen_jit(self.bearing, self.op, x, states)
+        return np.asarray(val), np.asarray(jac)
+
+
+def _trajectory(bearing, op, state, duration, num_saves, rtol):
+    return trajectory_states(bearing, op, state, duration, num_saves, rtol=rtol)
+
+
+_trajectory_jit = jax.jit(_trajectory, static_argnums=(4,))
+
+
+@jax.jit
+def _frozen_jit(bearing, op, x, states):
+    """Sum over the saved states of the frozen-load integrands and their Jacobian in x."""
+    q0 = jax.vmap(lambda s: contact_loads(s, _design_params(bearing, op, x)).flange.normal_force)(states)
+
+    def total(v):
+        per = jax.vmap(lambda s, q: frozen_load_integrands(bearing, op, v, s, q))(states, q0)
+        return jnp.sum(per, axis=0)
+
+    return forward_jacobian(total, x)
+
+
+def frozen_load_gradient(
+    bearing: Bearing,
+    op: OperatingPoint,
+    design: DesignVariables,
+    states,
+    *,
+    window: float = 1.0e-3,
+    saves_per_ms: int = 200,
+    rtol: float = 1e-3,
+    workers: int = 1,
+) -> SteadyGradient:
+    """The frozen-load estimate (module docstring) of the steady objective and its gradient at
+    `design`: from each of `states`, a plain solve over `window` seconds saves the state every
+    1 / `saves_per_ms` ms; at every saved state the flange PV is differentiated in the design at
+    the loads the dynamics gave (`frozen_load_integrands`), summed, and combined through the
+    ratio estimator; jackknife over the trajectories."""
+    x = np.asarray(design.as_array(), dtype=float)
+    n = max(1, int(round(window * 1e3 * saves_per_ms)))
+    job = _FrozenSample(bearing, op, x, float(window), n, float(rtol))
+    outs = parallel_map(job, list(states), workers=workers)
+    return _combine(outs, window)

@@ -1,0 +1,588 @@
+"""Design search on steady running (issue 13): the default objective of `optimise run`.
+
+Objective. For a design x = (R_end, theta_f, Delta_bf), at every operating point k of the
+envelope, the smooth mean flange PV over contact time of settled running (`jaxbearing.run.
+steady_design_metrics`: skid start or continuation, settling, a window of `window_revs` cage
+revolutions, `seeds` seeded scatters; Student-t CI over the seeds), combined over the envelope
+as in `DesignProblem.combine` (smooth max or weighted mean), in GPa m/s.
+
+Gradient (`estimator`). "frozen" (default): the frozen-load estimate of
+`jaxbearing.run.frozen_load_gradient`: from the settled states the objective's runs passed
+through (every seed's state at the start of its window and at its end: 2 x seeds samples of the
+invariant measure), plain trajectories of `gradient_window` seconds; at every saved state the
+flange PV is differentiated in the design at the loads the dynamics gave, through the ratio
+estimator. "window": the short-window forward-mode sensitivities of
+`jaxbearing.run.steady_gradient` over `gradient_window` seconds. benchmarks/bench_steady_gradient
+measures both against common-random-number central differences (README, Design on steady
+running).
+
+Constraints. The four static design-zone margins of `DesignProblem.constraints` and the
+dynamic corner-contact margin m_dyn = rho_lim - p99(contact radius) - `corner_margin` (the
+worst operating point), which has no derivative of its own (a percentile of a dynamic run). It
+is modelled as the measured value plus the change of the static limited-circle margin
+rho_lim - rho_c (the aligned contact radius): m_dyn(u') ~ m_dyn(u) + m_lc(u') - m_lc(u), i.e.
+the skew excursion p99 - rho_c is held at its measured value over one step; its gradient is the
+static margin's. All five enter the same augmented Lagrangian as `_search` (projected Adam step
+in the unit box, multiplier update).
+
+Continuation. Every start carries the settled states of its last design, per operating point;
+the next iterate (a step of a few per cent of the box) starts from them, so it settles in the
+minimum two revolutions instead of from the skid start.
+
+Resume. After every iteration the whole search state (iterates, optimiser and multiplier
+states, continuation states, history, best design) is written atomically to
+DIR/checkpoint.pkl; a killed run started again with the same settings continues from its last
+finished iteration and reaches the same result (the runs are deterministic per seed and state).
+
+Verification. The best feasible design and the start design are re-simulated from the skid
+start with `verify_seeds` seeds numbered from `verify_first_seed` (never used by the search:
+it uses 0 .. seeds - 1), window `verify_window_revs`; `result.json` holds both under
+`verification` with mean and p95 PV over contact time and the corner-contact share as
+value/ci95_low/ci95_high, and whether the CIs of the mean PV are disjoint.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import pathlib
+import pickle
+import time
+from collections.abc import Callable
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import optax
+
+from jaxbearing import UserInputError
+from jaxbearing.flange import MARGIN_NAMES, DesignVariables
+from jaxbearing.io import atomic_write, require
+from jaxbearing.run import (
+    CORNER_MARGIN,
+    available_cpus,
+    frozen_load_gradient,
+    steady_design_metrics,
+    steady_gradient,
+)
+
+from ._problem import MARGIN_SCALE, PV_SCALE, DesignProblem, any_feasible
+from ._search import _Hyper, start_points
+
+#: names of the five constraints of the steady search (static zone margins, then dynamic)
+CONSTRAINT_NAMES = (*MARGIN_NAMES, "dynamic_corner")
+CHECKPOINT = "checkpoint.pkl"
+#: gradient estimators (module docstring)
+ESTIMATORS = ("frozen", "window")
+
+
+@dataclasses.dataclass(frozen=True)
+class SteadySettings:
+    """How the steady objective is measured (module docstring). Times in seconds."""
+
+    seeds: int = 4
+    window_revs: int = 2
+    settle: object = "auto"
+    gradient_window: float = 1.0e-3
+    estimator: str = "frozen"
+    corner_margin: float = CORNER_MARGIN
+    rtol: float = 1e-3
+    workers: int = 0  # 0: one per CPU
+    verify_seeds: int = 4
+    verify_first_seed: int = 1000
+    verify_window_revs: int = 4
+
+    def __post_init__(self):
+        """One-line errors naming the setting, before anything runs."""
+        for name in ("seeds", "verify_seeds"):
+            require(name, getattr(self, name), lambda v: (v >= 1) & (v == np.round(v)), "an integer >= 1")
+        for name in ("window_revs", "verify_window_revs"):  # batch means need two batches
+            require(name, getattr(self, name), lambda v: (v >= 2) & (v == np.round(v)), "an integer >= 2")
+        require(
+            "verify_first_seed",
+            self.verify_first_seed,
+            lambda v: (v >= 0) & (v == np.round(v)),
+            "an integer >= 0",
+        )
+        if self.verify_first_seed < self.seeds:
+            raise UserInputError(
+                f"verify_first_seed = {self.verify_first_seed}: must be >= seeds = {self.seeds} "
+                "(verification uses seeds the search never saw)"
+            )
+        if self.estimator not in ESTIMATORS:
+            raise UserInputError(f"estimator = {self.estimator!r}: must be one of {', '.join(ESTIMATORS)}")
+        require("gradient_window", self.gradient_window, lambda v: np.isfinite(v) & (v > 0), "> 0 s")
+        require("corner_margin", self.corner_margin, lambda v: np.isfinite(v) & (v >= 0), ">= 0 m")
+        require("rtol", self.rtol, lambda v: np.isfinite(v) & (v > 0) & (v < 1), "in (0, 1)")
+        require("workers", self.workers, lambda v: (v >= 0) & (v == np.round(v)), "an integer >= 0")
+
+    @property
+    def num_workers(self) -> int:
+        return int(self.workers) or available_cpus()
+
+
+def _operating_point(problem: DesignProblem, k: int):
+    return jax.tree_util.tree_map(lambda a: a[k], problem.operating)
+
+
+@dataclasses.dataclass
+class Evaluation:
+    """The steady objective, its gradient and the constraints of one design (scaled u)."""
+
+    objective: float  # combined over the envelope [GPa m/s]
+    objective_ci: tuple  # (low, high) of the worst operating point's interval [GPa m/s]
+    gradient: np.ndarray  # dJ/du (3,)
+    gradient_stderr: np.ndarray  # (3,)
+    per_point: list  # per operating point: value, ci, gradient, corner margin [m], share
+    static_margins: np.ndarray  # (4,) [m]
+    dynamic_margin: float  # [m], worst operating point
+    states: list  # per operating point: the settled states to continue from
+    wall_time_s: float
+    simulated_ms: float  # simulated time of every seed's settling, window and gradient samples
+
+
+def evaluate(
+    problem: DesignProblem, settings: SteadySettings, u, states=None, *, gradient: bool = True
+) -> Evaluation:
+    """Settled objective and constraints of the scaled design u (one settled ensemble per
+    operating point, continuing from `states` when given) and, with `gradient`, the estimated
+    gradient (NaN without)."""
+    t0 = time.perf_counter()
+    design = problem.design(jnp.asarray(u))
+    width = np.asarray(problem.bounds.upper - problem.bounds.lower)
+    per, new_states, simulated = [], [], 0.0
+    for k in range(problem.num_operating_points):
+        op = _operating_point(problem, k)
+        m = steady_design_metrics(
+            problem.bearing,
+            op,
+            design,
+            seeds=settings.seeds,
+            window_revs=settings.window_revs,
+            settle=settings.settle,
+            corner_margin=settings.corner_margin,
+            flange_load=problem.flange_load,
+            initial_states=None if states is None else states[k],
+            workers=settings.num_workers,
+            rtol=settings.rtol,
+        )
+        estimate = frozen_load_gradient if settings.estimator == "frozen" else steady_gradient
+        g = (
+            _no_gradient()
+            if not gradient
+            else estimate(
+                design.apply(problem.bearing),
+                op,
+                design,
+                m.sample_states,
+                window=settings.gradient_window,
+                rtol=settings.rtol,
+                workers=settings.num_workers,
+            )
+        )
+        j = m.objective
+        per.append(
+            dict(
+                value=_num(j["value"]) / PV_SCALE,
+                ci=(_num(j["ci95_low"]) / PV_SCALE, _num(j["ci95_high"]) / PV_SCALE),
+                gradient=g.gradient * width / PV_SCALE,
+                gradient_stderr=g.gradient_stderr * width / PV_SCALE,
+                estimator_value=g.value / PV_SCALE,
+                corner_margin=_num(m.corner_margin["value"]),
+                corner_contact_share=_num(m.corner_contact_share["value"]),
+                mean_pv=m.mean_pv,
+                settled=m.settled,
+            )
+        )
+        new_states.append(m.final_states)
+        simulated += sum(r["settle_time_ms"] for r in m.summary["per_seed"])
+        simulated += len(m.seeds) * m.summary.get("window_ms", 0.0)
+        simulated += (len(m.sample_states) * settings.gradient_window * 1e3) if gradient else 0.0
+    values = jnp.asarray([p["value"] for p in per])
+    val, vjp = jax.vjp(problem.combine, values)
+    (weights,) = vjp(jnp.ones(()))
+    weights = np.asarray(weights)
+    grad = sum(w * p["gradient"] for w, p in zip(weights, per))
+    grad_se = np.sqrt(sum((w * p["gradient_stderr"]) ** 2 for w, p in zip(weights, per)))
+    worst = int(np.argmax([p["value"] for p in per]))
+    return Evaluation(
+        objective=float(val),
+        objective_ci=per[worst]["ci"],
+        gradient=np.where(width > 0, grad, 0.0),
+        gradient_stderr=grad_se,
+        per_point=per,
+        static_margins=np.asarray(problem.margins(jnp.asarray(u))),
+        dynamic_margin=float(min(p["corner_margin"] for p in per)),
+        states=new_states,
+        wall_time_s=time.perf_counter() - t0,
+        simulated_ms=simulated,
+    )
+
+
+def _no_gradient():
+    nan3 = np.full(3, np.nan)
+    return dataclasses.make_dataclass("NoGradient", ["gradient", "gradient_stderr", "value"])(
+        nan3, nan3, np.nan
+    )
+
+
+def _num(v) -> float:
+    return float("nan") if v is None else float(v)
+
+
+def _constraints(problem: DesignProblem, u, dynamic_margin: float, u_measured):
+    """Scaled, tightened constraints (5,) and their Jacobian (5, 3): the static ones exactly,
+    the dynamic corner margin by its measured value plus the static limited-circle margin's
+    change from `u_measured` (module docstring)."""
+
+    def c(v):
+        static = problem.margins(v)
+        lc = static[MARGIN_NAMES.index("limited_circle")]
+        lc0 = problem.margins(u_measured)[MARGIN_NAMES.index("limited_circle")]
+        dyn = dynamic_margin + lc - lc0
+        return jnp.concatenate([static, dyn[None]]) / MARGIN_SCALE - problem.tighten
+
+    u = jnp.asarray(u)
+    return np.asarray(c(u)), np.asarray(jax.jacfwd(c)(u))
+
+
+@dataclasses.dataclass
+class SteadySearchResult:
+    """Outcome of `steady_search` (designs in SI units; objective in GPa m/s)."""
+
+    status: str  # "ok", "no_feasible_design_in_bounds", "no_feasible_iterate"
+    feasible: bool
+    design: np.ndarray | None
+    objective: float
+    objective_ci: tuple | None
+    start_design: np.ndarray
+    history: dict  # per iteration and start: x, objective, ci, gradient, margins (5)
+    num_iterations: int
+    num_evaluations: int  # settled ensembles (one per start, iteration and operating point)
+    wall_time_s: float
+    resumed_from: int  # iteration the run resumed after (-1: fresh)
+    best_start: int = -1
+    best_iteration: int = -1
+    verification: dict | None = None
+
+
+def _fingerprint(problem: DesignProblem, settings: SteadySettings, hyper: _Hyper, starts) -> str:
+    """A hash of everything that decides the search's result (for resuming): the bearing and
+    operating points, bounds, constraints, envelope, measurement settings, step sizes, starts."""
+    leaves = [
+        np.asarray(v).tobytes() for v in jax.tree_util.tree_leaves((problem.bearing, problem.operating))
+    ]
+    text = repr(
+        (
+            problem.bounds,
+            problem.aggregate,
+            problem.temperature,
+            problem.tighten,
+            problem.flange_load,
+            problem.min_clearance,
+            np.asarray(problem.weights).tolist(),
+            dataclasses.replace(settings, workers=0),  # the processes do not change the result
+            hyper,
+            np.asarray(starts).tolist(),
+        )
+    )
+    h = hashlib.sha256(text.encode())
+    for leaf in leaves:
+        h.update(leaf)
+    return h.hexdigest()
+
+
+def steady_search(
+    problem: DesignProblem,
+    settings: SteadySettings = SteadySettings(),
+    *,
+    num_starts: int = 2,
+    num_iterations: int = 6,
+    learning_rate: float = 0.08,
+    rho: float = 10.0,
+    starts: np.ndarray | None = None,
+    directory: str | pathlib.Path | None = None,
+    callback: Callable[[int, dict], None] | None = None,
+    verify: bool = True,
+) -> SteadySearchResult:
+    """Minimise the steady objective inside the static and dynamic margins (module docstring)
+    from `num_starts` starts (the bearing's own design, then Halton points), `num_iterations`
+    projected Adam steps each. With `directory`, the state is checkpointed there after every
+    iteration and a matching checkpoint is resumed. `callback(iteration, info)` reports
+    progress after every iteration."""
+    t_start = time.perf_counter()
+    for name, v in (("starts", num_starts), ("iterations", num_iterations)):
+        if int(v) < 1:
+            raise UserInputError(f"{name} = {v}: must be >= 1")
+    u = np.asarray(starts, dtype=float) if starts is not None else start_points(problem, num_starts)
+    num_starts = u.shape[0]
+    x_start = np.asarray(problem.bounds.from_scaled(u[0]))
+    hyper = _Hyper(float(learning_rate), int(num_iterations), float(rho))
+    empty = dict(
+        x=[], objective=[], ci=[], gradient=[], gradient_stderr=[], margins=[], wall_s=[], simulated_ms=[]
+    )
+    if not any_feasible(problem)[0]:
+        return SteadySearchResult(
+            "no_feasible_design_in_bounds",
+            False,
+            None,
+            float("nan"),
+            None,
+            x_start,
+            empty,
+            0,
+            0,
+            time.perf_counter() - t_start,
+            -1,
+        )
+    optimiser = hyper.optimiser()
+    free = (problem.bounds.upper - problem.bounds.lower) > 0
+    state = dict(
+        iteration=-1,
+        u=u,
+        opt=[optimiser.init(jnp.asarray(ui)) for ui in u],
+        lam=np.zeros((num_starts, len(CONSTRAINT_NAMES))),
+        chains=[None] * num_starts,
+        history={k: [] for k in empty},
+        best=(np.inf, -1, -1, None, None),
+        evaluations=0,
+    )
+    path = None if directory is None else pathlib.Path(directory) / CHECKPOINT
+    key = _fingerprint(problem, settings, hyper, u)
+    resumed = -1
+    if path is not None and path.exists():
+        saved = _load_checkpoint(path)
+        if saved.get("fingerprint") != key:
+            raise UserInputError(
+                f"{path}: a checkpoint of a search with other settings; remove it or choose "
+                "another --out to start afresh"
+            )
+        state = saved["state"]
+        resumed = state["iteration"]
+    for it in range(state["iteration"] + 1, num_iterations + 1):
+        rows = {k: [] for k in empty}
+        u_next, opt_next, lam_next = [], [], []
+        for s in range(num_starts):
+            us = state["u"][s]
+            ev = evaluate(problem, settings, us, state["chains"][s])
+            state["chains"][s] = ev.states
+            state["evaluations"] += problem.num_operating_points
+            c, jc = _constraints(problem, us, ev.dynamic_margin, us)
+            g_obj = ev.gradient if np.all(np.isfinite(ev.gradient)) else np.zeros(3)
+            act = np.maximum(0.0, state["lam"][s] - rho * c)
+            g = np.where(free, g_obj - act @ jc, 0.0)
+            updates, opt = optimiser.update(jnp.asarray(g), state["opt"][s], jnp.asarray(us))
+            u_next.append(np.clip(np.asarray(optax.apply_updates(jnp.asarray(us), updates)), 0.0, 1.0))
+            opt_next.append(opt)
+            lam_next.append(act)
+            margins = np.concatenate([ev.static_margins, [ev.dynamic_margin]])
+            x = np.asarray(problem.bounds.from_scaled(us))
+            feasible = bool(np.all(margins > 0) and np.isfinite(ev.objective))
+            if feasible and ev.objective < state["best"][0]:
+                state["best"] = (ev.objective, it, s, x, ev.objective_ci)
+            for name, value in (
+                ("x", x),
+                ("objective", ev.objective),
+                ("ci", ev.objective_ci),
+                ("gradient", ev.gradient),
+                ("gradient_stderr", ev.gradient_stderr),
+                ("margins", margins),
+                ("wall_s", ev.wall_time_s),
+                ("simulated_ms", ev.simulated_ms),
+            ):
+                rows[name].append(value)
+        for name, value in rows.items():
+            state["history"][name].append(value)
+        if it < num_iterations:
+            state["u"], state["opt"], state["lam"] = np.stack(u_next), opt_next, np.stack(lam_next)
+        state["iteration"] = it
+        if path is not None:
+            _save_checkpoint(path, key, state)
+        if callback is not None:
+            callback(
+                it,
+                dict(
+                    x=np.stack(rows["x"]),
+                    objective=np.asarray(rows["objective"]),
+                    ci=rows["ci"],
+                    gradient=np.stack(rows["gradient"]),
+                    margins=np.stack(rows["margins"]),
+                    best=state["best"][0],
+                ),
+            )
+    history = {k: np.asarray(v) for k, v in state["history"].items()}
+    best = state["best"]
+    common = dict(
+        start_design=x_start,
+        history=history,
+        num_iterations=num_iterations,
+        num_evaluations=state["evaluations"],
+        resumed_from=resumed,
+    )
+    if best[1] < 0:
+        return SteadySearchResult(
+            "no_feasible_iterate",
+            False,
+            None,
+            float("nan"),
+            None,
+            wall_time_s=time.perf_counter() - t_start,
+            **common,
+        )
+    result = SteadySearchResult(
+        "ok",
+        True,
+        best[3],
+        float(best[0]),
+        tuple(best[4]),
+        wall_time_s=0.0,
+        best_start=int(best[2]),
+        best_iteration=int(best[1]),
+        **common,
+    )
+    if verify:
+        result.verification = verification(problem, settings, best[3], x_start)
+    result.wall_time_s = time.perf_counter() - t_start
+    return result
+
+
+def _save_checkpoint(path: pathlib.Path, key: str, state: dict) -> None:
+    blob = pickle.dumps({"fingerprint": key, "state": jax.tree_util.tree_map(np.asarray, state)})
+    atomic_write(path, lambda f: f.write(blob))
+
+
+def _load_checkpoint(path: pathlib.Path) -> dict:
+    try:
+        with open(path, "rb") as f:
+            return pickle.load(f)
+    except (OSError, pickle.UnpicklingError, EOFError, AttributeError) as exc:
+        raise UserInputError(f"{path}: unreadable checkpoint ({exc}); remove it to start afresh") from None
+
+
+def _estimates(m) -> dict:
+    return {
+        "mean_pv_GPa_m_s": _scaled(m.mean_pv),
+        "p95_pv_GPa_m_s": _scaled(m.p95_pv),
+        "objective_GPa_m_s": _scaled(m.objective),
+        "corner_contact_share": dict(m.corner_contact_share),
+        "corner_margin_mm": _scaled(m.corner_margin, 1e-3),
+        "settled": m.settled,
+        "seeds": m.seeds,
+    }
+
+
+def _scaled(est: dict, unit: float = PV_SCALE) -> dict:
+    return {
+        k: (None if est.get(k) is None else float(est[k]) / unit) if k != "n" else est.get("n", 0)
+        for k in ("value", "ci95_low", "ci95_high", "n")
+    }
+
+
+def verification(problem: DesignProblem, settings: SteadySettings, design, reference) -> dict:
+    """The found design and the reference design re-simulated from the skid start with seeds
+    the search never used (module docstring), at every operating point."""
+    out = {
+        "seeds": list(range(settings.verify_first_seed, settings.verify_first_seed + settings.verify_seeds))
+    }
+    for name, x in (("reference", reference), ("optimum", design)):
+        d = DesignVariables.from_array(jnp.asarray(x))
+        rows = []
+        for k in range(problem.num_operating_points):
+            m = steady_design_metrics(
+                problem.bearing,
+                _operating_point(problem, k),
+                d,
+                seeds=settings.verify_seeds,
+                window_revs=settings.verify_window_revs,
+                settle=settings.settle,
+                corner_margin=settings.corner_margin,
+                flange_load=problem.flange_load,
+                first_seed=settings.verify_first_seed,
+                workers=settings.num_workers,
+                rtol=settings.rtol,
+            )
+            rows.append(_estimates(m))
+        out[name] = rows[0] if len(rows) == 1 else {"per_operating_point": rows}
+    ref, opt = out["reference"], out["optimum"]
+    if "mean_pv_GPa_m_s" in ref:
+        r, o = ref["mean_pv_GPa_m_s"], opt["mean_pv_GPa_m_s"]
+        out["mean_pv_lower_disjoint"] = bool(
+            None not in (r["ci95_low"], o["ci95_high"]) and o["ci95_high"] < r["ci95_low"]
+        )
+        out["optimum_corner_contacts"] = bool((opt["corner_contact_share"].get("value") or 0.0) > 0)
+    return out
+
+
+def steady_grid(
+    problem: DesignProblem,
+    settings: SteadySettings,
+    n_end_radius: int,
+    n_layback: int,
+    axial_clearance: float,
+    *,
+    directory: str | pathlib.Path | None = None,
+    callback: Callable[[int, dict], None] | None = None,
+) -> dict:
+    """The steady objective (value only) over an n_end_radius x n_layback grid of (R_end,
+    theta_f) inside the bounds at fixed Delta_bf, for comparison with `steady_search`: the
+    statically feasible points in a serpentine order, each continuing from the previous point's
+    settled states (the first from the skid start). The best point is the lowest objective
+    among those with every static and dynamic margin positive. With `directory`, every finished
+    point is kept in DIR/grid_checkpoint.pkl and a rerun resumes."""
+    t0 = time.perf_counter()
+    lo, hi = problem.bounds.lower, problem.bounds.upper
+    r = np.linspace(lo[0], hi[0], n_end_radius)
+    t = np.linspace(lo[1], hi[1], n_layback)
+    order = [
+        (i, j if i % 2 == 0 else n_layback - 1 - j) for i in range(n_end_radius) for j in range(n_layback)
+    ]
+    path = None if directory is None else pathlib.Path(directory) / "grid_checkpoint.pkl"
+    done = _load_checkpoint(path)["state"] if path is not None and path.exists() else {}
+    objective = np.full((n_end_radius, n_layback), np.nan)
+    ci = np.full((n_end_radius, n_layback, 2), np.nan)
+    dynamic = np.full((n_end_radius, n_layback), np.nan)
+    static = np.full((n_end_radius, n_layback, 4), np.nan)
+    chain, evaluations, simulated = None, 0, 0.0
+    for i, j in order:
+        x = np.array([r[i], t[j], axial_clearance])
+        u = np.asarray(problem.bounds.to_scaled(x))
+        static[i, j] = np.asarray(problem.margins(jnp.asarray(u)))
+        if not np.all(static[i, j] > 0):
+            continue
+        if (i, j) not in done:
+            ev = evaluate(problem, settings, u, chain, gradient=False)
+            done[(i, j)] = dict(
+                objective=ev.objective,
+                ci=ev.objective_ci,
+                dynamic=ev.dynamic_margin,
+                states=ev.states,
+                simulated_ms=ev.simulated_ms,
+            )
+            if path is not None:
+                _save_checkpoint(path, "grid", done)
+        e = done[(i, j)]
+        chain = e["states"]
+        evaluations += problem.num_operating_points
+        simulated += e["simulated_ms"]
+        objective[i, j], ci[i, j], dynamic[i, j] = e["objective"], e["ci"], e["dynamic"]
+        if callback is not None:
+            callback(
+                evaluations, dict(x=x, objective=e["objective"], ci=e["ci"], dynamic_margin=e["dynamic"])
+            )
+    ok = np.isfinite(objective) & (dynamic > 0)
+    best = np.unravel_index(np.argmin(np.where(ok, objective, np.inf)), objective.shape) if ok.any() else None
+    return dict(
+        end_radius=r,
+        layback_angle=t,
+        axial_clearance=axial_clearance,
+        objective=objective,
+        ci=ci,
+        dynamic_margin=dynamic,
+        static_margins=static,
+        best_design=None if best is None else np.array([r[best[0]], t[best[1]], axial_clearance]),
+        best_objective=float("nan") if best is None else float(objective[best]),
+        best_ci=None if best is None else tuple(ci[best]),
+        num_evaluations=evaluations,
+        simulated_ms=simulated,
+        wall_time_s=time.perf_counter() - t0,
+    )
