@@ -24,7 +24,9 @@ measure over a window of whole revolutions (issue 11; docs/model.md 16).
   and spin in proportion) by tau d omega/dt, tau = `dynamics.cage_time_constant` (the Newton
   step of the linear slow mode onto its plateau), while the step exceeds a quarter of `tolerance`;
   at most `PROJECTIVE_STEPS` times. Settling is then detected as below, on revolutions after the last
-  step only. `start="quasi-static"`: kinematic speeds, no projective steps.
+  step only. Since the skid start's pre-start (`_initial`) measures that drift itself and lands
+  on the plateau, the projective steps are taken only when its pre-start failed.
+  `start="quasi-static"`: kinematic speeds, no projective steps.
 * The window is `window_revs` further revolutions; its statistics and intervals come from
   `_statistics`. With `seeds = N` the whole run is repeated for N seeded initial scatters
   (`Perturbation.seed` = 0 .. N-1), with `workers` > 1 one process per core (`parallel_map`: 1.52x the throughput of
@@ -394,7 +396,10 @@ def simulate_steady(
             integrate = _integrator(params, int(saves_per_rev), int(max_steps), rtol, atol, compiled)
             skid = skid_start(bearing, op, pert, integrate=integrate)
             compile_time += sum(compiled)
-            y0, tau = skid.state, float(skid.time_constant)
+            # on the plateau after a completed pre-start: no projective steps (their drift, from
+            # two revolution means, is noisier than the pre-start's secant; docs/model.md 16)
+            y0 = skid.state
+            tau = None if skid.pre_start_status == "ok" else float(skid.time_constant)
         else:
             y0, tau = initial_state(bearing, op, pert), None
         c0 = time.perf_counter()
