@@ -25,17 +25,19 @@ The skid start has two parts (docs/model.md 16):
      of the burst, not from the instantaneous cage speed (which rattles by about 3 rpm about
      its mean: a step from it would carry that offset along); tau is the static slow mode's
      tau_s (`dynamics.cage_time_constant`) for the first step and the secant of the last two
-     bursts, tau = -(w_k - w_{k-1}) / (g_k - g_{k-1}), afterwards (the drift is linear in the
-     cage speed near the plateau, the slow mode: a secant is a coarse Newton step);
+     bursts, tau = -(w_k - w_{k-1}) / (g_k - g_{k-1}), afterwards (near the plateau the drift is
+     close to linear in the cage speed, the slow mode: a secant step is a coarse Newton step);
    - stop after the second or third burst, when a step is below `PRE_START_TOLERANCE`.
 
-   The dynamics' slow mode is slower than the static one (at the reference point tau = 61 ms
-   against tau_s = 46 ms: the flange friction grows as the cage slows), which is why one
-   projective step with tau_s lands short and the settling loop used to need two or three.
-   Cost: 2.35 cage revolutions of simulated time (16.5 ms at the reference point), through the
-   run's own compiled `solve_from` (no compilation of its own). Deterministic per seed; not
-   differentiated (a start, not a model output). If a burst fails, the static state is handed
-   over (`pre_start_status` says why) and the settling loop's projective steps take over.
+   The running bearing's slow mode is slower than the static balance's (at the reference point
+   the secants give tau = 66 and 62 ms against tau_s = 46 ms), which is why one projective step
+   with tau_s lands short (-80 rpm of the 116 needed) and the settling loop used to need two or
+   three. Cost: 2.45 cage revolutions of simulated time (17.2 ms at the reference point), through
+   the run's own compiled `solve_from` (no compilation of its own). Measured there
+   (benchmarks/bench_settling.py): revolution 1 of the run within 0.006 % of the window's cage
+   speed. Deterministic per seed; not differentiated (a start, not a model output). If a burst
+   fails, the static state is handed over (`pre_start_status` says why) and the settling loop's
+   projective steps take over.
 """
 
 from __future__ import annotations
@@ -135,7 +137,7 @@ class SkidStart(eqx.Module):
     from, and the cage's slow mode (module docstring).
 
     `time_constant` [s]: of the cage speed's approach to steady running; with a pre-start the one
-    the dynamics showed (the secant of the two measured drifts), else the static
+    the dynamics showed (the secant of the last two measured drifts), else the static
     `dynamics.cage_time_constant`. `pre_start_time` [s]: simulated time spent before t = 0 (0 for
     the static start). `drift_speeds`, `drifts` [rad/s, rad/s^2]: the pre-start's measured
     revolution-mean cage speeds and their drifts d omega_c/dt (empty for the static start).
