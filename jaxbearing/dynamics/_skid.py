@@ -41,7 +41,18 @@ no tangential stiffness):
 The solve runs outside any `vmap` over cases (a vmapped bisection costs several times more per
 case on a CPU) and is not differentiated (`stop_gradient`): it is a start, not a model output.
 Oracle: with no drag, no land film and no gravity, it returns the kinematic speeds
-(tests/test_skid.py); the dynamics started from it stay at its cage speed.
+(tests/test_skid.py); the dynamics started from it show no start-up step (0.08 % in the first
+revolution at the reference point).
+
+What it cannot know: once running, the rollers skew (about 1 mrad, even with no initial scatter)
+and rub the flanges, and that friction is not in a balance at the start positions (the seeded
+skews of 0.1 mrad keep the ends off the flanges). At the reference point the static cage speed,
+8534 rpm, lies 1.4 % above the plateau the dynamics reach (about 8418 rpm). Adding the flanges'
+measured time-mean friction as constant loads would not close the gap either: a constant
+correction moves the balance through the static slope of the cage torque, and the running
+bearing's slow mode is slower (secants of measured drifts: 62-66 ms) than the static balance's
+(`cage_time_constant`, 46 ms), so such a correction stops about a quarter short. `run.skid_start`'s pre-start therefore measures the drift on the dynamics
+themselves, twice, and takes a secant step onto the plateau (run/_initial.py).
 """
 
 from __future__ import annotations

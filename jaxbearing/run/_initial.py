@@ -1,10 +1,44 @@
 """The initial state of a run: the quasi-static load distribution (`dynamics.quasi_static`) with
 pure-rolling speeds, plus a seeded `Perturbation` of the rollers' axial positions and skew (a
 perfectly symmetric bearing never skews in a deterministic model; real rollers start with
-manufacturing scatter); or, `skid_start`, the same positions with the speeds of steady running
-(`dynamics.skid_equilibrium`: cage and roller speeds from the skid balance, rollers against the
-pocket side they are pushed to, cage centre at its land equilibrium), solved in one compiled
-call per bearing structure and never inside a vmap over cases."""
+manufacturing scatter); or, `skid_start`, the same positions with the speeds of steady running.
+
+The skid start has two parts (docs/model.md 16):
+
+1. the static skid equilibrium (`dynamics.skid_equilibrium`: cage and roller speeds from the
+   skid balance, rollers against the pocket side they are pushed to, cage centre at its land
+   equilibrium), solved in one compiled call per bearing structure and never inside a vmap over
+   cases;
+2. the pre-start, given the run's integrator: what a static balance cannot know (once running,
+   the rollers skew to about 1 mrad and rub the flanges; their friction lowers the plateau by
+   1.3 % at the reference point) is measured on the dynamics themselves and the start moved onto
+   the plateau, by a secant (coarse Newton) step on the slow variable, the cage speed (the
+   equation-free fixed point of Kevrekidis et al. 2003, "Equation-free, coarse-grained multiscale
+   computation", Comm. Math. Sci. 1:715; Gear & Kevrekidis 2003, SIAM J. Sci. Comput. 24:1091):
+
+   - bursts of `PRE_START_SKIP` + `PRE_START_MEASURE` cage revolutions, the first from the
+     static state (the rollers skew and reach the flanges within its first quarter revolution);
+     in each, the drift g = d omega_c/dt is the slope of a least-squares line through the cage
+     speed after the skip, at the mean speed w (`cage_drift`);
+   - after each burst a step of the cage speed onto the plateau w* = w + tau g, the rollers'
+     orbit and spin along with it (`along_slow_mode`), taken from the line's value at the end
+     of the burst, not from the instantaneous cage speed (which rattles by about 3 rpm about
+     its mean: a step from it would carry that offset along); tau is the static slow mode's
+     tau_s (`dynamics.cage_time_constant`) for the first step and the secant of the last two
+     bursts, tau = -(w_k - w_{k-1}) / (g_k - g_{k-1}), afterwards (near the plateau the drift is
+     close to linear in the cage speed, the slow mode: a secant step is a coarse Newton step);
+   - stop after the second or third burst, when a step is below `PRE_START_TOLERANCE`.
+
+   The running bearing's slow mode is slower than the static balance's (at the reference point
+   the secants give tau = 66 and 62 ms against tau_s = 46 ms), which is why one projective step
+   with tau_s lands short (-80 rpm of the 116 needed) and the settling loop used to need two or
+   three. Cost: 2.45 cage revolutions of simulated time (17.2 ms at the reference point), through
+   the run's own compiled `solve_from` (no compilation of its own). Measured there
+   (benchmarks/bench_settling.py): revolution 1 of the run within 0.006 % of the window's cage
+   speed. Deterministic per seed; not differentiated (a start, not a model output). If a burst
+   fails, the static state is handed over (`pre_start_status` says why) and the settling loop's
+   projective steps take over.
+"""
 
 from __future__ import annotations
 
@@ -13,6 +47,7 @@ import dataclasses
 import equinox as eqx
 import jax
 import jax.numpy as jnp
+import numpy as np
 
 from ..dynamics import (
     Accumulators,
@@ -98,12 +133,26 @@ def initial_state(bearing: Bearing, op: OperatingPoint, perturbation: Perturbati
 
 
 class SkidStart(eqx.Module):
-    """The skid start of a run: its state, the equilibrium's residuals, and the time constant
-    [s] of the cage speed's slow approach to steady running (`dynamics.cage_time_constant`)."""
+    """The skid start of a run: the state handed over at t = 0, the static equilibrium it grew
+    from, and the cage's slow mode (module docstring).
+
+    `time_constant` [s]: of the cage speed's approach to steady running; with a pre-start the one
+    the dynamics showed (the secant of the last two measured drifts), else the static
+    `dynamics.cage_time_constant`. `pre_start_time` [s]: simulated time spent before t = 0 (0 for
+    the static start). `drift_speeds`, `drifts` [rad/s, rad/s^2]: the pre-start's measured
+    revolution-mean cage speeds and their drifts d omega_c/dt (empty for the static start).
+    `plateau_speed` [rad/s]: the cage speed at which the drift vanishes (the static one without
+    pre-start). `pre_start_status`: "ok", "static" (no integrator given) or why the pre-start
+    fell back to the static state."""
 
     state: State
     equilibrium: SkidEquilibrium
     time_constant: jax.Array
+    pre_start_time: float = 0.0
+    drift_speeds: tuple = ()
+    drifts: tuple = ()
+    plateau_speed: float = float("nan")
+    pre_start_status: str = eqx.field(static=True, default="static")
 
 
 def _skid(bearing, op, scatter):
@@ -116,15 +165,111 @@ def _skid(bearing, op, scatter):
 _COMPILED: dict = {}
 
 
-def skid_start(bearing: Bearing, op: OperatingPoint, perturbation: Perturbation | None) -> SkidStart:
-    """`initial_state`'s positions with the speeds of steady running (module docstring).
-
-    Compiled once per bearing structure (seeds, speeds and loads reuse it); runs outside any
-    vmap (a vmapped bisection costs several times more per case)."""
+def _static_skid_start(bearing: Bearing, op: OperatingPoint, perturbation: Perturbation | None) -> SkidStart:
     scatter = traced_scatter(perturbation)
     dyn = (bearing, op, scatter)
     leaves, treedef = jax.tree_util.tree_flatten(dyn)
     key = (treedef, tuple((jnp.shape(x), jnp.result_type(x)) for x in leaves))
     if key not in _COMPILED:
         _COMPILED[key] = jax.jit(_skid).lower(*dyn).compile()
-    return _COMPILED[key](*dyn)
+    static = _COMPILED[key](*dyn)
+    return dataclasses.replace(static, plateau_speed=float(static.equilibrium.cage_speed))
+
+
+#: the pre-start's bursts, in revolutions at the static skid speed: each skips `PRE_START_SKIP`
+#: (the first: the rollers skew and reach the flanges; the later ones: the rollers' spins and
+#: pocket contacts readjust to the stepped cage speed), then measures the cage speed's drift over
+#: `PRE_START_MEASURE` (the first two drifts only aim the last burst: half a revolution each)
+PRE_START_SKIP = (0.25, 0.1, 0.1)
+PRE_START_MEASURE = (0.5, 0.5, 1.0)
+#: the pre-start stops when a step is below this fraction of the cage speed (after two bursts)
+PRE_START_TOLERANCE = 2e-4
+#: a step of the pre-start moves the cage speed by at most this fraction
+PRE_START_CAP = 0.05
+#: the secant's time constant is accepted within these multiples of the static one
+TIME_CONSTANT_RANGE = (0.5, 4.0)
+
+
+def along_slow_mode(state: State, jump) -> State:
+    """The state with the cage speed moved by `jump` [rad/s] along the slow mode: every roller's
+    orbit rate moves with it, the rollers' angular velocities scale in proportion."""
+    ratio = (state.cage.speed + jump) / state.cage.speed
+    rollers = dataclasses.replace(
+        state.rollers,
+        azimuth_rate=state.rollers.azimuth_rate + jump,
+        angular_velocity=state.rollers.angular_velocity * ratio,
+    )
+    cage = dataclasses.replace(state.cage, speed=state.cage.speed + jump)
+    return dataclasses.replace(state, rollers=rollers, cage=cage)
+
+
+def cage_drift(t, cage_speed, since):
+    """Least-squares line through the cage speed samples at t >= `since`: (mean speed, drift
+    d omega_c/dt, the line's value at the last sample). The line's end value, not the last
+    sample, is the level a projective step starts from: the instantaneous cage speed rattles by
+    several rpm about its mean (pocket contacts)."""
+    t, w = np.asarray(t, float), np.asarray(cage_speed, float)
+    keep = t >= since
+    t, w = t[keep], w[keep]
+    tc = t - t.mean()
+    drift = float(np.sum(tc * w) / np.sum(tc * tc))
+    mean = float(w.mean())
+    return mean, drift, mean + drift * float(tc[-1])
+
+
+def _pre_start(static: SkidStart, integrate) -> SkidStart:
+    """Bursts of the dynamics from the static skid state with secant steps on the cage speed's
+    drift between them (module docstring); falls back to `static` if a burst fails."""
+    w0, tau_s = float(static.state.cage.speed), float(static.time_constant)
+    rev = 2 * np.pi / abs(w0)
+    cap = PRE_START_CAP * abs(w0)
+    lo, hi = TIME_CONSTANT_RANGE
+    state, tau, elapsed, speeds, drifts = static.state, tau_s, 0.0, [], []
+    for k, (skip, measure) in enumerate(zip(PRE_START_SKIP, PRE_START_MEASURE)):
+        hist, end, code, _ = integrate(state, (skip + measure) * rev)
+        elapsed += (skip + measure) * rev
+        speed = np.asarray(hist["cage_speed"])
+        if int(code) != 0 or not np.all(np.isfinite(speed)):
+            why = f"failed: the solver did not succeed in pre-start burst {k + 1}; static start"
+            return dataclasses.replace(static, pre_start_time=elapsed, pre_start_status=why)
+        w, drift, level = cage_drift(np.asarray(hist["t"]), speed, skip * rev)
+        if speeds and w != speeds[-1]:
+            # secant of the last two bursts: d(drift)/d(omega_c) = -1/tau; a flat one or one of
+            # the wrong sign, or a tau outside TIME_CONSTANT_RANGE x tau_s, keeps the last tau
+            secant = -(w - speeds[-1]) / (drift - drifts[-1]) if drift != drifts[-1] else float("nan")
+            tau = secant if lo * tau_s <= secant <= hi * tau_s else tau
+        speeds.append(w)
+        drifts.append(drift)
+        # step from the line's end value (the level) onto the plateau w + tau drift
+        jump = float(np.clip(w + tau * drift - level, -cap, cap))
+        state = along_slow_mode(end, jump)
+        if k >= 1 and abs(jump) <= PRE_START_TOLERANCE * abs(w0):
+            break
+    return SkidStart(
+        state=state,
+        equilibrium=static.equilibrium,
+        time_constant=jnp.asarray(tau),
+        pre_start_time=elapsed,
+        drift_speeds=tuple(speeds),
+        drifts=tuple(drifts),
+        plateau_speed=level + jump,
+        pre_start_status="ok",
+    )
+
+
+def skid_start(
+    bearing: Bearing, op: OperatingPoint, perturbation: Perturbation | None, *, integrate=None
+) -> SkidStart:
+    """The start of a settled run (module docstring): the static skid equilibrium at
+    `initial_state`'s positions, then, given `integrate`, the pre-start that lands it on the
+    settled plateau.
+
+    `integrate(state, duration) -> (histories, final state, result code, steps)`: the run's own
+    compiled continuation (`solve_from` with its parameters and tolerances bound; histories with
+    "t" and "cage_speed"), so that the pre-start costs no compilation of its own. The static
+    equilibrium is compiled once per bearing structure (seeds, speeds and loads reuse it) and
+    runs outside any vmap (a vmapped bisection costs several times more per case)."""
+    static = _static_skid_start(bearing, op, perturbation)
+    if integrate is None:
+        return static
+    return _pre_start(static, integrate)

@@ -24,7 +24,9 @@ measure over a window of whole revolutions (issue 11; docs/model.md 16).
   and spin in proportion) by tau d omega/dt, tau = `dynamics.cage_time_constant` (the Newton
   step of the linear slow mode onto its plateau), while the step exceeds a quarter of `tolerance`;
   at most `PROJECTIVE_STEPS` times. Settling is then detected as below, on revolutions after the last
-  step only. `start="quasi-static"`: kinematic speeds, no projective steps.
+  step only. Since the skid start's pre-start (`_initial`) measures that drift itself and lands
+  on the plateau, the projective steps are taken only when its pre-start failed.
+  `start="quasi-static"`: kinematic speeds, no projective steps.
 * The window is `window_revs` further revolutions; its statistics and intervals come from
   `_statistics`. With `seeds = N` the whole run is repeated for N seeded initial scatters
   (`Perturbation.seed` = 0 .. N-1), with `workers` > 1 one process per core (`parallel_map`: 1.52x the throughput of
@@ -49,7 +51,7 @@ from ..geometry import Bearing, OperatingPoint, kinematic_cage_speed, rad_s_to_r
 from ..io import require
 from ._compile_cache import checks_without_host_callbacks
 from ._ensemble import parallel_map
-from ._initial import STARTS, Perturbation, initial_state, skid_start
+from ._initial import STARTS, Perturbation, along_slow_mode, initial_state, skid_start
 from ._result import result_code
 from ._simulate import SolveArgs, _diffeqsolve, _save
 from ._simulate import simulate as _simulate_fixed
@@ -125,6 +127,19 @@ def _compiled(params, start, num_saves, max_steps):
     return _COMPILED[key]
 
 
+def _integrator(params, num_saves, max_steps, rtol, atol, compile_times: list):
+    """`solve_from` compiled (`_compiled`) with the run's parameters and tolerances bound, as
+    `skid_start`'s pre-start needs it; compilation times are appended to `compile_times`."""
+
+    def integrate(state, duration):
+        c0 = time.perf_counter()
+        run = _compiled(params, state, num_saves, max_steps)
+        compile_times.append(time.perf_counter() - c0)
+        return run(params, state, jnp.asarray(duration), jnp.asarray(rtol), jnp.asarray(atol))
+
+    return integrate
+
+
 @dataclasses.dataclass
 class SeedRun:
     """One seed's settled run: the window's histories (absolute times) and its revolutions."""
@@ -198,19 +213,6 @@ def _as_float(name, value):
         ) from None
 
 
-def _projected(state: State, jump) -> State:
-    """The state with the cage speed moved by `jump` [rad/s] along the slow mode: the rollers'
-    orbit rates move with it and their angular velocities scale in proportion."""
-    ratio = (state.cage.speed + jump) / state.cage.speed
-    rollers = dataclasses.replace(
-        state.rollers,
-        azimuth_rate=state.rollers.azimuth_rate + jump,
-        angular_velocity=state.rollers.angular_velocity * ratio,
-    )
-    cage = dataclasses.replace(state.cage, speed=state.cage.speed + jump)
-    return dataclasses.replace(state, rollers=rollers, cage=cage)
-
-
 def _run_seed(
     params,
     start,
@@ -279,7 +281,7 @@ def _run_seed(
             big = abs(jump) > PROJECTIVE_THRESHOLD * tolerance * abs(speeds[-1])
             if big and (fixed is None or t < fixed - 1e-12):
                 jumps.append(jump)
-                state = _projected(state, jump * math.pi / 30)
+                state = along_slow_mode(state, jump * math.pi / 30)
                 since_jump = 0
                 if progress:
                     print(f"  projective step: cage speed {jump:+.2f} rpm", flush=True)
@@ -438,9 +440,15 @@ def simulate_steady(
     for pert, given in zip(perturbations, states):
         if given is not None:  # continuation from a given state
             y0, tau = jax.tree_util.tree_map(jnp.asarray, given), None
-        elif start == "skid":  # its compilation and solve count in the wall time
-            skid = skid_start(bearing, op, pert)
-            y0, tau = skid.state, float(skid.time_constant)
+        elif start == "skid":  # its solve and pre-start count in the wall time, not compilation
+            compiled = []
+            integrate = _integrator(params, int(saves_per_rev), int(max_steps), rtol, atol, compiled)
+            skid = skid_start(bearing, op, pert, integrate=integrate)
+            compile_time += sum(compiled)
+            # on the plateau after a completed pre-start: no projective steps (their drift, from
+            # two revolution means, is noisier than the pre-start's secant; docs/model.md 16)
+            y0 = skid.state
+            tau = None if skid.pre_start_status == "ok" else float(skid.time_constant)
         else:
             y0, tau = initial_state(bearing, op, pert), None
         c0 = time.perf_counter()
