@@ -254,6 +254,28 @@ def _margin_text(m) -> str:
     )
 
 
+def _progress(quiet: bool, start_line):
+    """The per-iteration progress callback of both searches: the best feasible objective, then
+    one line per start (`start_line(j, info, margins, index of the smallest margin)`)."""
+    import numpy as np
+
+    def progress(it, info):
+        if quiet:
+            return
+        best = info["best"]
+        print(
+            f"iter {it:3d}  best feasible {best:.4f} GPa m/s"
+            if np.isfinite(best)
+            else f"iter {it:3d}  best feasible   none yet"
+        )
+        for j in range(info["x"].shape[0]):
+            m = info["margins"][j]
+            print(f"   start {j}: " + start_line(j, info, m, int(np.argmin(m))))
+        sys.stdout.flush()
+
+    return progress
+
+
 def run(args) -> int:
     import numpy as np
 
@@ -286,24 +308,14 @@ def run(args) -> int:
         f"({problem.aggregate} over the envelope)"
     )
 
-    def progress(it, info):
-        if args.quiet:
-            return
-        best = info["best"]
-        print(
-            f"iter {it:3d}  best feasible {best:.4f} GPa m/s"
-            if np.isfinite(best)
-            else f"iter {it:3d}  best feasible   none yet"
+    def start_line(j, info, m, w):
+        return (
+            f"J {info['objective'][j]:8.4f} GPa m/s  "
+            f"min margin {MARGIN_NAMES[w]} {m[w] * 1e3:+.4f} mm  {_design_text(info['x'][j])}"
+            f"{'' if info['feasible'][j] else '  (infeasible)'}"
         )
-        for j in range(info["x"].shape[0]):
-            m = info["margins"][j]
-            w = int(np.argmin(m))
-            print(
-                f"   start {j}: J {info['objective'][j]:8.4f} GPa m/s  "
-                f"min margin {MARGIN_NAMES[w]} {m[w] * 1e3:+.4f} mm  {_design_text(info['x'][j])}"
-                f"{'' if info['feasible'][j] else '  (infeasible)'}"
-            )
-        sys.stdout.flush()
+
+    progress = _progress(args.quiet, start_line)
 
     res = search(problem, callback=progress, **options)
     result = _result_json(problem, options, res)
@@ -349,7 +361,6 @@ def run(args) -> int:
 def run_steady(args, problem, options, settings, out) -> int:
     """`optimise run --objective steady` (the default): `_steady.steady_search` with progress,
     checkpoint and resume in `out`, verification, result.json and the search-path plot."""
-    import numpy as np
 
     from jaxbearing.io import write_json
 
@@ -365,26 +376,16 @@ def run_steady(args, problem, options, settings, out) -> int:
     )
     sys.stdout.flush()
 
-    def progress(it, info):
-        if args.quiet:
-            return
-        best = info["best"]
-        print(
-            f"iter {it:3d}  best feasible {best:.4f} GPa m/s"
-            if np.isfinite(best)
-            else f"iter {it:3d}  best feasible   none yet"
+    def start_line(j, info, m, w):
+        lo, hi = info["ci"][j]
+        g = info["gradient"][j]
+        return (
+            f"J {info['objective'][j]:7.4f} [{lo:.4f}, {hi:.4f}] GPa m/s  "
+            f"min margin {CONSTRAINT_NAMES[w]} {m[w] * 1e3:+.4f} mm  {_design_text(info['x'][j])}  "
+            f"dJ/du ({g[0]:+.3f}, {g[1]:+.3f}, {g[2]:+.3f})"
         )
-        for j in range(info["x"].shape[0]):
-            m = info["margins"][j]
-            w = int(np.argmin(m))
-            lo, hi = info["ci"][j]
-            g = info["gradient"][j]
-            print(
-                f"   start {j}: J {info['objective'][j]:7.4f} [{lo:.4f}, {hi:.4f}] GPa m/s  "
-                f"min margin {CONSTRAINT_NAMES[w]} {m[w] * 1e3:+.4f} mm  {_design_text(info['x'][j])}  "
-                f"dJ/du ({g[0]:+.3f}, {g[1]:+.3f}, {g[2]:+.3f})"
-            )
-        sys.stdout.flush()
+
+    progress = _progress(args.quiet, start_line)
 
     res = steady_search(
         problem, settings, directory=out, callback=progress, verify=not args.no_verify, **options
