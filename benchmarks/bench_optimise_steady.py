@@ -5,9 +5,10 @@ objective (issue 13 acceptance): ``python benchmarks/bench_optimise_steady.py [-
    settings (reference bearing, 20,000 rpm, 1000 N): its wall time (compilation included, as a
    user sees it), result.json (design, objective with CI, verification on unseen seeds).
 2. `optimise._steady.steady_grid`: the same objective (same seeds, settings) on a 7 x 7 grid of
-   (R_end, theta_f) over the default bounds at the Delta_bf the search found, every statically
-   feasible point continuing from the previous one; the best point with every static and
-   dynamic margin positive.
+   (R_end, theta_f) over the default bounds at the reference Delta_bf (0.15 mm), every
+   statically feasible point continuing from the previous one; the best point with every static
+   and dynamic margin positive. `--grid-only` runs this stage alone (it can run beside the
+   search; a later full run takes the finished grid from its checkpoint).
 3. Costs of both: settled ensembles and simulated milliseconds (seeds x (settling + window),
    plus the gradient samples of the search).
 
@@ -38,10 +39,17 @@ NAME = "bench_optimise_steady"
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 OUT = ROOT / "out" / NAME
 GRID = 7
+GRID_CLEARANCE = 0.15e-3  # [m] the reference design's Delta_bf
 
 
 def _run_search(quick: bool) -> tuple[dict, float]:
+    """result.json and the wall time of the default `optimise run`; with `--assemble` a finished
+    run's result.json is read back (its own wall time: the search with compilation, without
+    the process start)."""
     out = OUT / ("run_quick" if quick else "run")
+    if "--assemble" in sys.argv and (out / "result.json").exists():
+        result = json.loads((out / "result.json").read_text())
+        return result, float(result["wall_time_s"])
     cmd = [str(pathlib.Path(sys.executable).parent / "optimise"), "run", "--out", str(out)]
     if quick:
         cmd += ["--starts", "1", "--iterations", "1", "--seeds", "2", "--verify-seeds", "2"]
@@ -53,19 +61,39 @@ def _run_search(quick: bool) -> tuple[dict, float]:
     return json.loads((out / "result.json").read_text()), wall
 
 
-def main(quick: bool = False) -> dict:
+def _grid(quick: bool) -> dict:
     import jaxbearing as jb
     from optimise import make_problem
     from optimise._steady import SteadySettings, steady_grid
 
-    result, wall = _run_search(quick)
-    bearing, op = jb.reference_bearing(), jb.reference_operating_point()
-    problem = make_problem(bearing, op)
+    problem = make_problem(jb.reference_bearing(), jb.reference_operating_point())
     settings = SteadySettings(seeds=2 if quick else 4)
     n = 3 if quick else GRID
-    dbf = (result["design"] or {}).get("axial_clearance_mm", 0.15) * 1e-3
-    _common.log(f"{NAME}: {n} x {n} grid at Delta_bf = {dbf * 1e3:.4f} mm")
-    grid = steady_grid(problem, settings, n, n, dbf, directory=OUT / ("grid_quick" if quick else "grid"))
+    _common.log(f"{NAME}: {n} x {n} grid at Delta_bf = {GRID_CLEARANCE * 1e3:.4f} mm")
+
+    def progress(k, info):
+        x = info["x"]
+        _common.log(
+            f"  grid point {k}: R_end {x[0] * 1e3:.1f} mm, theta_f {math.degrees(x[1]):.3f} deg: "
+            f"J {info['objective']:.4f} GPa m/s, dynamic corner margin {info['dynamic_margin'] * 1e3:+.4f} mm"
+        )
+
+    return steady_grid(
+        problem,
+        settings,
+        n,
+        n,
+        GRID_CLEARANCE,
+        directory=OUT / ("grid_quick" if quick else "grid"),
+        callback=progress,
+    )
+
+
+def main(quick: bool = False) -> dict:
+    result, wall = _run_search(quick)
+    grid = _grid(quick)
+    n = 3 if quick else GRID
+    dbf = GRID_CLEARANCE
     best = grid["best_objective"]
     search_obj = (result.get("objective_GPa_m_s") or {}).get("value")
     search_ci = result.get("objective_GPa_m_s") or {}
@@ -163,4 +191,7 @@ def main(quick: bool = False) -> dict:
 
 
 if __name__ == "__main__":
-    main(quick="--quick" in sys.argv)
+    if "--grid-only" in sys.argv:
+        _grid("--quick" in sys.argv)
+    else:
+        main(quick="--quick" in sys.argv)
