@@ -1,5 +1,5 @@
-"""Misalignment study at reduced size, on settled running (slow: several minutes on the shared
-2-core machine).
+"""Misalignment study at reduced size, on settled running (slow: 468 s on the shared 2-core
+machine under a load average of 6-10, `pytest -m slow -k skew`).
 
 benchmarks/bench_misalignment.py's `study` with its QUICK settings: misalignment 0, 1, 2 mrad at
 the reference point, each settled (`settle="auto"` from the skid start, docs/model.md 16), then a
