@@ -1,25 +1,25 @@
-"""Misalignment study (issue 14, item 5): mean roller skew and mean flange load against an imposed
-inner-ring misalignment (tilt about +Y, `OperatingPoint.misalignment`) at the reference point
-(20,000 rpm, 1000 N, gravity on; inner ring held axially and in tilt).
+"""Misalignment study (issue 14, item 5) on settled running: mean roller skew and mean flange
+load against an imposed inner-ring misalignment (tilt about +Y, `OperatingPoint.misalignment`)
+at the reference point (arc end, 20,000 rpm, 1000 N, gravity on; inner ring held axially and in
+tilt).
 
-For each misalignment, `jaxbearing.simulate(bearing, op, settle=..., window_revs=...,
-seeds=...)` and `jaxbearing.summarise` give, over the measurement window:
+Every misalignment is run as `jaxbearing.simulate(bearing, op, settle="auto", window_revs=...,
+seeds=..., workers=...)`: from the skid start (the default) with projective steps of the cage
+speed until the revolution-mean cage speed changes by less than 1e-3 between two revolutions
+(cap 300 ms; docs/model.md 16), then a window of whole cage revolutions. Reported per case, over
+the window, with 95 % intervals (Student-t over the seeds' means, N-1 dof):
 
 * mean roller skew: `roller_skew_rad.mean_abs`, the time-mean of |e . e_tan| over rollers
   (skew measured against the bearing frame, i.e. against the fixed outer ring);
 * mean flange load, two ways:
-  - `flange_force_N.mean`: mean peak normal force of the flange contact events (summarise);
   - `total_flange_load_N`: the time-mean of the sum of all flange normal forces (all rollers,
-    all four flanges) per cage revolution, computed here from the window histories;
-each with a 95 % interval: Student-t over the seeds' means (N-1 dof) with several seeds,
-batch means over the window's revolutions with one (`jaxbearing.run.student_t_interval`).
+    all four flanges), per cage revolution, computed here from the window histories;
+  - `flange_force_N.mean`: the mean peak normal force of the flange contact events;
+* how each seed settled (settled or cap hit, settling time, projective steps).
 
-Settling: a full settled run (`settle="auto"`) needs 100-150 ms of simulated time per seed (the
-cage slip settles slowly) and takes tens of minutes per seed on this shared 2-core machine. This
-benchmark therefore uses a FIXED settling time (`settle="5"` ms, quick: 1 ms) followed by a
-short window (2 cage revolutions, about 13 ms): the cage speed is NOT fully settled, and the
-results file says so (`settled_note`). The trend with misalignment is what is measured, at
-equal settling for every case.
+A step between neighbouring misalignments counts as resolved when the two intervals do not
+overlap, or when the Welch 95 % interval of the difference of the means excludes 0 (both are
+recorded).
 """
 
 from __future__ import annotations
@@ -34,33 +34,12 @@ import _common  # noqa: E402
 
 NAME = "bench_misalignment"
 
-FULL = {"misalignments_mrad": [0.0, 0.5, 1.0, 2.0], "settle_ms": 5.0, "window_revs": 2, "seeds": 3}
-QUICK = {"misalignments_mrad": [0.0, 1.0, 2.0], "settle_ms": 1.0, "window_revs": 2, "seeds": 1}
+FULL = {"misalignments_mrad": [0.0, 0.5, 1.0, 2.0], "window_revs": 4, "seeds": 4, "workers": 2}
+#: reduced size (tests/test_misalignment_trend.py): one seed, a 2-revolution window
+QUICK = {"misalignments_mrad": [0.0, 1.0, 2.0], "window_revs": 2, "seeds": 1, "workers": 1}
 
 
-def total_flange_load(result) -> dict:
-    """Time-mean total flange normal force [N] per cage revolution of each seed's window, and its
-    95 % interval (Student-t over seeds, or batch means over revolutions with one seed)."""
-    import numpy as np
-
-    from jaxbearing.run import student_t_interval
-
-    per_seed = []
-    for run in result.runs:
-        t = np.asarray(run.window["t"])
-        total = np.asarray(run.window["flange_force"]).sum(axis=(1, 2))
-        revs = [float(np.mean(total[(t >= a) & (t < b)])) for a, b in zip(run.edges[:-1], run.edges[1:])]
-        per_seed.append(revs)
-    if len(per_seed) > 1:
-        est = student_t_interval([float(np.mean(r)) for r in per_seed])
-    else:
-        est = student_t_interval(per_seed[0])
-    out = est.as_dict()
-    out["per_seed_per_revolution"] = per_seed
-    return out
-
-
-def case(misalignment_mrad: float, settle_ms: float, window_revs: int, seeds: int) -> dict:
+def case(misalignment_mrad: float, window_revs: int, seeds: int, workers: int) -> dict:
     """One misalignment: the settled run's skew and flange-load statistics with 95 % intervals."""
     import equinox as eqx
     import jax.numpy as jnp
@@ -72,47 +51,98 @@ def case(misalignment_mrad: float, settle_ms: float, window_revs: int, seeds: in
         lambda o: o.misalignment, jb.reference_operating_point(), jnp.asarray(misalignment_mrad * 1e-3)
     )
     start = time.perf_counter()
-    result = jb.simulate(bearing, op, settle=f"{settle_ms:g}", window_revs=window_revs, seeds=seeds)
+    result = jb.simulate(bearing, op, settle="auto", window_revs=window_revs, seeds=seeds, workers=workers)
     summary = jb.summarise(result)
-    if summary["status"] != "ok":
-        return {"misalignment_mrad": misalignment_mrad, "status": summary["status"]}
-    return {
+    row = {
         "misalignment_mrad": misalignment_mrad,
         "status": summary["status"],
         "settled": summary["settled"],
-        "settle_time_ms": summary["settle_time_ms"],
-        "window_ms": summary["window_ms"],
-        "ci_method": summary["ci_method"],
-        "roller_skew_rad_mean_abs": summary["roller_skew_rad"]["mean_abs"],
-        "roller_skew_rad_max_abs": summary["roller_skew_rad"]["max_abs"],
-        "flange_event_peak_force_N_mean": summary["flange_force_N"]["mean"],
-        "flange_contact_events_per_rev": summary["flange_contact_events_per_rev"],
-        "total_flange_load_N": total_flange_load(result),
-        "cage_speed_rpm": summary["cage_speed_rpm"],
-        "num_steps": summary["num_steps"],
+        "settle_time_ms_max": summary["settle_time_ms"],
+        "per_seed_settling": [
+            {
+                "seed": s["seed"],
+                "settled": s["settled"],
+                "settle_time_ms": s["settle_time_ms"],
+                "cap_hit": not s["settled"],
+                "projective_steps_rpm": s["projective_steps_rpm"],
+                "start_cage_speed_rpm": s["start_cage_speed_rpm"],
+                "revolution_cage_speed_rpm": s["revolution_cage_speed_rpm"],
+            }
+            for s in summary["per_seed"]
+        ],
         "wall_s": time.perf_counter() - start,
+    }
+    if summary["status"] != "ok":
+        return row
+    means = _common.seed_means(result)
+    total = _common.interval(means["total_flange_load_N"]) if seeds > 1 else None
+    if total is None:  # one seed: batch means over the window's revolutions
+        total = _common.interval(_common.seed_revolution_values(result)[0]["total_flange_load_N"])
+    row["_per_seed"] = {
+        "roller_skew_rad_mean_abs": means["roller_skew_rad.mean_abs"],
+        "total_flange_load_N": means["total_flange_load_N"],
+        "flange_event_peak_force_N_mean": means["flange_force_N.mean"],
+    }
+    row.update(
+        {
+            "window_ms": summary["window_ms"],
+            "ci_method": summary["ci_method"],
+            "roller_skew_rad_mean_abs": summary["roller_skew_rad"]["mean_abs"],
+            "roller_skew_rad_max_abs": summary["roller_skew_rad"]["max_abs"],
+            "total_flange_load_N": total,
+            "per_seed_means": row["_per_seed"],
+            "flange_event_peak_force_N_mean": summary["flange_force_N"]["mean"],
+            "flange_contact_events_per_rev": summary["flange_contact_events_per_rev"],
+            "cage_speed_rpm": summary["cage_speed_rpm"],
+            "num_steps": summary["num_steps"],
+            "solve_wall_s": summary["wall_time_s"],
+        }
+    )
+    return row
+
+
+def monotone(rows: list[dict], key: str) -> dict:
+    """Whether the means increase with misalignment, and whether each step is resolved at 95 %:
+    intervals not overlapping, or (with several seeds) the Welch interval of the difference
+    excluding 0."""
+    vals = [r[key] for r in rows]
+    means = [v["value"] for v in vals]
+    steps = []
+    for (ra, a), (rb, b) in zip(zip(rows, vals), zip(rows[1:], vals[1:])):
+        step = {
+            "from_mrad": ra["misalignment_mrad"],
+            "to_mrad": rb["misalignment_mrad"],
+            "increase": b["value"] - a["value"],
+            "intervals_disjoint": bool(
+                a["ci95_high"] is not None and b["ci95_low"] is not None and b["ci95_low"] > a["ci95_high"]
+            ),
+        }
+        sa, sb = ra.get("_per_seed", {}).get(key), rb.get("_per_seed", {}).get(key)
+        if sa is not None and len(sa) > 1 and len(sb) > 1:
+            step["difference_welch"] = _common.welch_difference(sa, sb)
+            step["difference_excludes_0"] = step["difference_welch"]["ci95_low"] > 0
+        else:
+            step["difference_excludes_0"] = False
+        step["resolved"] = step["intervals_disjoint"] or step["difference_excludes_0"]
+        steps.append(step)
+    return {
+        "means": means,
+        "increasing": all(b > a for a, b in zip(means, means[1:])),
+        "every_step_resolved_at_95": all(s["resolved"] for s in steps),
+        "steps": steps,
     }
 
 
-def monotone(rows: list[dict], key: str, sub: str | None = None) -> dict:
-    """Whether the values increase with misalignment (means), and whether each step is resolved
-    (the next interval's low end above the previous interval's high end)."""
-    vals = [r[key] if sub is None else r[key][sub] for r in rows]
-    means = [v["value"] for v in vals]
-    increasing = all(b > a for a, b in zip(means, means[1:]))
-    resolved = all(
-        a["ci95_high"] is not None and b["ci95_low"] is not None and b["ci95_low"] > a["ci95_high"]
-        for a, b in zip(vals, vals[1:])
-    )
-    return {"means": means, "increasing": increasing, "every_step_resolved_at_95": resolved}
-
-
-def study(misalignments_mrad, settle_ms, window_revs, seeds, log=print) -> dict:
+def study(misalignments_mrad, window_revs, seeds, workers=1, log=print) -> dict:
     rows = []
     for m in misalignments_mrad:
-        row = case(m, settle_ms, window_revs, seeds)
+        row = case(m, window_revs, seeds, workers)
+        settle = ", ".join(
+            f"seed {s['seed']}: {'settled' if s['settled'] else 'CAP HIT'} at {s['settle_time_ms']:.1f} ms"
+            for s in row["per_seed_settling"]
+        )
         log(
-            f"misalignment {m:g} mrad: {row['status']}"
+            f"misalignment {m:g} mrad: {row['status']} ({settle})"
             + (
                 f", skew {row['roller_skew_rad_mean_abs']['value'] * 1e3:.4f} mrad, "
                 f"total flange load {row['total_flange_load_N']['value']:.2f} N "
@@ -130,7 +160,9 @@ def study(misalignments_mrad, settle_ms, window_revs, seeds, log=print) -> dict:
             "total_flange_load": monotone(rows, "total_flange_load_N"),
             "flange_event_peak_force_mean": monotone(rows, "flange_event_peak_force_N_mean"),
         }
-    return {"rows": rows, "trend": trend, "ok": ok}
+    for r in rows:
+        r.pop("_per_seed", None)
+    return {"rows": rows, "trend": trend, "ok": ok, "all_settled": all(r["settled"] for r in rows)}
 
 
 def _ci(est, scale=1.0, digits=3):
@@ -148,26 +180,33 @@ def main(quick: bool = False) -> dict:
     out = study(**cfg, log=_common.log)
     result = {
         "quick": quick,
-        "operating_point": "reference: 20000 rpm, 1000 N radial, gravity on; inner ring held axially and in tilt",
+        "command": "python benchmarks/bench_misalignment.py" + (" --quick" if quick else ""),
+        "operating_point": "reference: arc end, 20000 rpm, 1000 N radial, gravity on; inner ring held axially and in tilt",
         "misalignment_axis": "inner-ring tilt about +Y (perpendicular to the radial load along +Z)",
+        "settling": "settle='auto' from the skid start (projective steps), tolerance 1e-3, cap 300 ms",
         **cfg,
-        "settled_note": (
-            f"fixed settling time of {cfg['settle_ms']:g} ms, not a verified settled state: the cage "
-            "speed of the reference point needs 100-150 ms to settle (settle='auto'); the trend is "
-            "measured at equal settling for every case; each row's 'settled' is true only because a "
-            "fixed settling time counts as declared settled (run/_settle.py), nothing was verified"
-        ),
         **out,
         "benchmark_wall_s": time.perf_counter() - started,
+        "machine": _common.machine_info(),
     }
     if out["ok"]:
         result["table"] = _common.format_table(
-            f"Misalignment study: settle {cfg['settle_ms']:g} ms, window {cfg['window_revs']} revs, "
+            f"Misalignment study, settled (auto) from the skid start: window {cfg['window_revs']} revs, "
             f"{cfg['seeds']} seed(s); mean [95 % CI]",
-            ["misalignment mrad", "mean |skew| mrad", "total flange load N", "event peak force N"],
+            [
+                "misalignment mrad",
+                "settled at ms",
+                "mean |skew| mrad",
+                "total flange load N",
+                "event peak force N",
+            ],
             [
                 [
                     r["misalignment_mrad"],
+                    ", ".join(
+                        f"{s['settle_time_ms']:.1f}" + ("" if s["settled"] else " (cap)")
+                        for s in r["per_seed_settling"]
+                    ),
                     _ci(r["roller_skew_rad_mean_abs"], 1e3, 4),
                     _ci(r["total_flange_load_N"], 1.0, 2),
                     _ci(r["flange_event_peak_force_N_mean"], 1.0, 2),
@@ -177,7 +216,11 @@ def main(quick: bool = False) -> dict:
         )
         print(result["table"])
         for k, v in out["trend"].items():
-            print(f"{k}: increasing {v['increasing']}, every step resolved {v['every_step_resolved_at_95']}")
+            steps = "; ".join(
+                f"{s['from_mrad']:g}->{s['to_mrad']:g}: {'resolved' if s['resolved'] else 'NOT resolved'}"
+                for s in v["steps"]
+            )
+            print(f"{k}: increasing {v['increasing']}; {steps}")
     _common.write_json(NAME if not quick else NAME + "_quick", result)
     return result
 

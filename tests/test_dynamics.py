@@ -75,6 +75,10 @@ def test_run_ok_and_cage_speed_between_zero_and_kinematic(reference_run):
     assert 0.0 < s["cage_speed_rpm"] < kin
     assert s["flange_contact_events"] > 0
     assert s["on_arc_fraction"] == 1.0  # the reference arc design keeps contacts on the arc
+    # the default flange traction is MODEL.md 4.1's constant mu_f at every saved contact
+    mu = np.asarray(res.histories["flange_friction_coefficient"])
+    assert mu.shape == np.asarray(res.histories["flange_force"]).shape
+    np.testing.assert_array_equal(mu, float(res.bearing.flange_traction))
 
 
 def test_steady_force_balance(reference_run):

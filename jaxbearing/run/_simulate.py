@@ -82,6 +82,7 @@ def _save(t, y_scaled, args: SolveArgs):
         flange_film_parameter=fl.film_parameter,
         flange_top_edge=fl.top_edge,
         flange_face_error=fl.face_error,
+        flange_friction_coefficient=fl.friction_coefficient,
         cage_speed=y.cage.speed,
         cage_centre=y.cage.centre,
         inner_ring_centre=y.inner_ring.centre,
