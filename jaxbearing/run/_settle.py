@@ -50,6 +50,7 @@ from ._compile_cache import checks_without_host_callbacks
 from ._ensemble import parallel_map
 from ._initial import STARTS, Perturbation, initial_state, skid_start
 from ._result import result_code
+from ._rosenbrock import DEFAULT_SOLVER, check_solver
 from ._simulate import SolveArgs, _diffeqsolve, _save
 from ._simulate import simulate as _simulate_fixed
 from ._statistics import steady_statistics
@@ -72,9 +73,20 @@ PROJECTIVE_CAP = 0.05
 PROJECTIVE_THRESHOLD = 0.25
 
 
-def solve_from(params: Params, start: State, duration, *, num_saves: int, rtol, atol, max_steps: int):
-    """Integrate from the physical state `start` over [0, duration]: (histories, final state,
-    diffrax result code, steps). Accumulators restart from zero. jit-able."""
+def solve_from(
+    params: Params,
+    start: State,
+    duration,
+    *,
+    num_saves: int,
+    rtol,
+    atol,
+    max_steps: int,
+    solver=DEFAULT_SOLVER,
+):
+    """Integrate from the physical state `start` over [0, duration] with `solver` ("tsit5" or
+    "ros34pw2"): (histories, final state, diffrax result code, steps). Accumulators restart
+    from zero. jit-able."""
     b = params.bearing
     zero_acc = jax.tree_util.tree_map(jnp.zeros_like, start.accumulators)
     start = State(rollers=start.rollers, cage=start.cage, inner_ring=start.inner_ring, accumulators=zero_acc)
@@ -91,7 +103,7 @@ def solve_from(params: Params, start: State, duration, *, num_saves: int, rtol, 
     y0_scaled = scaling.scale_state(0.0, start)
     controller = step_controller(rtol, atol, raceway_normal_norm(y0_scaled))
     with checks_without_host_callbacks():  # the same integrator and error norm as `solve`
-        sol = _diffeqsolve(y0_scaled, args, duration, saveat, controller, max_steps, None, False)
+        sol = _diffeqsolve(y0_scaled, args, duration, saveat, controller, max_steps, None, False, solver)
     hist, final = sol.ys
     final = scaling.unscale(duration, jax.tree_util.tree_map(lambda a: a[-1], final))
     return hist, final, result_code(sol.result), jnp.asarray(sol.stats["num_steps"])
@@ -100,13 +112,15 @@ def solve_from(params: Params, start: State, duration, *, num_saves: int, rtol, 
 _COMPILED: dict = {}
 
 
-def _compiled(params, start, num_saves, max_steps):
+def _compiled(params, start, num_saves, max_steps, solver=DEFAULT_SOLVER):
     leaves, treedef = jax.tree_util.tree_flatten((params, start))
-    key = (treedef, tuple((jnp.shape(x), jnp.result_type(x)) for x in leaves), num_saves, max_steps)
+    key = (treedef, tuple((jnp.shape(x), jnp.result_type(x)) for x in leaves), num_saves, max_steps, solver)
     if key not in _COMPILED:
 
         def run(p, s, d, r, a):
-            return solve_from(p, s, d, num_saves=num_saves, rtol=r, atol=a, max_steps=max_steps)
+            return solve_from(
+                p, s, d, num_saves=num_saves, rtol=r, atol=a, max_steps=max_steps, solver=solver
+            )
 
         f = jnp.asarray(1.0)
         _COMPILED[key] = jax.jit(run).lower(params, start, f, f, f).compile()
@@ -205,10 +219,11 @@ def _run_seed(
     saves,
     progress,
     time_constant=None,
+    solver=DEFAULT_SOLVER,
 ):
     """Settle then measure one seed (module docstring); `time_constant` [s] (skid start) turns
     on the projective steps of the cage speed."""
-    compiled = _compiled(params, start, saves, max_steps)
+    compiled = _compiled(params, start, saves, max_steps, solver)
     state, t, steps = start, 0.0, 0
     speeds, ends, windows, edges, jumps = [], [], [], [], []
     since_jump = 0  # revolutions run since the last projective step
@@ -336,6 +351,7 @@ def simulate_steady(
     functionals: Functionals = Functionals(),
     progress: bool = False,
     workers: int = 1,
+    solver: str = DEFAULT_SOLVER,
 ) -> SteadyResult:
     """Settle (module docstring), then measure `window_revs` cage revolutions, for each of
     `seeds` seeded initial scatters, each from `start`: "skid" (default; the skid equilibrium and
@@ -343,9 +359,11 @@ def simulate_steady(
 
     `workers` > 1 runs the seeds in that many processes (`parallel_map`, started with `spawn`: a
     script calling this needs the `if __name__ == "__main__":` guard); `jaxbearing simulate`
-    uses one per CPU. Default 1: one after another, in this process."""
+    uses one per CPU. Default 1: one after another, in this process. `solver`: "tsit5" (default)
+    or "ros34pw2" (`solve`)."""
     from ..io import validate_bearing
 
+    check_solver(solver)
     validate_bearing(bearing, op)
     check_steady_options(settle, window_revs, seeds, tolerance, settle_cap_ms, start=start, workers=workers)
     kwargs = dict(
@@ -360,6 +378,7 @@ def simulate_steady(
         saves_per_rev=saves_per_rev,
         functionals=functionals,
         progress=progress,
+        solver=solver,
     )
     perturbations = [dataclasses.replace(perturbation, seed=perturbation.seed + k) for k in range(int(seeds))]
     workers = min(int(seeds), int(workers))
@@ -382,7 +401,7 @@ def simulate_steady(
         else:
             y0, tau = initial_state(bearing, op, pert), None
         c0 = time.perf_counter()
-        _compiled(params, y0, int(saves_per_rev), int(max_steps))
+        _compiled(params, y0, int(saves_per_rev), int(max_steps), solver)
         compile_time += time.perf_counter() - c0
         if progress:
             print(f"seed {pert.seed}: settling ({settle}), then {window_revs} revolutions", flush=True)
@@ -399,6 +418,7 @@ def simulate_steady(
             saves=int(saves_per_rev),
             progress=progress,
             time_constant=tau,
+            solver=solver,
         )
         runs.append(SeedRun(pert.seed, *out, start_cage_speed_rpm=float(rad_s_to_rpm(y0.cage.speed))))
     wall = time.perf_counter() - wall0 - compile_time
