@@ -266,3 +266,26 @@ def test_agrees_with_tsit5_on_a_short_reference_bearing_run():
     assert np.allclose(ros["cage_speed"], t5["cage_speed"], rtol=1e-5)
     load = np.max(t5["roller_inner_load"])
     assert np.max(np.abs(ros["roller_inner_load"] - t5["roller_inner_load"])) < 1e-2 * load
+
+
+@pytest.mark.slow
+def test_forward_mode_gradient_through_the_bearing_solve_is_finite():
+    """d(largest inner-raceway roller load at 50 us)/d(radial load) through ROS34PW2 in forward
+    mode (diffrax.ForwardMode, the quasi-static start included): finite, nonzero and equal to a
+    central difference of the same solve to 1 %."""
+    import equinox as eqx
+
+    b, op = jb.reference_bearing(), jb.reference_operating_point()
+
+    def peak_load(radial_load):
+        o = eqx.tree_at(lambda x: x.radial_load, op, radial_load)
+        sol = jb.solve(b, o, 5e-5, num_saves=2, rtol=1e-6, solver="ros34pw2", adjoint=diffrax.ForwardMode())
+        return jnp.max(sol.histories["roller_inner_load"][-1])
+
+    f0 = op.radial_load
+    grad = float(jax.jit(jax.jacfwd(peak_load))(f0))
+    f = jax.jit(peak_load)
+    step = 1e-3 * float(f0)
+    fd = (float(f(f0 + step)) - float(f(f0 - step))) / (2 * step)
+    print(f"d(max inner load)/d(radial load): forward mode {grad:.6g}, central difference {fd:.6g}")
+    assert np.isfinite(grad) and fd != 0.0 and abs(grad - fd) <= 1e-2 * abs(fd), (grad, fd)
