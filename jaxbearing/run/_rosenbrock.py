@@ -264,7 +264,7 @@ class RollerBlockJacobian(eqx.Module):
 
 # -- the solvers `solve` offers ---------------------------------------------------------------
 #: rebuild the per-roller blocks every this many accepted steps (ROS34PW2 keeps its order with
-#: a stale T; chosen with benchmarks/bench_work_precision.py)
+#: a stale T); 1, every step attempt, is what benchmarks/bench_work_precision.py --imex measured
 JACOBIAN_REFRESH = 1
 #: solver names accepted by `solve`, `simulate`, `simulate_steady`
 SOLVERS = ("tsit5", "ros34pw2")

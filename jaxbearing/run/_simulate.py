@@ -8,7 +8,8 @@
   max norm, so that every component's tolerance means something physical, except that the
   raceway-normal coordinates (roller radial position and velocity, inner-ring centre) have
   tolerances `raceway_loosen` = 100 times looser (`_step_control`: their 62 kHz ringing need not
-  be resolved to rtol); `max_steps` explicit.
+  be resolved to rtol); `max_steps` explicit. `solver="ros34pw2"` selects the linearly implicit
+  Rosenbrock-W method with per-roller Jacobian blocks instead (`_rosenbrock`; slower, README).
 * Outputs through `SaveAt(ts=..., fn=...)`: only the flange-contact quantities, cage speed and
   roller loads are kept, so memory does not grow with the state.
 * Smooth peak functionals (p-norm of PV, log-sum-exp of the contact height) are integrated in the
