@@ -26,10 +26,17 @@ Integrators (all on the same compiled field and initial state):
   1000; `jaxbearing.run._step_control`);
 * `jaxbearing.solve` with `optimistix.rms_norm` (SciPy's norm inside diffrax);
 * SciPy `solve_ivp(RK45)` at rtol 1e-3, atol 1e-6 (RMS norm) driving the compiled flat field
-  (`_common.FlatField`), from Python.
+  (`_common.FlatField`), from Python;
+* `jaxbearing.solve(..., solver="ros34pw2")`: the linearly implicit Rosenbrock-W method with every
+  roller's 12 x 12 Jacobian block implicit (`jaxbearing.run._rosenbrock`), same error norm.
+
+`--imex` runs only the reference, the default Tsit5 rows and the Rosenbrock-W rows
+(`IMEX_VARIANTS`) and writes `bench_work_precision_imex.json`.
 
 Reported per integrator and seed: step attempts, rejected steps, field evaluations (Tsit5:
-6 attempts + 1, `_common.fsal_rk_evaluations`; SciPy: nfev), evaluations per simulated ms, wall
+6 attempts + 1, `_common.fsal_rk_evaluations`; SciPy: nfev; Rosenbrock-W: 4 attempts + 1, plus
+one batched 12-JVP block Jacobian per attempt, counted as `jacobian_cost_in_evaluations`
+field evaluations, measured by `jacobian_cost`), evaluations per simulated ms, wall
 time (compile excluded; single runs, on a shared machine: read the evaluation counts first),
 every statistic, its relative error and its error in units of the reference's CI half-width.
 """
@@ -65,8 +72,13 @@ VARIANTS = (
     ("Tsit5, raceway-normal tol x1e4, rtol 1e-2", "solve", 1e-2, 1e-6, 1e4),
     ("Tsit5, RMS norm, rtol 1e-3", "rms", 1e-3, 1e-6, 1.0),
     ("SciPy RK45 (same field, RMS), rtol 1e-3", "scipy", 1e-3, 1e-6, 1.0),
+    ("Rosenbrock-W ROS34PW2, raceway-normal tol x100, rtol 1e-3", "ros", 1e-3, 1e-6, 100.0),
+    ("Rosenbrock-W ROS34PW2, raceway-normal tol x100, rtol 1e-2", "ros", 1e-2, 1e-6, 100.0),
+    ("Rosenbrock-W ROS34PW2, raceway-normal tol x100, rtol 3e-2", "ros", 3e-2, 1e-6, 100.0),
 )
 QUICK_VARIANTS = (0, 3, 5, 8, 9)
+#: `--imex`: the old and new Tsit5 defaults, Tsit5 at rtol 1e-2, and the Rosenbrock-W rows
+IMEX_VARIANTS = (0, 3, 6, 10, 11, 12)
 
 
 def tsit5_stability_limit(eigenvalue: complex, h_max: float = 1e-4) -> float:
@@ -161,6 +173,7 @@ def compile_solve(bearing, op, num_saves: int, kind: str):
             b,
             o,
             d,
+            solver="ros34pw2" if kind == "ros" else "tsit5",
             num_saves=num_saves,
             rtol=r,
             atol=a,
@@ -173,7 +186,31 @@ def compile_solve(bearing, op, num_saves: int, kind: str):
     return _common.compile_jit(run, bearing, op, f(1e-3), f(1e-3), f(1e-6), f(1.0), jnp.asarray(0, jnp.int32))
 
 
-def run_solve(compiled, bearing, op, duration, rtol, atol, loosen, seed) -> dict:
+def jacobian_cost(bearing, op, repeats: int = 20) -> dict:
+    """Wall time of one field evaluation and of one per-roller block Jacobian (12 JVPs, vmapped;
+    `RollerBlockJacobian`) at the initial state, compiled, and their ratio: the Jacobian's cost
+    in field evaluations."""
+    import jax
+    import jax.numpy as jnp
+
+    import jaxbearing as jb
+    from jaxbearing.run import scaled_field
+    from jaxbearing.run._rosenbrock import RollerBlockJacobian
+
+    field = _common.FlatField(bearing, op, perturbation=jb.Perturbation(seed=0))
+    y0 = field._unravel_state(field.y0)
+    t0 = jnp.asarray(1e-4)
+    f = jax.jit(lambda t, y, a: scaled_field(t, y, a))
+    jac = jax.jit(lambda t, y, a: RollerBlockJacobian()(lambda t_, y_: scaled_field(t_, y_, a), t, y).blocks)
+    out = {}
+    for name, fn in (("field_s", f), ("jacobian_s", jac)):
+        times = _common.time_repeats(lambda fn=fn: fn(t0, y0, field.args), repeats)
+        out[name] = min(times)
+    out["jacobian_cost_in_evaluations"] = out["jacobian_s"] / out["field_s"]
+    return out
+
+
+def run_solve(compiled, bearing, op, duration, rtol, atol, loosen, seed, kind="solve", jac_cost=0.0) -> dict:
     import jax
     import jax.numpy as jnp
     import numpy as np
@@ -184,14 +221,23 @@ def run_solve(compiled, bearing, op, duration, rtol, atol, loosen, seed) -> dict
     )
     hist = jax.tree_util.tree_map(np.asarray, sol.histories)
     steps = int(sol.num_steps)
-    return {
+    rejected = int(sol.num_rejected_steps)
+    out = {
         "ok": int(sol.result) == 0,
         "wall_s": wall,
         "step_attempts": steps,
-        "rejected_steps": int(sol.num_rejected_steps),
+        "rejected_steps": rejected,
+        "mean_accepted_step_us": 1e6 * float(duration) / max(steps - rejected, 1),
         "evaluations": _common.fsal_rk_evaluations(steps),
         "hist": hist,
     }
+    if kind == "ros":
+        # ROS34PW2, FSAL: 3 new stages + f(t1, y1) per attempt, f(t0, y0) once; one block
+        # Jacobian per attempt (refresh every step) and one at the start
+        out["field_evaluations"] = 4 * steps + 1
+        out["jacobians"] = steps + 1
+        out["evaluations"] = out["field_evaluations"] + jac_cost * out["jacobians"]
+    return out
 
 
 class ScipyRunner:
@@ -261,7 +307,7 @@ class ScipyRunner:
 
 
 # -- the benchmark -----------------------------------------------------------------------------
-def main(quick: bool = False) -> dict:
+def main(quick: bool = False, imex: bool = False) -> dict:
     import numpy as np
 
     import jaxbearing as jb
@@ -275,6 +321,8 @@ def main(quick: bool = False) -> dict:
     jb.validate_bearing(bearing, op)
     omega_kin = float(jb.kinematic_cage_speed(bearing, op))
     variants = [VARIANTS[i] for i in QUICK_VARIANTS] if quick else list(VARIANTS)
+    if imex:
+        variants = [VARIANTS[i] for i in IMEX_VARIANTS]
 
     _common.log(
         f"{NAME}: compiling solve (max/weighted norm), {num_saves} samples over {duration * 1e3:g} ms"
@@ -282,6 +330,12 @@ def main(quick: bool = False) -> dict:
     programs = {"solve": compile_solve(bearing, op, num_saves, "solve")}
     if any(v[1] == "rms" for v in variants):
         programs["rms"] = compile_solve(bearing, op, num_saves, "rms")
+    jac = None
+    if any(v[1] == "ros" for v in variants):
+        _common.log(f"{NAME}: compiling the Rosenbrock-W solve")
+        programs["ros"] = compile_solve(bearing, op, num_saves, "ros")
+        jac = jacobian_cost(bearing, op)
+        _common.log(f"{NAME}: block Jacobian = {jac['jacobian_cost_in_evaluations']:.2f} field evaluations")
     scipy_runner = ScipyRunner(bearing, op) if any(v[1] == "scipy" for v in variants) else None
     compile_s = {k: v[1] for k, v in programs.items()}
     if scipy_runner is not None:
@@ -290,7 +344,8 @@ def main(quick: bool = False) -> dict:
     def run(kind, rtol, atol, loosen, seed):
         if kind == "scipy":
             return scipy_runner.run(duration, num_saves, rtol, atol, seed)
-        return run_solve(programs[kind][0], bearing, op, duration, rtol, atol, loosen, seed)
+        cost = jac["jacobian_cost_in_evaluations"] if kind == "ros" else 0.0
+        return run_solve(programs[kind][0], bearing, op, duration, rtol, atol, loosen, seed, kind, cost)
 
     reference = {}
     for seed in seeds:
@@ -354,13 +409,14 @@ def main(quick: bool = False) -> dict:
             "means of the reference over the window; errors of cage slip are absolute",
         },
         "compile_s": compile_s,
+        "jacobian_cost": jac,
         "reference": reference,
         "variants": rows,
         "benchmark_wall_s": time.perf_counter() - started,
     }
     result["table"] = _table(result)
     print(result["table"])
-    _common.write_json(NAME, result)
+    _common.write_json(NAME + ("_imex" if imex else ""), result)
     return result
 
 
@@ -447,4 +503,4 @@ def self_check() -> None:
 
 
 if __name__ == "__main__":
-    main(quick="--quick" in sys.argv)
+    main(quick="--quick" in sys.argv, imex="--imex" in sys.argv)

@@ -53,6 +53,7 @@ from ._compile_cache import checks_without_host_callbacks
 from ._ensemble import parallel_map
 from ._initial import STARTS, Perturbation, along_slow_mode, initial_state, skid_start
 from ._result import result_code
+from ._rosenbrock import DEFAULT_SOLVER, check_solver
 from ._simulate import SolveArgs, _diffeqsolve, _save
 from ._simulate import simulate as _simulate_fixed
 from ._statistics import steady_statistics
@@ -91,12 +92,21 @@ def prepare_from(params: Params, start: State, rtol, atol):
 
 
 def solve_from(
-    params: Params, start: State, duration, *, num_saves: int, rtol, atol, max_steps: int, adjoint=None
+    params: Params,
+    start: State,
+    duration,
+    *,
+    num_saves: int,
+    rtol,
+    atol,
+    max_steps: int,
+    adjoint=None,
+    solver=DEFAULT_SOLVER,
 ):
-    """Integrate from the physical state `start` over [0, duration]: (histories, final state,
-    diffrax result code, steps). Accumulators restart from zero. jit-able; `adjoint` as in
-    `solve` (`diffrax.ForwardMode()` for forward-mode derivatives; `num_saves = 0` keeps only
-    the final state)."""
+    """Integrate from the physical state `start` over [0, duration] with `solver` ("tsit5" or
+    "ros34pw2"): (histories, final state, diffrax result code, steps). Accumulators restart
+    from zero. jit-able; `adjoint` as in `solve` (`diffrax.ForwardMode()` for forward-mode
+    derivatives; `num_saves = 0` keeps only the final state)."""
     scaling, args, y0_scaled, controller = prepare_from(params, start, rtol, atol)
     last = diffrax.SubSaveAt(t1=True)
     if num_saves:
@@ -105,7 +115,7 @@ def solve_from(
     else:
         saveat = diffrax.SaveAt(subs=[last])
     with checks_without_host_callbacks():  # the same integrator and error norm as `solve`
-        sol = _diffeqsolve(y0_scaled, args, duration, saveat, controller, max_steps, adjoint, False)
+        sol = _diffeqsolve(y0_scaled, args, duration, saveat, controller, max_steps, adjoint, False, solver)
     hist, final = sol.ys if num_saves else ({}, sol.ys[0])
     final = scaling.unscale(duration, jax.tree_util.tree_map(lambda a: a[-1], final))
     return hist, final, result_code(sol.result), jnp.asarray(sol.stats["num_steps"])
@@ -114,26 +124,28 @@ def solve_from(
 _COMPILED: dict = {}
 
 
-def _compiled(params, start, num_saves, max_steps):
+def _compiled(params, start, num_saves, max_steps, solver=DEFAULT_SOLVER):
     leaves, treedef = jax.tree_util.tree_flatten((params, start))
-    key = (treedef, tuple((jnp.shape(x), jnp.result_type(x)) for x in leaves), num_saves, max_steps)
+    key = (treedef, tuple((jnp.shape(x), jnp.result_type(x)) for x in leaves), num_saves, max_steps, solver)
     if key not in _COMPILED:
 
         def run(p, s, d, r, a):
-            return solve_from(p, s, d, num_saves=num_saves, rtol=r, atol=a, max_steps=max_steps)
+            return solve_from(
+                p, s, d, num_saves=num_saves, rtol=r, atol=a, max_steps=max_steps, solver=solver
+            )
 
         f = jnp.asarray(1.0)
         _COMPILED[key] = jax.jit(run).lower(params, start, f, f, f).compile()
     return _COMPILED[key]
 
 
-def _integrator(params, num_saves, max_steps, rtol, atol, compile_times: list):
+def _integrator(params, num_saves, max_steps, rtol, atol, compile_times: list, solver=DEFAULT_SOLVER):
     """`solve_from` compiled (`_compiled`) with the run's parameters and tolerances bound, as
     `skid_start`'s pre-start needs it; compilation times are appended to `compile_times`."""
 
     def integrate(state, duration):
         c0 = time.perf_counter()
-        run = _compiled(params, state, num_saves, max_steps)
+        run = _compiled(params, state, num_saves, max_steps, solver)
         compile_times.append(time.perf_counter() - c0)
         return run(params, state, jnp.asarray(duration), jnp.asarray(rtol), jnp.asarray(atol))
 
@@ -227,10 +239,11 @@ def _run_seed(
     saves,
     progress,
     time_constant=None,
+    solver=DEFAULT_SOLVER,
 ):
     """Settle then measure one seed (module docstring); `time_constant` [s] (skid start) turns
     on the projective steps of the cage speed."""
-    compiled = _compiled(params, start, saves, max_steps)
+    compiled = _compiled(params, start, saves, max_steps, solver)
     state, t, steps = start, 0.0, 0
     speeds, ends, windows, edges, jumps, integrals = [], [], [], [], [], []
     window_start = start
@@ -384,6 +397,7 @@ def simulate_steady(
     progress: bool = False,
     workers: int = 1,
     initial_states=None,
+    solver: str = DEFAULT_SOLVER,
 ) -> SteadyResult:
     """Settle (module docstring), then measure `window_revs` cage revolutions, for each of
     `seeds` seeded initial scatters, each from `start`: "skid" (default; the skid equilibrium and
@@ -391,7 +405,8 @@ def simulate_steady(
 
     `workers` > 1 runs the seeds in that many processes (`parallel_map`, started with `spawn`: a
     script calling this needs the `if __name__ == "__main__":` guard); `jaxbearing simulate`
-    uses one per CPU. Default 1: one after another, in this process.
+    uses one per CPU. Default 1: one after another, in this process. `solver`: "tsit5" (default)
+    or "ros34pw2" (`solve`).
 
     `initial_states` (continuation): one `State` per seed (e.g. `SeedRun.final_state` of a
     neighbouring design's settled run) to start from instead of `start`; settling then runs
@@ -399,6 +414,7 @@ def simulate_steady(
     as "continuation"."""
     from ..io import validate_bearing
 
+    check_solver(solver)
     validate_bearing(bearing, op)
     check_steady_options(settle, window_revs, seeds, tolerance, settle_cap_ms, start=start, workers=workers)
     kwargs = dict(
@@ -413,6 +429,7 @@ def simulate_steady(
         saves_per_rev=saves_per_rev,
         functionals=functionals,
         progress=progress,
+        solver=solver,
     )
     perturbations = [dataclasses.replace(perturbation, seed=perturbation.seed + k) for k in range(int(seeds))]
     if initial_states is not None:
@@ -442,7 +459,7 @@ def simulate_steady(
             y0, tau = jax.tree_util.tree_map(jnp.asarray, given), None
         elif start == "skid":  # its solve and pre-start count in the wall time, not compilation
             compiled = []
-            integrate = _integrator(params, int(saves_per_rev), int(max_steps), rtol, atol, compiled)
+            integrate = _integrator(params, int(saves_per_rev), int(max_steps), rtol, atol, compiled, solver)
             skid = skid_start(bearing, op, pert, integrate=integrate)
             compile_time += sum(compiled)
             # on the plateau after a completed pre-start: no projective steps (their drift, from
@@ -452,7 +469,7 @@ def simulate_steady(
         else:
             y0, tau = initial_state(bearing, op, pert), None
         c0 = time.perf_counter()
-        _compiled(params, y0, int(saves_per_rev), int(max_steps))
+        _compiled(params, y0, int(saves_per_rev), int(max_steps), solver)
         compile_time += time.perf_counter() - c0
         if progress:
             print(f"seed {pert.seed}: settling ({settle}), then {window_revs} revolutions", flush=True)
@@ -469,6 +486,7 @@ def simulate_steady(
             saves=int(saves_per_rev),
             progress=progress,
             time_constant=tau,
+            solver=solver,
         )
         runs.append(SeedRun(pert.seed, *out, start_cage_speed_rpm=float(rad_s_to_rpm(y0.cage.speed))))
     wall = time.perf_counter() - wall0 - compile_time

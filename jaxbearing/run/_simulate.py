@@ -8,7 +8,8 @@
   max norm, so that every component's tolerance means something physical, except that the
   raceway-normal coordinates (roller radial position and velocity, inner-ring centre) have
   tolerances `raceway_loosen` = 100 times looser (`_step_control`: their 62 kHz ringing need not
-  be resolved to rtol); `max_steps` explicit.
+  be resolved to rtol); `max_steps` explicit. `solver="ros34pw2"` selects the linearly implicit
+  Rosenbrock-W method with per-roller Jacobian blocks instead (`_rosenbrock`; slower, README).
 * Outputs through `SaveAt(ts=..., fn=...)`: only the flange-contact quantities, cage speed and
   roller loads are kept, so memory does not grow with the state.
 * Smooth peak functionals (p-norm of PV, log-sum-exp of the contact height) are integrated in the
@@ -43,6 +44,7 @@ from ._compile_cache import checks_without_host_callbacks
 from ._initial import Perturbation, initial_state, perturbation_of, traced_scatter
 from ._progress import SolveProgress
 from ._result import SimulationResult, Solution, result_code, simulation_result, smooth_functionals
+from ._rosenbrock import DEFAULT_SOLVER, check_solver, diffrax_solver
 from ._step_control import DT0, RACEWAY_NORMAL_LOOSEN, raceway_normal_norm, step_controller
 
 
@@ -96,9 +98,10 @@ def _save(t, y_scaled, args: SolveArgs):
     )
 
 
-def _check_solve(bearing, op, duration, *, adjoint=None, **kwargs) -> None:
+def _check_solve(bearing, op, duration, *, adjoint=None, solver=DEFAULT_SOLVER, **kwargs) -> None:
     """`check_solve_inputs` of the solver arguments, perturbation, functionals and pytrees;
-    `adjoint` must be a diffrax adjoint or None."""
+    `adjoint` must be a diffrax adjoint or None; `solver` one of `_rosenbrock.SOLVERS`."""
+    check_solver(solver)
     if adjoint is not None and not isinstance(adjoint, diffrax.AbstractAdjoint):
         raise UserInputError(
             f"adjoint = {adjoint!r}: must be a diffrax adjoint (e.g. diffrax.ForwardMode()) or None"
@@ -110,11 +113,14 @@ def _save_functionals(t, y_scaled, args: SolveArgs):
     return args.scaling.unscale(t, y_scaled).accumulators
 
 
-def _diffeqsolve(y0_scaled, args, duration, saveat, controller, max_steps, adjoint, progress):
-    """diffrax Tsit5 over [0, duration] from the scaled state; failures land in `result`."""
+def _diffeqsolve(
+    y0_scaled, args, duration, saveat, controller, max_steps, adjoint, progress, solver=DEFAULT_SOLVER
+):
+    """diffrax's solver named `solver` (`_rosenbrock.diffrax_solver`: "tsit5" or "ros34pw2")
+    over [0, duration] from the scaled state; failures land in `result`."""
     return diffrax.diffeqsolve(
         diffrax.ODETerm(scaled_field),
-        diffrax.Tsit5(),
+        diffrax_solver(solver),
         t0=0.0,
         t1=duration,
         dt0=DT0,
@@ -144,6 +150,7 @@ def solve(
     adjoint: diffrax.AbstractAdjoint | None = None,
     raceway_loosen=RACEWAY_NORMAL_LOOSEN,
     error_norm=None,
+    solver: str = DEFAULT_SOLVER,
 ) -> Solution:
     """Pure, jit-able and vmappable solve of the whole bearing over [0, duration].
 
@@ -154,6 +161,9 @@ def solve(
     Error control (`_step_control`): the max norm over the scaled state with the raceway-normal
     coordinates' tolerances `raceway_loosen` times looser (a float, may be traced; 1 = plain max
     norm); `error_norm` (a function pytree -> scalar, e.g. `optimistix.rms_norm`) replaces it.
+    `solver` (static): "tsit5" (default, explicit) or "ros34pw2" (linearly implicit
+    Rosenbrock-W with every roller's Jacobian block implicit, `_rosenbrock`; slower at the
+    tolerances measured so far: README, Performance).
 
     Every argument is checked before anything is traced (`jaxbearing.io.check_solve_inputs`;
     one-line `UserInputError`/`ConfigError`); under jit/vmap/grad traced values cannot be
@@ -171,6 +181,7 @@ def solve(
         perturbation=perturbation,
         functionals=functionals,
         adjoint=adjoint,
+        solver=solver,
     )
     y0 = initial_state(bearing, op, perturbation)
     scaling = Scaling(
@@ -187,7 +198,17 @@ def solve(
     norm = error_norm if error_norm is not None else raceway_normal_norm(y0_scaled, raceway_loosen)
     controller = step_controller(rtol, atol, norm)
     with checks_without_host_callbacks():  # cacheable program (`_compile_cache`)
-        sol = _diffeqsolve(y0_scaled, args, duration, saveat, controller, max_steps, adjoint, progress)
+        sol = _diffeqsolve(
+            y0_scaled,
+            args,
+            duration,
+            saveat,
+            controller,
+            max_steps,
+            adjoint,
+            progress,
+            solver,
+        )
     if num_saves:
         ys = dict(sol.ys)
         acc = jax.tree_util.tree_map(lambda a: a[-1], ys.pop("accumulators"))
@@ -223,10 +244,10 @@ def _compiled_solve(bearing, op, duration, rtol, atol, static: tuple):
     """Ahead-of-time compiled `solve`, cached on the pytree structure, shapes and static
     arguments, so arc and corner ends, other speeds, loads, tolerances and seeds of the initial
     scatter reuse one compilation (the scatter's seed and amplitudes are traced)."""
-    num_saves, max_steps, progress, perturbation, functionals = static
+    num_saves, max_steps, progress, perturbation, functionals, solver = static
     scatter = traced_scatter(perturbation)
     dyn = (bearing, op, duration, rtol, atol, scatter)
-    static = (num_saves, max_steps, progress, perturbation is None, functionals)
+    static = (num_saves, max_steps, progress, perturbation is None, functionals, solver)
     leaves, treedef = jax.tree_util.tree_flatten(dyn)
     key = (treedef, tuple((jnp.shape(x), jnp.result_type(x)) for x in leaves), static)
     if key not in _COMPILED:
@@ -244,6 +265,7 @@ def _compiled_solve(bearing, op, duration, rtol, atol, static: tuple):
                 progress=progress,
                 perturbation=pert,
                 functionals=functionals,
+                solver=solver,
             )
 
         _COMPILED[key] = jax.jit(run).lower(*dyn).compile()
@@ -262,8 +284,10 @@ def simulate(
     progress: bool = False,
     perturbation: Perturbation | None = Perturbation(),
     functionals: Functionals = Functionals(),
+    solver: str = DEFAULT_SOLVER,
 ) -> SimulationResult:
-    """Integrate the bearing for `duration` seconds from the quasi-static state.
+    """Integrate the bearing for `duration` seconds from the quasi-static state with `solver`
+    ("tsit5" or "ros34pw2", `solve`).
 
     Compiles once per bearing structure (cached) and reports compile and run time separately.
     """
@@ -278,10 +302,11 @@ def simulate(
         progress=progress,
         perturbation=perturbation,
         functionals=functionals,
+        solver=solver,
         rules={"num_saves": SIMULATE_NUM_SAVES},
     )
     dyn = (bearing, op, jnp.asarray(duration, float), jnp.asarray(rtol, float), jnp.asarray(atol, float))
-    static = (int(num_saves), int(max_steps), bool(progress), perturbation, functionals)
+    static = (int(num_saves), int(max_steps), bool(progress), perturbation, functionals, solver)
     start = time.perf_counter()
     compiled = _compiled_solve(*dyn, static)
     compile_time = time.perf_counter() - start
