@@ -48,14 +48,15 @@ def test_jackknife_of_a_mean_is_the_standard_error():
 
 @pytest.fixture(scope="module")
 def running():
-    """Two states of running (reduced size): the skid start of two seeds after 1.5 ms."""
+    """Two states of running (reduced size): the skid start of two seeds after 3 ms (the rollers
+    have skewed onto their flanges)."""
     b = dataclasses.replace(jb.reference_bearing(), num_slices=11)
     op = jb.reference_operating_point()
     params = jb.dynamics.Params(bearing=b, operating=op, functionals=STEADY_FUNCTIONALS)
     states = []
     for seed in (0, 1):
         s0 = skid_start(b, op, jb.Perturbation(seed=seed, skew=1e-3)).state
-        _, s, code, _ = solve_from(params, s0, 1.5e-3, num_saves=0, rtol=1e-3, atol=1e-6, max_steps=100_000)
+        _, s, code, _ = solve_from(params, s0, 3e-3, num_saves=0, rtol=1e-3, atol=1e-6, max_steps=100_000)
         assert int(code) == 0
         states.append(s)
     return b, op, states
@@ -97,3 +98,37 @@ def test_tangent_growth_is_finite_and_starts_at_zero(running):
     ts, norms = tangent_growth(b, op, DesignVariables.of(b), states[0], 0.2e-3, num_saves=5)
     assert norms.shape == (3, 5) and np.all(np.isfinite(norms))
     assert np.all(norms[:, 0] == 0.0) and np.all(norms[:, -1] > 0)
+
+
+def test_frozen_load_derivative_matches_central_differences(running):
+    """The frozen-load estimator's derivative (jax.jacfwd through the flange geometry and the
+    exact-Hertz radii at the loads the dynamics gave) against central differences of the same
+    frozen functional on the same saved states (relative steps 1e-6)."""
+    import jax
+
+    from jaxbearing.dynamics import Params, contact_loads
+    from jaxbearing.run._steady_gradient import frozen_load_integrands, trajectory_states
+
+    b, op, states = running
+    x = jnp.asarray(DesignVariables.of(b).as_array())
+    saved, code = jax.jit(lambda s: trajectory_states(b, op, s, 0.2e-3, 40))(states[0])
+    assert int(code) == 0
+    params = Params(bearing=b, operating=op, functionals=STEADY_FUNCTIONALS)
+    q0 = jax.vmap(lambda s: contact_loads(s, params).flange.normal_force)(saved)
+    assert float(jnp.sum(q0 > 1.0)) > 0  # some flange contact among the saved states
+
+    @jax.jit
+    def frozen(v):
+        return jnp.sum(jax.vmap(lambda s, q: frozen_load_integrands(b, op, v, s, q))(saved, q0), axis=0)
+
+    value, jac = frozen(x), jax.jacfwd(frozen)(x)
+    for i in range(3):
+        h = 1e-6 * float(x[i])
+        e = jnp.zeros(3).at[i].set(h)
+        fd = (frozen(x + e) - frozen(x - e)) / (2 * h)
+        np.testing.assert_allclose(jac[:, i], fd, rtol=1e-4, atol=1e-6 * float(value[0]) / float(x[i]))
+    # at the dynamic loads themselves the frozen PV is the dynamic PV
+    fl = jax.vmap(lambda s: contact_loads(s, params).flange)(saved)
+    w = q0 / (q0 + STEADY_FUNCTIONALS.contact_load)
+    direct = jnp.sum(w * fl.pv) / STEADY_FUNCTIONALS.pv_reference
+    assert float(value[0]) == pytest.approx(float(direct), rel=1e-9)
