@@ -494,14 +494,7 @@ def _result_json(problem, options, res) -> dict:
 
     from jaxbearing.flange import MARGIN_NAMES
 
-    def design(x):
-        if x is None:
-            return None
-        return {
-            "end_radius_mm": float(x[0]) * 1e3,
-            "layback_angle_deg": math.degrees(float(x[1])),
-            "axial_clearance_mm": float(x[2]) * 1e3,
-        }
+    design = _engineering
 
     def margins(m):
         return None if m is None else {f"{n}_margin_mm": float(v) * 1e3 for n, v in zip(MARGIN_NAMES, m)}
