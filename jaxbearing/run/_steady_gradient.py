@@ -48,6 +48,7 @@ from ..contact import LOAD_FLOOR
 from ..dynamics import Functionals, Params, State, contact_loads
 from ..flange import DesignVariables, with_design
 from ..geometry import Bearing, OperatingPoint
+from ..io import require
 from ._compile_cache import checks_without_host_callbacks
 from ._design import forward_jacobian
 from ._ensemble import parallel_map
@@ -141,6 +142,10 @@ class SteadyGradient:
     ok: np.ndarray  # (K,) bool
 
 
+def _check_window(window) -> None:
+    require("window", window, lambda v: np.isfinite(v) & (v > 0), "> 0 s and finite")
+
+
 def ratio_gradient(a, c, da, dc, pv_reference: float):
     """(J, dJ/dx) of J = PV_ref sum a / sum c from per-sample a (K,), c (K,), da, dc (K, n)."""
     sa, sc = np.sum(a), np.sum(c)
@@ -178,6 +183,7 @@ def steady_gradient(
     gradient at `design`, from `states` (settled states of this design, e.g.
     `SeedRun.final_state`), each integrated over `window` seconds with three forward-mode
     tangents; `workers` processes share the samples."""
+    _check_window(window)
     x = np.asarray(design.as_array(), dtype=float)
     job = _WindowSample(bearing, op, x, float(window), float(rtol), float(atol), int(max_steps))
     outs = parallel_map(job, list(states), workers=workers)
@@ -349,6 +355,8 @@ def frozen_load_gradient(
     1 / `saves_per_ms` ms; at every saved state the flange PV is differentiated in the design at
     the loads the dynamics gave (`frozen_load_integrands`), summed, and combined through the
     ratio estimator; jackknife over the trajectories."""
+    _check_window(window)
+    require("saves_per_ms", saves_per_ms, lambda v: (v >= 1) & (v == np.round(v)), "an integer >= 1")
     x = np.asarray(design.as_array(), dtype=float)
     n = max(1, int(round(window * 1e3 * saves_per_ms)))
     job = _FrozenSample(bearing, op, x, float(window), n, float(rtol))
