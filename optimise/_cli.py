@@ -121,7 +121,7 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument(
         "--corner-margin-mm",
         type=float,
-        help="steady: p99 of the contact radius this far inside the limited circle (default 0.05)",
+        help="steady: the largest contact radius this far inside the limited circle (default 0.05)",
     )
     r.add_argument("--verify-seeds", type=int, help="steady: unseen seeds of the verification (default 4)")
     r.add_argument("--no-verify", action="store_true", help="steady: skip the verification")

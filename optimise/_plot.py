@@ -41,7 +41,7 @@ def plot_search(problem, result, path) -> pathlib.Path:
     h = result.history
     margins = np.asarray(h.get("margins", [])) if h else np.zeros(0)
     if margins.ndim == 3 and margins.shape[-1] == 5 and getattr(result, "best_iteration", -1) >= 0:
-        # steady search: the dynamic corner margin, with the skew excursion p99 - rho_c measured
+        # steady search: the dynamic corner margin, with the skew excursion max - rho_c measured
         # at the final design: limited-circle margin = excursion + corner margin
         m = margins[result.best_iteration, result.best_start]
         offset = m[2] - m[4]

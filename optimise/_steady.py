@@ -17,11 +17,11 @@ measures both against common-random-number central differences (README, Design o
 running).
 
 Constraints. The four static design-zone margins of `DesignProblem.constraints` and the
-dynamic corner-contact margin m_dyn = rho_lim - p99(contact radius) - `corner_margin` (the
-worst operating point), which has no derivative of its own (a percentile of a dynamic run). It
+dynamic corner-contact margin m_dyn = rho_lim - max(contact radius) (the largest per cage revolution) - `corner_margin` (the
+worst operating point), which has no derivative of its own (an extreme of a dynamic run). It
 is modelled as the measured value plus the change of the static limited-circle margin
 rho_lim - rho_c (the aligned contact radius): m_dyn(u') ~ m_dyn(u) + m_lc(u') - m_lc(u), i.e.
-the skew excursion p99 - rho_c is held at its measured value over one step; its gradient is the
+the skew excursion max - rho_c is held at its measured value over one step; its gradient is the
 static margin's. All five enter the same augmented Lagrangian as `_search` (projected Adam step
 in the unit box, multiplier update).
 
@@ -72,6 +72,10 @@ from ._search import _Hyper, start_points
 #: names of the five constraints of the steady search (static zone margins, then dynamic)
 CONSTRAINT_NAMES = (*MARGIN_NAMES, "dynamic_corner")
 CHECKPOINT = "checkpoint.pkl"
+#: version of the measured objective and margins, part of a checkpoint's fingerprint: a
+#: checkpoint of an older definition (2: the dynamic corner margin on the largest contact
+#: radius instead of the p99) is refused, not resumed
+MEASUREMENT_VERSION = 2
 #: gradient estimators (module docstring)
 ESTIMATORS = ("frozen", "window")
 
@@ -274,6 +278,7 @@ def _fingerprint(problem: DesignProblem, settings: SteadySettings, hyper: _Hyper
     ]
     text = repr(
         (
+            MEASUREMENT_VERSION,
             problem.bounds,
             problem.aggregate,
             problem.temperature,

@@ -49,6 +49,24 @@ def test_batch_means_coverage_ar1():
     assert _coverage(naive, -1.5) < 0.6
 
 
+def test_widest_contact_sees_what_the_p99_misses():
+    """A long contact inside the limited circle with one sample on the corner: the p99 of the
+    contact radius stays inside, the largest contact radius (the dynamic corner margin's
+    statistic) and the corner share see it."""
+    edges = [0.0, 0.01, 0.02]
+    hist = _history(edges, 400)
+    force, radius = hist["flange_force"], hist["contact_radius"]
+    force[:] = 0.0
+    force[50:250, 0, 0] = 5.0  # 200 touching samples in revolution 0
+    force[450:650, 0, 0] = 5.0  # and in revolution 1
+    radius[:] = 3.0e-3
+    radius[100, 0, 0] = 3.5e-3  # one corner sample in revolution 0
+    s = revolution_statistics(hist, edges, rho_lim=3.2e-3, kinematic_speed=120.0)
+    assert s["contact_radius_m.p99"][0] < 3.2e-3
+    np.testing.assert_allclose(s["contact_radius_m.max_in_contact"], [3.5e-3, 3.0e-3])
+    np.testing.assert_allclose(s["corner_contact_share.time"], [1 / 200, 0.0])
+
+
 def test_batch_means_rejects_too_few_batches():
     with pytest.raises(ValueError, match="num_batches"):
         batch_means(np.ones(10), 1)
@@ -94,6 +112,7 @@ def test_revolution_statistics_closed_form():
     # forces above the 1 N threshold: 0.6, 1.0, 0.6 x peak... all 5 samples for both pulses
     np.testing.assert_allclose(s["corner_contact_share.time"], [0.0, 1.0])
     np.testing.assert_allclose(s["contact_radius_m.p99"], [3.0e-3, 3.5e-3])
+    np.testing.assert_allclose(s["contact_radius_m.max_in_contact"], [3.0e-3, 3.5e-3])
     rpm = 60 / (2 * np.pi)
     np.testing.assert_allclose(s["cage_speed_rpm"], [100 * rpm, 110 * rpm])
     np.testing.assert_allclose(s["cage_slip"], [1 - 100 / 120, 1 - 110 / 120])

@@ -118,6 +118,12 @@ def format_table(summaries: dict) -> str:
             lines.append(row)
     extra = (
         ("contact radius, p99", "mm", lambda s: s.get("contact_radius_m", {}).get("p99"), 1e3),
+        (
+            "contact radius, max in contact",
+            "mm",
+            lambda s: s.get("contact_radius_m", {}).get("max_in_contact"),
+            1e3,
+        ),
         ("corner-contact share, time", "%", lambda s: s.get("corner_contact_share", {}).get("time"), 100.0),
         (
             "corner-contact share, events",

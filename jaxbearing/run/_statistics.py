@@ -135,6 +135,7 @@ def revolution_statistics(
         "corner_contact_share.time",
         "corner_contact_share.events",
         "contact_radius_m.p99",
+        "contact_radius_m.max_in_contact",
         "flange_contact_events_per_rev",
         "flange_pv_contact_time_Pa_m_s.mean",
         "flange_pv_contact_time_Pa_m_s.p95",
@@ -160,7 +161,10 @@ def revolution_statistics(
             pv = np.asarray(w["flange_pv"])[touching]
             out["flange_pv_contact_time_Pa_m_s.mean"][i] = np.mean(pv)
             out["flange_pv_contact_time_Pa_m_s.p95"][i] = np.percentile(pv, 95.0)
-            out["contact_radius_m.p99"][i] = np.percentile(w["contact_radius"][touching], 99.0)
+            rho = np.asarray(w["contact_radius"])[touching]
+            out["contact_radius_m.p99"][i] = np.percentile(rho, 99.0)
+            # the largest contact radius of any touching sample: the corner is reached iff > rho_lim
+            out["contact_radius_m.max_in_contact"][i] = np.max(rho)
         for key, value in film_statistics(w, threshold).items():
             out[key][i] = value
         sel = rev_of_event == i
