@@ -3,11 +3,14 @@
 
 Checked: the settings' one-line errors; a run killed after its first iteration resumes from
 the checkpoint and ends with exactly the result of an uninterrupted run; the verification uses
-seeds the search never saw and reports value and CI of mean PV, p95 PV and corner share."""
+seeds the search never saw and reports value and CI of mean PV, p95 PV and corner share. The
+mechanics run on stand-ins for the settled ensemble (seconds instead of minutes); the real
+ensemble is measured in tests/test_steady_design.py and by the search in notebook 05."""
 
 import json
 import math
 
+import jax.numpy as jnp
 import numpy as np
 import pytest
 
@@ -80,19 +83,50 @@ def _history(out):
     return r, np.asarray(r["history"]["objective_GPa_m_s"]), np.asarray(r["history"]["end_radius_mm"])
 
 
+def _stand_in(problem, settings, u, states=None, *, gradient=True):
+    """A cheap deterministic stand-in for the settled ensemble of `steady.evaluate` (the real one
+    runs in tests/test_steady_design.py and notebook 05): J = 1 + |u - u*|^2 plus a term that
+    depends on the continuation chain (the states count the evaluations along a start), so a
+    resume that lost the continuation states would give other numbers."""
+    u = np.asarray(u, dtype=float)
+    target = np.array([0.7, 0.6, 0.5])
+    steps = 0 if states is None else int(states[0][0])
+    value = 1.0 + float(np.sum((u - target) ** 2)) + 0.01 * steps
+    return steady.Evaluation(
+        objective=value,
+        objective_ci=(value - 0.02, value + 0.02),
+        gradient=2.0 * (u - target) if gradient else np.full(3, np.nan),
+        gradient_stderr=np.full(3, 0.01),
+        per_point=[],
+        static_margins=np.asarray(problem.margins(jnp.asarray(u))),
+        dynamic_margin=1e-4,
+        states=[[steps + 1]],
+        wall_time_s=0.0,
+        simulated_ms=10.0,
+    )
+
+
 def test_killed_run_resumes_with_the_same_result(tmp_path, config, monkeypatch, capsys):
+    """The checkpoint mechanics of the steady search through the command line, on a stand-in
+    for the settled ensemble: a run killed in its second evaluation exits 130 with a checkpoint
+    and no result, resumes after iteration 0 with the continuation states, and ends with exactly
+    the history and design of an uninterrupted run; other settings are refused."""
+    monkeypatch.setattr(steady, "evaluate", _stand_in)
+    args = list(ARGS)
+    args[args.index("--iterations") + 1] = "2"
     whole, killed = tmp_path / "whole", tmp_path / "killed"
-    assert main(["run", "--config", config, *ARGS, "--no-verify", "--out", str(whole)]) == 0
+    assert main(["run", "--config", config, *args, "--no-verify", "--out", str(whole)]) == 0
     r1, j1, x1 = _history(whole)
     assert r1["objective_kind"] == "steady" and r1["status"] == "ok" and r1["resumed_from_iteration"] == -1
-    assert j1.shape == (2, 1) and np.all(np.isfinite(j1)) and np.all(j1 > 0)
+    assert j1.shape == (3, 1) and np.all(np.isfinite(j1)) and np.all(j1 > 0)
     assert np.all(np.isfinite(np.asarray(r1["history"]["gradient_per_unit_box"])))
     lo, hi = r1["objective_GPa_m_s"]["ci95_low"], r1["objective_GPa_m_s"]["ci95_high"]
     assert lo <= r1["objective_GPa_m_s"]["value"] <= hi
+    assert j1[1, 0] < j1[0, 0]  # the step went downhill
 
     # kill the second run in its second evaluation (after iteration 0 was checkpointed)
     calls = {"n": 0}
-    evaluate = steady.evaluate
+    evaluate = _stand_in
 
     def dying(*a, **k):
         calls["n"] += 1
@@ -102,10 +136,10 @@ def test_killed_run_resumes_with_the_same_result(tmp_path, config, monkeypatch, 
 
     monkeypatch.setattr(steady, "evaluate", dying)
     # the command line reports the interruption (exit code 130) and writes no result
-    assert main(["run", "--config", config, *ARGS, "--no-verify", "--out", str(killed)]) == 130
+    assert main(["run", "--config", config, *args, "--no-verify", "--out", str(killed)]) == 130
     assert (killed / "checkpoint.pkl").exists() and not (killed / "result.json").exists()
     monkeypatch.setattr(steady, "evaluate", evaluate)
-    assert main(["run", "--config", config, *ARGS, "--no-verify", "--out", str(killed)]) == 0
+    assert main(["run", "--config", config, *args, "--no-verify", "--out", str(killed)]) == 0
     assert "resumed after iteration 0" in capsys.readouterr().out
     r2, j2, x2 = _history(killed)
     assert r2["resumed_from_iteration"] == 0
@@ -113,34 +147,60 @@ def test_killed_run_resumes_with_the_same_result(tmp_path, config, monkeypatch, 
     np.testing.assert_array_equal(x2, x1)
     assert r2["design"] == r1["design"]
     # other settings: the checkpoint is refused in one line
-    assert main(["run", "--config", config, *ARGS[:-2], "--no-verify", "--out", str(killed)]) == 2
+    assert main(["run", "--config", config, *args[:-2], "--no-verify", "--out", str(killed)]) == 2
     assert "checkpoint of a search with other settings" in capsys.readouterr().err
 
 
-def test_verification_uses_unseen_seeds(config):
+def test_verification_uses_unseen_seeds(config, monkeypatch):
+    """`verification` re-measures both designs with the seeds from verify_first_seed on (a
+    stand-in for `steady_design_metrics` records them; the real one is tested in
+    tests/test_steady_design.py) and reports value and CI of mean PV, p95 PV and corner share,
+    whether the mean-PV intervals are disjoint, and corner contacts of the found design."""
+    import types
+
     import jaxbearing as jb
     from optimise import make_problem
 
+    calls = []
+
+    def metrics(bearing, op, design, *, seeds, first_seed, window_revs, **kw):
+        calls.append((float(design.end_radius), seeds, first_seed, window_revs))
+        pv = 1e9 * float(design.end_radius) / 0.08  # lower for a smaller end radius here
+
+        def est(v, hw):
+            return {"value": v, "ci95_low": v - hw, "ci95_high": v + hw, "n": seeds}
+
+        share = 0.01 if design.end_radius < 0.075 else 0.0
+        return types.SimpleNamespace(
+            mean_pv=est(pv, 0.05e9),
+            p95_pv=est(2 * pv, 0.1e9),
+            objective=est(pv, 0.05e9),
+            corner_contact_share=est(share, 0.0),
+            corner_margin=est(1e-4, 1e-5),
+            settled=True,
+            seeds=list(range(first_seed, first_seed + seeds)),
+        )
+
+    monkeypatch.setattr(steady, "steady_design_metrics", metrics)
     cfg = jb.load_config(config)
     problem = make_problem(cfg.bearing(), cfg.operating_point())
     settings = steady.SteadySettings(
-        seeds=2,
-        window_revs=2,
-        settle=0.5,
-        workers=1,
-        verify_seeds=2,
-        verify_first_seed=7,
-        verify_window_revs=2,
+        seeds=2, window_revs=2, workers=1, verify_seeds=3, verify_first_seed=7, verify_window_revs=4
     )
     x = np.array([0.08, 1.6 * math.pi / 180, 0.15e-3])
     v = steady.verification(problem, settings, x, x)
-    assert v["seeds"] == [7, 8]
+    assert v["seeds"] == [7, 8, 9]
+    assert calls == [(0.08, 3, 7, 4), (0.08, 3, 7, 4)]
     for name in ("reference", "optimum"):
         row = v[name]
-        assert row["seeds"] == [7, 8]
+        assert row["seeds"] == [7, 8, 9]
         for key in ("mean_pv_GPa_m_s", "p95_pv_GPa_m_s", "corner_contact_share"):
             est = row[key]
             assert est["ci95_low"] <= est["value"] <= est["ci95_high"]
     # the same design and seeds: the same numbers, so the CIs overlap
     assert v["mean_pv_lower_disjoint"] is False
     assert v["optimum_corner_contacts"] is False
+    # a design 12.5 % lower, beyond the intervals, with corner contact
+    v = steady.verification(problem, settings, np.array([0.07, *x[1:]]), x)
+    assert v["optimum"]["mean_pv_GPa_m_s"]["value"] == pytest.approx(0.875)
+    assert v["mean_pv_lower_disjoint"] is True and v["optimum_corner_contacts"] is True
