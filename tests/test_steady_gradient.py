@@ -132,3 +132,39 @@ def test_frozen_load_derivative_matches_central_differences(running):
     w = q0 / (q0 + STEADY_FUNCTIONALS.contact_load)
     direct = jnp.sum(w * fl.pv) / STEADY_FUNCTIONALS.pv_reference
     assert float(value[0]) == pytest.approx(float(direct), rel=1e-9)
+
+
+def test_frozen_load_estimator_agrees_with_crn_differences_on_settled_running():
+    """The acceptance check of benchmarks/bench_steady_gradient.py at reduced size (11 slices,
+    3 seeds, theta_f at the reference design): settled running from the skid start, then a
+    common-random-number central difference of the ensemble objective (both designs continue
+    from the same settled states, settle half a cage revolution, measure two; paired over the
+    seeds) against the frozen-load estimate from the same settled states. The difference must
+    be significant (|FD| > 2 SE) and the estimate agree with it in sign and within 30 %."""
+    from jaxbearing.run import frozen_load_gradient, steady_design_metrics
+
+    b = dataclasses.replace(jb.reference_bearing(), num_slices=11)
+    op = jb.reference_operating_point()
+    x = np.asarray(DesignVariables.of(b).as_array())
+    kw = dict(seeds=3, window_revs=2, workers=2)
+    # the skid start lands on the plateau (tests/test_skid.py): settle 5 ms, then measure
+    base = steady_design_metrics(b, op, DesignVariables.from_array(x), settle=5e-3, **kw)
+    rev = 2 * np.pi / abs(float(np.asarray(base.final_states[0].cage.speed)))
+    h = 0.04 * np.radians(1.0)  # 4 % of the optimiser's theta_f range (1-2 deg)
+    per_seed = []
+    for sign in (1.0, -1.0):
+        xs = x.copy()
+        xs[1] += sign * h
+        m = steady_design_metrics(
+            b, op, DesignVariables.from_array(xs), settle=rev / 2, initial_states=base.final_states, **kw
+        )
+        per_seed.append(np.asarray(m.objective_per_seed))
+    d = (per_seed[0] - per_seed[1]) / (2 * h)
+    fd, se = float(np.mean(d)), float(np.std(d, ddof=1) / np.sqrt(d.size))
+    g = frozen_load_gradient(b, op, DesignVariables.from_array(x), base.sample_states, workers=2)
+    print(
+        f"dJ/dtheta_f: CRN FD {fd:.3e} +- {se:.1e}, frozen load {g.gradient[1]:.3e} +- {g.gradient_stderr[1]:.1e}"
+    )
+    assert abs(fd) > 2 * se
+    assert np.sign(g.gradient[1]) == np.sign(fd)
+    assert abs(g.gradient[1] - fd) <= max(0.3 * abs(fd), 2 * se)
