@@ -82,6 +82,33 @@ def test_invalid_override_one_line_exit_2(tmp_path, capsys):
     assert len(err) == 1 and "operating.speed_rpm" in err[0]
 
 
+def test_unknown_solver_one_line_exit_2(capsys):
+    """`--solver` overrides simulation.solver; a name outside the choices is one line naming the
+    option and the valid values, before anything is compiled."""
+    assert main(["simulate", "--solver", "rk4"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--solver" in err[0] and "tsit5" in err[0] and "ros34pw2" in err[0]
+
+
+def test_solver_reaches_the_run(monkeypatch):
+    """The configured solver is the one `simulate` receives."""
+    import jaxbearing as jb
+    import jaxbearing.run as run
+    from jaxbearing.cli._simulate import run_cases
+
+    seen = {}
+
+    def fake(bearing, op, **kw):
+        seen.update(kw)
+        raise SystemExit(0)
+
+    monkeypatch.setattr(run, "simulate", fake)
+    cfg = jb.loads_config('[simulation]\nsolver = "ros34pw2"\nend = "arc"\n')
+    with pytest.raises(SystemExit):
+        run_cases(cfg, progress=False)
+    assert seen["solver"] == "ros34pw2"
+
+
 def test_forced_solver_failure_nonzero_exit(tmp_path, capsys):
     """A failed solve: exit 1, the progress meter says where it stopped (no jump to 100 %), the
     table marks the failed run's values, summary.json is strict JSON (issue 16)."""

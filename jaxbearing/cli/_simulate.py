@@ -34,6 +34,7 @@ def register(sub) -> None:
     p.add_argument("--duration-ms", type=float, help="simulated time [ms]")
     p.add_argument("--out", help="output directory (summary.json, histories .npz, plots)")
     p.add_argument("--no-progress", action="store_true", help="no progress meter")
+    p.add_argument("--solver", help="time integrator: tsit5 (default) or ros34pw2 (simulation.solver)")
     _steady.add_arguments(p)
     p.set_defaults(func=run)
 
@@ -44,6 +45,7 @@ _OVERRIDES = {
     "load_N": ("--load-N", "operating.radial_load_N"),
     "duration_ms": ("--duration-ms", "simulation.duration_ms"),
     "end": ("--end", "simulation.end"),
+    "solver": ("--solver", "simulation.solver"),
 }
 
 
@@ -122,6 +124,7 @@ def run_cases(cfg, progress: bool = True, steady: dict | None = None) -> dict:
             atol=sim.atol,
             max_steps=sim.max_steps,
             progress=progress,
+            solver=sim.solver,
             **(steady or {}),
         )
         out[end] = (res, summarise(res))

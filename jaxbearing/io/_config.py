@@ -14,7 +14,7 @@ its meaning, symbol and valid range. The schema and the ranges are `jaxbearing.i
     [lubricant]          viscosity_Pa_s, ..., traction_a, traction_b_s_m, traction_c_s_m, traction_d
     [operating]          speed_rpm, radial_load_N, gravity, misalignment_mrad, axial_load_N,
                          inner_ring_axial_freedom, inner_ring_tilt_freedom
-    [simulation]         end, duration_ms, rtol, atol, max_steps, progress
+    [simulation]         end, duration_ms, rtol, atol, max_steps, progress, solver
 
 Missing keys take the reference value (docs/MODEL.md section 2); unknown keys and sections are
 errors with a "did you mean ...?" suggestion; wrong types and out-of-range values are errors
@@ -74,7 +74,7 @@ class SimulationSettings:
 
     `end`: "arc", "corner" or "both"; `duration_ms`: simulated time; `rtol`, `atol`: PID
     step-size controller tolerances (on the scaled state); `max_steps`: integrator step limit;
-    `progress`: show a progress meter.
+    `progress`: show a progress meter; `solver`: "tsit5" or "ros34pw2" (`run.simulate`).
     """
 
     end: str
@@ -83,6 +83,7 @@ class SimulationSettings:
     atol: float
     max_steps: int
     progress: bool
+    solver: str = "tsit5"
 
     @property
     def duration(self) -> float:

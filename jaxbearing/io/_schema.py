@@ -65,6 +65,7 @@ Schema (ranges; "(" open, "[" closed; symbols as in docs/MODEL.md and the source
 | simulation.rtol, atol | | (0, 1) |
 | simulation.max_steps | | integer in [1, 1e9] |
 | simulation.progress | | true / false |
+| simulation.solver | | "tsit5" (default) or "ros34pw2" |
 
 The inner and outer raceway diameters are d_m -/+ (D + P_d/2) (`Bearing.inner_raceway_radius`).
 Non-finite values are rejected everywhere except `roller.end_radius_mm = inf`.
@@ -778,6 +779,16 @@ KEYS: tuple[Key, ...] = (
         constant_bound(1_000_000_000, True),
     ),
     make_key("simulation.progress", bool, True, "", "", "show a progress meter"),
+    make_key(
+        "simulation.solver",
+        str,
+        "tsit5",
+        "",
+        "",
+        "time integrator",
+        choices=("tsit5", "ros34pw2"),
+        note="ros34pw2: linearly implicit Rosenbrock-W; costs more at equal error (README, Performance)",
+    ),
 )
 
 KEY_BY_PATH: dict[str, Key] = {k.path: k for k in KEYS}
