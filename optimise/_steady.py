@@ -60,6 +60,7 @@ from jaxbearing.flange import MARGIN_NAMES, DesignVariables
 from jaxbearing.io import atomic_write, require
 from jaxbearing.run import (
     CORNER_MARGIN,
+    SteadyGradient,
     available_cpus,
     frozen_load_gradient,
     steady_design_metrics,
@@ -172,7 +173,7 @@ def evaluate(
         )
         estimate = frozen_load_gradient if settings.estimator == "frozen" else steady_gradient
         g = (
-            _no_gradient()
+            SteadyGradient.missing()
             if not gradient
             else estimate(
                 design.apply(problem.bearing),
@@ -220,13 +221,6 @@ def evaluate(
         states=new_states,
         wall_time_s=time.perf_counter() - t0,
         simulated_ms=simulated,
-    )
-
-
-def _no_gradient():
-    nan3 = np.full(3, np.nan)
-    return dataclasses.make_dataclass("NoGradient", ["gradient", "gradient_stderr", "value"])(
-        nan3, nan3, np.nan
     )
 
 

@@ -204,3 +204,35 @@ def test_verification_uses_unseen_seeds(config, monkeypatch):
     v = steady.verification(problem, settings, np.array([0.07, *x[1:]]), x)
     assert v["optimum"]["mean_pv_GPa_m_s"]["value"] == pytest.approx(0.875)
     assert v["mean_pv_lower_disjoint"] is True and v["optimum_corner_contacts"] is True
+
+
+def test_grid_picks_the_best_point_inside_every_margin_and_resumes(tmp_path, config, monkeypatch):
+    """`steady_grid` on the stand-in ensemble: only statically feasible points are evaluated,
+    each continuing from the previous one (serpentine order), the best point is the lowest
+    objective whose dynamic margin is positive too, and a rerun takes every point from
+    DIR/grid_checkpoint.pkl without evaluating again."""
+    import jaxbearing as jb
+    from optimise import make_problem
+
+    problem = make_problem(jb.load_config(config).bearing(), jb.load_config(config).operating_point())
+    seen = []
+
+    def evaluate(problem, settings, u, states=None, *, gradient=True):
+        assert gradient is False
+        seen.append((np.asarray(u).copy(), states))
+        ev = _stand_in(problem, settings, u, states, gradient=False)
+        ev.dynamic_margin = 1e-4 if u[0] < 0.6 else -1e-4  # large end radii reach the corner
+        return ev
+
+    monkeypatch.setattr(steady, "evaluate", evaluate)
+    settings = steady.SteadySettings(seeds=2, workers=1)
+    grid = steady.steady_grid(problem, settings, 4, 3, 0.15e-3, directory=tmp_path)
+    feasible = np.all(grid["static_margins"] > 0, axis=-1)
+    assert len(seen) == grid["num_evaluations"] == feasible.sum() > 0
+    assert seen[0][1] is None and all(s is not None for _, s in seen[1:])  # continuation
+    ok = feasible & (grid["dynamic_margin"] > 0)
+    assert grid["best_objective"] == pytest.approx(np.min(grid["objective"][ok]))
+    assert np.all(np.isnan(grid["objective"][~feasible]))
+    seen.clear()
+    again = steady.steady_grid(problem, settings, 4, 3, 0.15e-3, directory=tmp_path)
+    assert seen == [] and again["best_objective"] == grid["best_objective"]

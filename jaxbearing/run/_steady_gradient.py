@@ -141,6 +141,14 @@ class SteadyGradient:
     integral_jacobians: np.ndarray  # (K, 3, 2): dA_k/dx_i, dC_k/dx_i
     ok: np.ndarray  # (K,) bool
 
+    @classmethod
+    def missing(cls) -> SteadyGradient:
+        """No estimate (value-only evaluations): NaN value and gradient, no samples."""
+        nan3 = np.full(3, np.nan)
+        return cls(
+            np.nan, nan3, nan3, np.nan, 0.0, 0, np.zeros((0, 2)), np.zeros((0, 3, 2)), np.zeros(0, bool)
+        )
+
 
 def _check_window(window) -> None:
     require("window", window, lambda v: np.isfinite(v) & (v > 0), "> 0 s and finite")
