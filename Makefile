@@ -28,8 +28,10 @@ format: $(STAMP)
 	$(BIN)/ruff check --fix jaxbearing optimise tests benchmarks
 	$(BIN)/ruff format jaxbearing optimise tests benchmarks
 
+# two test processes (one per core of the 2-core CI machine), a whole file per process so that
+# module fixtures and compiled programs are built once per file
 test: $(STAMP) lint
-	MPLBACKEND=Agg $(BIN)/python -m pytest -q
+	MPLBACKEND=Agg $(BIN)/python -m pytest -q -n 2 --dist loadfile
 
 test-slow: $(STAMP)
 	MPLBACKEND=Agg $(BIN)/python -m pytest -q -m slow
