@@ -89,3 +89,21 @@ def test_cache_directory_from_environment(monkeypatch, tmp_path):
 def test_parallel_map_keeps_order_in_two_processes():
     assert parallel_map(operator.neg, [3, 1, 2], workers=2) == [-3, -1, -2]
     assert parallel_map(operator.neg, [4], workers=2) == [-4]  # one item: no pool
+
+
+def test_parallel_map_in_an_unguarded_script_is_one_line_not_a_hang(tmp_path):
+    """A script that calls parallel_map at top level (no `if __name__ == "__main__":`): every
+    spawned worker re-runs the script on import and dies. The map ends with one line naming
+    the cause instead of a pool restarting workers for ever."""
+    import subprocess
+    import sys
+
+    script = tmp_path / "unguarded.py"
+    script.write_text(
+        "import operator\nfrom jaxbearing.run import parallel_map\n"
+        "print(parallel_map(operator.neg, [1, 2], workers=2))\n"
+    )
+    proc = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=240)
+    assert proc.returncode != 0
+    last = proc.stderr.strip().splitlines()[-1]
+    assert "workers = 2" in last and "__main__" in last

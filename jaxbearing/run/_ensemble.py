@@ -15,7 +15,10 @@ worker is loaded, not recompiled, by the others. `threads_per_worker=1` limits e
 one XLA thread; the default keeps this process's XLA flags, because the flags are part of the
 cache key (with other flags every worker compiles its program again: measured 2 min 13 s per
 worker against 16 s for a cache load, benchmarks/bench_ensemble.py). `workers=1` runs in this
-process (no pool).
+process (no pool). A worker that dies (killed, out of memory, or a script without
+``if __name__ == "__main__":`` whose workers re-run it on import, as `spawn` does) ends the map
+with a one-line `UserInputError` instead of a pool that restarts workers for ever
+(`concurrent.futures.ProcessPoolExecutor` reports a broken pool; `multiprocessing.Pool` hangs).
 
 `simulate_ensemble(bearing, op, seeds, ...)` runs `simulate` once per seed of the initial roller
 scatter (`Perturbation(seed=s)`) through `parallel_map`.
@@ -28,7 +31,11 @@ import dataclasses
 import multiprocessing
 import os
 from collections.abc import Callable, Iterable, Sequence
+from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
 from typing import Any
+
+from .._errors import UserInputError
 
 #: XLA flags of a worker with one thread
 _ONE_THREAD_FLAGS = "--xla_cpu_multi_thread_eigen=false intra_op_parallelism_threads=1"
@@ -74,8 +81,15 @@ def parallel_map(
     if threads_per_worker == 1:
         flags = f"{flags} {_ONE_THREAD_FLAGS}".strip()
     ctx = multiprocessing.get_context("spawn")
-    with _environment(XLA_FLAGS=flags), ctx.Pool(workers) as pool:
-        return pool.map(function, items, chunksize=1)
+    try:
+        with _environment(XLA_FLAGS=flags), ProcessPoolExecutor(workers, mp_context=ctx) as pool:
+            return list(pool.map(function, items))
+    except BrokenProcessPool:
+        raise UserInputError(
+            f"workers = {workers}: a worker process died before finishing its case. In a script, "
+            'call this under `if __name__ == "__main__":` (each worker imports the main module '
+            "first), check the memory, or pass workers=1"
+        ) from None
 
 
 @dataclasses.dataclass(frozen=True)
