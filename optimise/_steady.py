@@ -44,6 +44,7 @@ value/ci95_low/ci95_high, and whether the CIs of the mean PV are disjoint.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import hashlib
 import pathlib
 import pickle
@@ -63,6 +64,7 @@ from jaxbearing.run import (
     SteadyGradient,
     available_cpus,
     frozen_load_gradient,
+    shared_workers,
     steady_design_metrics,
     steady_gradient,
 )
@@ -124,6 +126,20 @@ class SteadySettings:
     @property
     def num_workers(self) -> int:
         return int(self.workers) or available_cpus()
+
+
+def _in_shared_pool(function):
+    """Run `function(problem, settings, ...)` with one pool of `settings.num_workers` processes
+    for all its ensembles and gradients (`jaxbearing.run.shared_workers`): the workers import
+    JAX and load their programs once per search instead of twice per evaluation."""
+
+    @functools.wraps(function)
+    def wrapper(problem, settings=None, *args, **kwargs):
+        settings = SteadySettings() if settings is None else settings
+        with shared_workers(settings.num_workers):
+            return function(problem, settings, *args, **kwargs)
+
+    return wrapper
 
 
 def _operating_point(problem: DesignProblem, k: int):
@@ -291,6 +307,7 @@ def _fingerprint(problem: DesignProblem, settings: SteadySettings, hyper: _Hyper
     return h.hexdigest()
 
 
+@_in_shared_pool
 def steady_search(
     problem: DesignProblem,
     settings: SteadySettings = SteadySettings(),
@@ -477,6 +494,7 @@ def _scaled(est: dict, unit: float = PV_SCALE) -> dict:
     }
 
 
+@_in_shared_pool
 def verification(problem: DesignProblem, settings: SteadySettings, design, reference) -> dict:
     """The found design and the reference design re-simulated from the skid start with seeds
     the search never used (module docstring), at every operating point."""
@@ -512,6 +530,7 @@ def verification(problem: DesignProblem, settings: SteadySettings, design, refer
     return out
 
 
+@_in_shared_pool
 def steady_grid(
     problem: DesignProblem,
     settings: SteadySettings,

@@ -91,6 +91,23 @@ def test_parallel_map_keeps_order_in_two_processes():
     assert parallel_map(operator.neg, [4], workers=2) == [-4]  # one item: no pool
 
 
+def test_shared_workers_keep_one_pool_for_the_block():
+    """Inside `shared_workers`, consecutive maps run in the same two processes (the pids the
+    workers report); outside, every map starts processes of its own."""
+    import os
+
+    from jaxbearing.run import shared_workers
+
+    def pids():  # three maps: three pools of new processes unless one is shared
+        return {pid for _ in range(3) for pid in parallel_map(os.readlink, ["/proc/self"] * 4, workers=2)}
+
+    with shared_workers(2):
+        inside = pids()
+    assert len(inside) <= 2
+    outside = pids()
+    assert len(outside) >= 3 and not outside & inside
+
+
 def test_parallel_map_in_an_unguarded_script_is_one_line_not_a_hang(tmp_path):
     """A script that calls parallel_map at top level (no `if __name__ == "__main__":`): every
     spawned worker re-runs the script on import and dies. The map ends with one line naming

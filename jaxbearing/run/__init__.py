@@ -21,7 +21,8 @@
 - `plot_run`: the figures of one run;
 - speed: `raceway_normal_norm` (the error norm of `solve`), `enable_compilation_cache` (JAX's
   persistent cache in a user directory, `$JAXBEARING_CACHE_DIR`; on at import),
-  `parallel_map` / `simulate_ensemble` (independent cases, one process per core).
+  `parallel_map` / `simulate_ensemble` (independent cases, one process per core),
+  `shared_workers` (one pool for every `parallel_map` of a block).
 
 May import: `jaxbearing._errors`, `contact`, `geometry`, `io`, `flange`, `forces`, `dynamics`.
 """
@@ -38,7 +39,7 @@ from ._design import (
     forward_jacobian,
     seated_perturbation,
 )
-from ._ensemble import available_cpus, parallel_map, simulate_ensemble
+from ._ensemble import available_cpus, parallel_map, shared_workers, simulate_ensemble
 from ._initial import STARTS, Perturbation, SkidStart, initial_state, skid_start
 from ._plots import plot_run
 from ._progress import SolveProgress
@@ -102,6 +103,7 @@ __all__ = [
     "RacewayNormalNorm",
     "enable_compilation_cache",
     "parallel_map",
+    "shared_workers",
     "raceway_normal_norm",
     "simulate_ensemble",
     "GRADIENT_ATOL",

@@ -20,6 +20,9 @@ process (no pool). A worker that dies (killed, out of memory, or a script withou
 with a one-line `UserInputError` instead of a pool that restarts workers for ever
 (`concurrent.futures.ProcessPoolExecutor` reports a broken pool; `multiprocessing.Pool` hangs).
 
+`shared_workers(workers)` keeps one pool open for every `parallel_map` inside a `with` block (a
+search's ensembles and gradients), so the workers import JAX and load their programs once.
+
 `simulate_ensemble(bearing, op, seeds, ...)` runs `simulate` once per seed of the initial roller
 scatter (`Perturbation(seed=s)`) through `parallel_map`.
 """
@@ -80,16 +83,52 @@ def parallel_map(
     flags = os.environ.get("XLA_FLAGS", "")
     if threads_per_worker == 1:
         flags = f"{flags} {_ONE_THREAD_FLAGS}".strip()
-    ctx = multiprocessing.get_context("spawn")
+    shared = _SHARED.get(flags)
     try:
-        with _environment(XLA_FLAGS=flags), ProcessPoolExecutor(workers, mp_context=ctx) as pool:
+        if shared is not None and shared[0] >= workers:
+            return list(shared[1].map(function, items))
+        with _environment(XLA_FLAGS=flags), _pool(workers) as pool:
             return list(pool.map(function, items))
     except BrokenProcessPool:
+        _SHARED.pop(flags, None)
         raise UserInputError(
             f"workers = {workers}: a worker process died before finishing its case. In a script, "
             'call this under `if __name__ == "__main__":` (each worker imports the main module '
             "first), check the memory, or pass workers=1"
         ) from None
+
+
+def _pool(workers: int) -> ProcessPoolExecutor:
+    return ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"))
+
+
+#: pools kept open by `shared_workers`, by XLA flags: (workers, executor)
+_SHARED: dict[str, tuple[int, ProcessPoolExecutor]] = {}
+
+
+@contextlib.contextmanager
+def shared_workers(workers: int | None = None):
+    """Keep one pool of `workers` processes for every `parallel_map` inside the block (with the
+    default XLA flags and at most `workers` workers), instead of starting a pool per call.
+
+    A fresh worker imports JAX and loads its programs from the persistent compilation cache
+    before its first case (seconds per program); a loop of short parallel calls (the steady
+    design search: an ensemble and a gradient per iteration) pays that once in the block. The
+    workers are pure (every case carries its inputs), so results do not depend on which worker
+    ran a case. Nested blocks reuse the outer pool."""
+    workers = available_cpus() if workers is None else int(workers)
+    flags = os.environ.get("XLA_FLAGS", "")
+    if workers <= 1 or flags in _SHARED:
+        yield
+        return
+    with _environment(XLA_FLAGS=flags):
+        pool = _pool(workers)
+    _SHARED[flags] = (workers, pool)
+    try:
+        yield
+    finally:
+        _SHARED.pop(flags, None)
+        pool.shutdown(wait=True, cancel_futures=True)
 
 
 @dataclasses.dataclass(frozen=True)
