@@ -31,6 +31,7 @@ kept in out/bench_steady_gradient/, which git ignores).
 
 from __future__ import annotations
 
+import json
 import math
 import pathlib
 import pickle
@@ -288,7 +289,9 @@ def replicate_clearance() -> dict:
     from jaxbearing.run import frozen_load_gradient
 
     path = _common.RESULTS_DIR / f"{NAME}.json"
-    out = __import__("json").loads(path.read_text())
+    if not (STATE_DIR / f"full_{REPLICATE}_axial_clearance_plus.pkl").exists():
+        raise SystemExit(f"{STATE_DIR}: the first study's runs are missing; run the full study first")
+    out = json.loads(path.read_text())
     first = out["designs"][REPLICATE]["central_difference"]["axial_clearance"]
     bearing, op = jb.reference_bearing(), jb.reference_operating_point()
     t_start = time.perf_counter()
@@ -310,8 +313,6 @@ def replicate_clearance() -> dict:
         d.apply(bearing), op, d, base["samples"], window=FROZEN_WINDOW, workers=WORKERS
     )
     # seeds 0-7 per seed, from the first study's kept runs (out/bench_steady_gradient/)
-    if not (STATE_DIR / f"full_{REPLICATE}_axial_clearance_plus.pkl").exists():
-        raise SystemExit(f"{STATE_DIR}: the first study's runs are missing; run the full study first")
     first_d = _fd(x, i, h, bearing, op, None, f"full_{REPLICATE}", SEEDS, rev_ms, WINDOW_REVS)["per_seed"]
     pooled = _paired(np.concatenate([first_d, fd["per_seed"]]), h, 0.0)
     rep = dict(
@@ -332,11 +333,7 @@ def replicate_clearance() -> dict:
     )
     out["clearance_replication"] = rep
     _common.write_json(NAME, out)
-    print(
-        __import__("json").dumps(
-            {k: v for k, v in rep.items() if k != "central_difference_seeds_0_7"}, indent=1
-        )
-    )
+    print(json.dumps({k: v for k, v in rep.items() if k != "central_difference_seeds_0_7"}, indent=1))
     return rep
 
 

@@ -17,8 +17,9 @@ measures both against common-random-number central differences (README, Design o
 running).
 
 Constraints. The four static design-zone margins of `DesignProblem.constraints` and the
-dynamic corner-contact margin m_dyn = rho_lim - max(contact radius) (the largest per cage revolution) - `corner_margin` (the
-worst operating point), which has no derivative of its own (an extreme of a dynamic run). It
+dynamic corner-contact margin m_dyn = rho_lim - max(contact radius) - `corner_margin`, max
+being the largest contact radius of a cage revolution (the worst operating point), which has no
+derivative of its own (an extreme of a dynamic run). It
 is modelled as the measured value plus the change of the static limited-circle margin
 rho_lim - rho_c (the aligned contact radius): m_dyn(u') ~ m_dyn(u) + m_lc(u') - m_lc(u), i.e.
 the skew excursion max - rho_c is held at its measured value over one step; its gradient is the
