@@ -12,8 +12,10 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import optimistix as optx
+import pytest
 
 import jaxbearing as jb
+from jaxbearing import UserInputError
 from jaxbearing.run import (
     CACHE_ENV,
     RacewayNormalNorm,
@@ -106,6 +108,9 @@ def test_shared_workers_keep_one_pool_for_the_block():
     assert len(inside) <= 2
     outside = pids()
     assert len(outside) >= 3 and not outside & inside
+    with pytest.raises(UserInputError, match="workers = 0"):
+        with shared_workers(0):
+            pass
 
 
 def test_parallel_map_in_an_unguarded_script_is_one_line_not_a_hang(tmp_path):

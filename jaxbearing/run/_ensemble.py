@@ -39,6 +39,7 @@ from concurrent.futures.process import BrokenProcessPool
 from typing import Any
 
 from .._errors import UserInputError
+from ..io import require
 
 #: XLA flags of a worker with one thread
 _ONE_THREAD_FLAGS = "--xla_cpu_multi_thread_eigen=false intra_op_parallelism_threads=1"
@@ -116,6 +117,8 @@ def shared_workers(workers: int | None = None):
     design search: an ensemble and a gradient per iteration) pays that once in the block. The
     workers are pure (every case carries its inputs), so results do not depend on which worker
     ran a case. Nested blocks reuse the outer pool."""
+    if workers is not None:
+        require("workers", workers, lambda v: (v >= 1) & (v % 1 == 0), "an integer >= 1")
     workers = available_cpus() if workers is None else int(workers)
     flags = os.environ.get("XLA_FLAGS", "")
     if workers <= 1 or flags in _SHARED:
