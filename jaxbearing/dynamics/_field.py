@@ -129,6 +129,7 @@ def inner_ring_pose(ring: RingState, op: OperatingPoint) -> RingPose:
     )
 
 
+@jax.jit
 def contact_loads(state: State, params: Params) -> Loads:
     """All contacts at a physical (unscaled) state."""
     b, op = params.bearing, params.operating
@@ -164,6 +165,7 @@ def contact_loads(state: State, params: Params) -> Loads:
     return Loads(inner=inner, outer=outer, flange=flange, pocket=pocket)
 
 
+@jax.jit
 def physical_rates(t, state: State, params: Params) -> State:
     """d(state)/dt in physical units: every contact of the state (`contact_loads`), then the
     rates of the rollers, the cage, the inner ring and the smooth flange functionals."""

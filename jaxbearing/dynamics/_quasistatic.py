@@ -143,6 +143,7 @@ def _approaches(prob: _Problem, d, r):
     return a_i, a_o
 
 
+@jax.jit
 def _roller_residual(prob: _Problem, d, r):
     """f_j(r_j) = Q_o,j - Q_i,j - F_ext,j (increasing in r_j)."""
     a_i, a_o = _approaches(prob, d, r)
@@ -160,6 +161,7 @@ def _deflection_bound(prob: _Problem, load):
     return (n * jnp.abs(load) / (k_c * n_central)) ** 0.9
 
 
+@jax.jit
 def _solve_rollers(prob: _Problem, d):
     """Roller radial positions r_j(d) by bisection (no gradient; see `_roller_positions`)."""
     b = prob.bearing
