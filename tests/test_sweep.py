@@ -2,8 +2,8 @@
 
 The sweep of tests/sweeps/small.toml (arc/corner x two speeds, 0.2 ms, 2 batches of 2) is run
 once in this process (the reference); the kill/restart test runs the same command in
-subprocesses and must reproduce it bit for bit. (The solve's program holds host callbacks, so
-JAX's persistent compilation cache does not apply: every subprocess compiles once, ~10-30 s.)
+subprocesses and must reproduce it bit for bit. (Each subprocess traces the batch program and
+loads it from JAX's persistent compilation cache, a few seconds.)
 """
 
 from __future__ import annotations
