@@ -154,7 +154,12 @@ def _ftle(ts, norms) -> float:
     return float(np.mean([np.polyfit(ts[keep], np.log(n[keep]), 1)[0] for n in norms]))
 
 
-def main(quick: bool = False) -> dict:
+def main(
+    quick: bool = False, *, tag: str | None = None, short_windows: bool = True, into: str | None = None
+) -> dict:
+    """The study (module docstring). `tag` names its kept runs in STATE_DIR (default "quick" or
+    "full"); `short_windows=False` leaves out the short-window estimators and the tangent growth;
+    `into` writes the result under that key of the existing JSON instead of replacing it."""
     import jaxbearing as jb
     from jaxbearing.flange import DesignVariables
     from jaxbearing.run import frozen_load_gradient, steady_gradient, tangent_growth
@@ -162,8 +167,8 @@ def main(quick: bool = False) -> dict:
     bearing, op = jb.reference_bearing(), jb.reference_operating_point()
     seeds = 2 if quick else SEEDS
     designs = dict(list(DESIGNS.items())[:1]) if quick else DESIGNS
-    windows = WINDOWS[:1] if quick else WINDOWS
-    tag = "quick" if quick else "full"
+    windows = (WINDOWS[:1] if quick else WINDOWS) if short_windows else ()
+    tag = tag or ("quick" if quick else "full")
     t_start = time.perf_counter()
     ref_x = np.array(DESIGNS["reference"])
     ref = _cached(
@@ -208,9 +213,15 @@ def main(quick: bool = False) -> dict:
             t0 = time.perf_counter()
             g = steady_gradient(b, op, d, base["samples"], window=w, workers=WORKERS)
             short[w] = (g, time.perf_counter() - t0)
-        t0 = time.perf_counter()
-        ts, norms = tangent_growth(b, op, d, base["samples"][0], 1.0e-3 if quick else 2.0e-3, num_saves=21)
-        growth_wall = time.perf_counter() - t0
+        if short_windows:
+            t0 = time.perf_counter()
+            ts, norms = tangent_growth(
+                b, op, d, base["samples"][0], 1.0e-3 if quick else 2.0e-3, num_saves=21
+            )
+            growth = dict(t_s=ts.tolist(), norms=norms.tolist(), ftle_per_s=_ftle(ts, norms))
+            growth["wall_s"] = time.perf_counter() - t0
+        else:
+            growth = None
 
         def est(g, wall):
             return dict(
@@ -236,9 +247,7 @@ def main(quick: bool = False) -> dict:
             short_window={
                 f"{w * 1e3:g}_ms": est(g, wall) | {"window_s": w} for w, (g, wall) in short.items()
             },
-            tangent_growth=dict(
-                t_s=ts.tolist(), norms=norms.tolist(), ftle_per_s=_ftle(ts, norms), wall_s=growth_wall
-            ),
+            tangent_growth=growth,
         )
         out["designs"][name] = entry
         for i, v in enumerate(VARIABLES):
@@ -252,7 +261,7 @@ def main(quick: bool = False) -> dict:
                 ]
                 + [f"{g.gradient[i]:.3e} +- {g.gradient_stderr[i]:.1e}" for g, _ in short.values()]
             )
-        _common.write_json(NAME, out | {"partial": True})
+        _write(out | {"partial": True}, into)
     checks = [
         a for e in out["designs"].values() for a in e["frozen_load"]["agreement"].values() if a["checked"]
     ]
@@ -269,21 +278,36 @@ def main(quick: bool = False) -> dict:
         rows,
     )
     print(out["table"])
-    _common.write_json(NAME, out)
+    _write(out, into)
     return out
+
+
+def _write(out: dict, into: str | None) -> None:
+    """Write the study's JSON, or put `out` under the key `into` of the existing one."""
+    if into is None:
+        _common.write_json(NAME, out)
+        return
+    path = _common.RESULTS_DIR / f"{NAME}.json"
+    existing = json.loads(path.read_text()) if path.exists() else {}
+    existing[into] = out
+    _common.write_json(NAME, existing)
 
 
 REPLICATE = "R100_t1.4"
 REPLICATE_FIRST_SEED = 8
 
 
-def replicate_clearance() -> dict:
+def replicate_clearance(first_seed: int = REPLICATE_FIRST_SEED) -> dict:
     """The one significant Delta_bf difference (R_end 100 mm / theta_f 1.4 deg, seeds 0-7)
     repeated with 8 new seeds (8-15) by the same protocol (skid start at the reference design,
     continuation to the design, CRN central difference), with the frozen-load estimate from the
     new states, and the 16-seed pooled difference: is it a property of the design or a
     2.9-sigma draw among nine checks? ``python benchmarks/bench_steady_gradient.py
-    --replicate-clearance`` (needs the full study's results for seeds 0-7)."""
+    --replicate-clearance`` (needs the full study's results for seeds 0-7).
+
+    ``--first-seed N`` runs seeds N .. N+7 instead (written under
+    ``clearance_replication_seeds_N_M``); N = 0 repeats the first batch's seeds with today's
+    code, whose start-up path (skid pre-start) differs from the one the first batch ran."""
     import jaxbearing as jb
     from jaxbearing.flange import DesignVariables
     from jaxbearing.run import frozen_load_gradient
@@ -295,7 +319,7 @@ def replicate_clearance() -> dict:
     first = out["designs"][REPLICATE]["central_difference"]["axial_clearance"]
     bearing, op = jb.reference_bearing(), jb.reference_operating_point()
     t_start = time.perf_counter()
-    s0 = REPLICATE_FIRST_SEED
+    s0 = int(first_seed)
     ref_x, x = np.array(DESIGNS["reference"]), np.array(DESIGNS[REPLICATE])
     ref = _cached(
         f"rep{s0}_reference_base",
@@ -331,7 +355,12 @@ def replicate_clearance() -> dict:
         ),
         wall_time_s=time.perf_counter() - t_start,
     )
-    out["clearance_replication"] = rep
+    key = (
+        "clearance_replication"
+        if s0 == REPLICATE_FIRST_SEED
+        else f"clearance_replication_seeds_{s0}_{s0 + SEEDS - 1}"
+    )
+    out[key] = rep
     _common.write_json(NAME, out)
     print(json.dumps({k: v for k, v in rep.items() if k != "central_difference_seeds_0_7"}, indent=1))
     return rep
@@ -339,6 +368,11 @@ def replicate_clearance() -> dict:
 
 if __name__ == "__main__":
     if "--replicate-clearance" in sys.argv:
-        replicate_clearance()
+        first = int(sys.argv[sys.argv.index("--first-seed") + 1]) if "--first-seed" in sys.argv else None
+        replicate_clearance(REPLICATE_FIRST_SEED if first is None else first)
+    elif "--today" in sys.argv:
+        # the whole check again on today's code (seeds 0-7; the kept runs of --replicate-clearance
+        # --first-seed 0 are reused), frozen-load estimator only, under "today_code"
+        main(tag="rep0", short_windows=False, into="today_code")
     else:
         main(quick="--quick" in sys.argv)

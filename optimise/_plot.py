@@ -68,7 +68,7 @@ def plot_search(problem, result, path) -> pathlib.Path:
     free_clearance = problem.bounds.upper[2] > problem.bounds.lower[2]
     ax.set_title(
         f"design zone at Delta_bf = {x_ref[2] * 1e3:.3f} mm (green: feasible) and search paths"
-        + (" (projected: Delta_bf varies along them)" if free_clearance else ""),
+        + ("\n(projected: Delta_bf varies along them)" if free_clearance else ""),
         fontsize=9,
     )
     if ax.get_legend_handles_labels()[0]:

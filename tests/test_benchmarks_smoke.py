@@ -97,3 +97,18 @@ def _load(name, directory):
 def test_only_rejects_unknown_names(capsys):
     assert run_all.main(["--only", "no_such_bench"]) == 2
     assert "unknown benchmark" in capsys.readouterr().err
+
+
+def test_integrated_autocorrelation_time_of_ar1_is_its_closed_form():
+    """tau_int of an AR(1) series x_k = phi x_(k-1) + e_k is (1 + phi) / (1 - phi) (white noise:
+    1), the estimator `diagnose_axial_memory` reads the rollers' axial memory with."""
+    import numpy as np
+    from diagnose_axial_memory import integrated_autocorrelation_time
+    from scipy.signal import lfilter
+
+    rng = np.random.default_rng(0)
+    assert abs(integrated_autocorrelation_time(rng.normal(size=20_000)) - 1.0) < 0.1
+    for phi in (0.5, 0.9):
+        x = lfilter([1.0], [1.0, -phi], rng.normal(size=200_000))
+        exact = (1 + phi) / (1 - phi)
+        assert abs(integrated_autocorrelation_time(x) / exact - 1) < 0.1
