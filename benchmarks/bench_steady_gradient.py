@@ -366,10 +366,42 @@ def replicate_clearance(first_seed: int = REPLICATE_FIRST_SEED) -> dict:
     return rep
 
 
+def pool_clearance() -> dict:
+    """The Delta_bf differences at R_end 100 mm / theta_f 1.4 deg of every batch run on today's
+    code (`--replicate-clearance --first-seed 0, 8, 16`) pooled: per-seed mean, paired standard
+    error and Student-t interval over all seeds, and a one-way ANOVA across the batches (are
+    they draws of one distribution?). No simulation: reads the JSON. ``--pool-clearance``."""
+    from scipy import stats
+
+    path = _common.RESULTS_DIR / f"{NAME}.json"
+    out = json.loads(path.read_text())
+    keys = [k for k in out if k.startswith("clearance_replication")]
+    batches = {out[k]["seeds"][0]: np.asarray(out[k]["central_difference"]["per_seed"]) for k in keys}
+    per_seed = np.concatenate([batches[s0] for s0 in sorted(batches)])
+    anova = stats.f_oneway(*[batches[s0] for s0 in sorted(batches)])
+    pooled = _paired(per_seed, FD_STEP * RANGES[2], 0.0) | {
+        "ci95": _common.interval(per_seed),
+        "first_seeds_of_batches": sorted(batches),
+        "anova_between_batches": {"F": float(anova.statistic), "p": float(anova.pvalue)},
+        "frozen_load_per_batch": {
+            str(out[k]["seeds"][0]): out[k]["frozen_load"]["gradient"][2] for k in keys
+        },
+    }
+    pooled["frozen_load_agreement"] = _agreement(
+        float(np.mean(list(pooled["frozen_load_per_batch"].values()))), pooled
+    )
+    out["clearance_pooled_today"] = pooled
+    _common.write_json(NAME, out)
+    print(json.dumps({k: v for k, v in pooled.items() if k != "per_seed"}, indent=1))
+    return pooled
+
+
 if __name__ == "__main__":
     if "--replicate-clearance" in sys.argv:
         first = int(sys.argv[sys.argv.index("--first-seed") + 1]) if "--first-seed" in sys.argv else None
         replicate_clearance(REPLICATE_FIRST_SEED if first is None else first)
+    elif "--pool-clearance" in sys.argv:
+        pool_clearance()
     elif "--today" in sys.argv:
         # the whole check again on today's code (seeds 0-7; the kept runs of --replicate-clearance
         # --first-seed 0 are reused), frozen-load estimator only, under "today_code"
