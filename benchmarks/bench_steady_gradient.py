@@ -398,8 +398,13 @@ def pool_clearance() -> dict:
 
 if __name__ == "__main__":
     if "--replicate-clearance" in sys.argv:
-        first = int(sys.argv[sys.argv.index("--first-seed") + 1]) if "--first-seed" in sys.argv else None
-        replicate_clearance(REPLICATE_FIRST_SEED if first is None else first)
+        first = REPLICATE_FIRST_SEED
+        if "--first-seed" in sys.argv:
+            value = (sys.argv[sys.argv.index("--first-seed") + 1 :] or [""])[0]
+            if not value.isdigit():
+                raise SystemExit(f"--first-seed {value!r}: must be an integer >= 0")
+            first = int(value)
+        replicate_clearance(first)
     elif "--pool-clearance" in sys.argv:
         pool_clearance()
     elif "--today" in sys.argv:
