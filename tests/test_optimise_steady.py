@@ -194,9 +194,14 @@ def test_verification_uses_unseen_seeds(config, monkeypatch):
     for name in ("reference", "optimum"):
         row = v[name]
         assert row["seeds"] == [7, 8, 9]
-        for key in ("mean_pv_GPa_m_s", "p95_pv_GPa_m_s", "corner_contact_share"):
+        for key in ("mean_pv", "p95_pv", "corner_contact_share", "mean_pv_GPa_m_s", "p95_pv_GPa_m_s"):
             est = row[key]
             assert est["ci95_low"] <= est["value"] <= est["ci95_high"]
+        # the keys in SI, the engineering-unit keys in GPa m/s: the same estimates
+        for key in ("mean_pv", "p95_pv"):
+            assert row[key]["unit"] == "Pa m/s"
+            for k in ("value", "ci95_low", "ci95_high"):
+                assert row[key][k] == pytest.approx(row[f"{key}_GPa_m_s"][k] * 1e9, rel=1e-12)
     # the same design and seeds: the same numbers, so the CIs overlap
     assert v["mean_pv_lower_disjoint"] is False
     assert v["optimum_corner_contacts"] is False
