@@ -282,15 +282,18 @@ def main(
     return out
 
 
+def _results() -> dict:
+    """The study's JSON as written so far ({} before the first write)."""
+    path = _common.RESULTS_DIR / f"{NAME}.json"
+    return json.loads(path.read_text()) if path.exists() else {}
+
+
 def _write(out: dict, into: str | None) -> None:
     """Write the study's JSON, or put `out` under the key `into` of the existing one."""
     if into is None:
         _common.write_json(NAME, out)
         return
-    path = _common.RESULTS_DIR / f"{NAME}.json"
-    existing = json.loads(path.read_text()) if path.exists() else {}
-    existing[into] = out
-    _common.write_json(NAME, existing)
+    _common.write_json(NAME, _results() | {into: out})
 
 
 REPLICATE = "R100_t1.4"
@@ -312,11 +315,9 @@ def replicate_clearance(first_seed: int = REPLICATE_FIRST_SEED) -> dict:
     from jaxbearing.flange import DesignVariables
     from jaxbearing.run import frozen_load_gradient
 
-    path = _common.RESULTS_DIR / f"{NAME}.json"
     if not (STATE_DIR / f"full_{REPLICATE}_axial_clearance_plus.pkl").exists():
         raise SystemExit(f"{STATE_DIR}: the first study's runs are missing; run the full study first")
-    out = json.loads(path.read_text())
-    first = out["designs"][REPLICATE]["central_difference"]["axial_clearance"]
+    first = _results()["designs"][REPLICATE]["central_difference"]["axial_clearance"]
     bearing, op = jb.reference_bearing(), jb.reference_operating_point()
     t_start = time.perf_counter()
     s0 = int(first_seed)
@@ -360,8 +361,7 @@ def replicate_clearance(first_seed: int = REPLICATE_FIRST_SEED) -> dict:
         if s0 == REPLICATE_FIRST_SEED
         else f"clearance_replication_seeds_{s0}_{s0 + SEEDS - 1}"
     )
-    out[key] = rep
-    _common.write_json(NAME, out)
+    _write(rep, key)
     print(json.dumps({k: v for k, v in rep.items() if k != "central_difference_seeds_0_7"}, indent=1))
     return rep
 
@@ -373,8 +373,7 @@ def pool_clearance() -> dict:
     they draws of one distribution?). No simulation: reads the JSON. ``--pool-clearance``."""
     from scipy import stats
 
-    path = _common.RESULTS_DIR / f"{NAME}.json"
-    out = json.loads(path.read_text())
+    out = _results()
     keys = [k for k in out if k.startswith("clearance_replication")]
     batches = {out[k]["seeds"][0]: np.asarray(out[k]["central_difference"]["per_seed"]) for k in keys}
     per_seed = np.concatenate([batches[s0] for s0 in sorted(batches)])
@@ -390,8 +389,7 @@ def pool_clearance() -> dict:
     pooled["frozen_load_agreement"] = _agreement(
         float(np.mean(list(pooled["frozen_load_per_batch"].values()))), pooled
     )
-    out["clearance_pooled_today"] = pooled
-    _common.write_json(NAME, out)
+    _write(pooled, "clearance_pooled_today")
     print(json.dumps({k: v for k, v in pooled.items() if k != "per_seed"}, indent=1))
     return pooled
 
