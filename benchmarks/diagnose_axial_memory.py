@@ -62,12 +62,10 @@ def integrated_autocorrelation_time(x: np.ndarray, c: float = 5.0) -> float:
         return float("nan")
     f = np.fft.rfft(x, 2 * n)
     acf = np.fft.irfft(f * np.conj(f))[:n] / (n * var)
-    tau = 1.0
-    for m in range(1, n):
-        tau = 1.0 + 2.0 * np.sum(acf[1 : m + 1])
-        if m >= c * tau:
-            return float(tau)
-    return float("nan")  # the window never closed: longer than the series can tell
+    tau = 1.0 + 2.0 * np.cumsum(acf[1:])  # tau_int(M) for M = 1 .. n-1
+    closed = np.nonzero(np.arange(1, n) >= c * tau)[0]
+    # the window never closed: longer than the series can tell
+    return float(tau[closed[0]]) if closed.size else float("nan")
 
 
 def slope_per_revolution(y) -> tuple[float, float]:
