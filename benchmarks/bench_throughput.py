@@ -61,7 +61,7 @@ def measure(
     inputs = _inputs(size, duration)
     runner = batch_runner(num_saves, max_steps, devices)
     start = time.perf_counter()
-    compiled = runner.lower(*inputs).compile()
+    compiled = runner.compile(*inputs)
     compile_s = time.perf_counter() - start
     walls = []
     for _ in range(repeats):

@@ -21,13 +21,15 @@
 - `plot_run`: the figures of one run;
 - speed: `raceway_normal_norm` (the error norm of `solve`), `enable_compilation_cache` (JAX's
   persistent cache in a user directory, `$JAXBEARING_CACHE_DIR`; on at import),
+  `compiled_program` (a program compiled once per process and traced once per machine:
+  `jax.export` artefacts in `program_cache_dir`),
   `parallel_map` / `simulate_ensemble` (independent cases, one process per core),
   `shared_workers` (one pool for every `parallel_map` of a block).
 
 May import: `jaxbearing._errors`, `contact`, `geometry`, `io`, `flange`, `forces`, `dynamics`.
 """
 
-from ._compile_cache import CACHE_ENV, enable_compilation_cache
+from ._compile_cache import CACHE_ENV, compiled_program, enable_compilation_cache, program_cache_dir
 from ._design import (
     GRADIENT_ATOL,
     GRADIENT_HORIZON,
@@ -102,6 +104,8 @@ __all__ = [
     "RACEWAY_NORMAL_LOOSEN",
     "RacewayNormalNorm",
     "enable_compilation_cache",
+    "compiled_program",
+    "program_cache_dir",
     "parallel_map",
     "shared_workers",
     "raceway_normal_norm",

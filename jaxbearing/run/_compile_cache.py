@@ -3,7 +3,7 @@
 Compiling `simulate` takes 10-40 s and the forward-mode gradient about 40 s; a second process
 that compiles the same program reads it from the cache instead.
 
-Two parts:
+Three parts:
 
 * `checks_without_host_callbacks`: JAX refuses to persist an executable that contains a host
   callback, and equinox implements its run-time checks (`equinox.internal.error_if`, under
@@ -19,15 +19,30 @@ Two parts:
   `$JAXBEARING_CACHE_DIR` if set (`off`, `0`, `false`, `no` or an empty value switch the cache
   off), else `$XDG_CACHE_HOME/jaxbearing/xla` (default `~/.cache/jaxbearing/xla`). Called when
   `jaxbearing` is imported; a cache directory the user configured in JAX already is kept.
+* `compiled_program`: the persistent cache skips compilation, not tracing, and tracing a solve's
+  forward-mode Jacobian or a vmapped batch takes 5-10 s (the JVP and batching of diffrax's while
+  loop). The library's programs (`simulate`, `solve_from`, the skid start, `design_jacobian`,
+  the steady gradients and the one-device sweep batch) are therefore built once per machine
+  and stored as `jax.export` artefacts (serialized StableHLO, "Exporting and serializing staged
+  out computations" in JAX's documentation) in `programs/` inside the cache directory, keyed on
+  the argument structure, shapes, dtypes and static arguments and on a digest of jaxbearing's
+  source and the traced packages' versions. A second process deserializes the program instead of
+  tracing it, and compiles it with a hit in the persistent cache
+  (`benchmarks/bench_compile_cache.py`).
 """
 
 from __future__ import annotations
 
 import contextlib
+import functools
+import hashlib
 import os
+import pickle
+import tempfile
 from pathlib import Path
 
 import jax
+import jax.numpy as jnp
 
 #: environment variable naming the cache directory (or switching the cache off)
 CACHE_ENV = "JAXBEARING_CACHE_DIR"
@@ -84,3 +99,163 @@ def enable_compilation_cache(directory: str | os.PathLike | None = None) -> Path
     # every solve program is worth caching; tiny helper programs are not
     jax.config.update("jax_persistent_cache_min_compile_time_secs", 1.0)
     return path
+
+
+# --------------------------------------------------------------------------------------------
+# Traced once per machine: programs exported to disk (jax.export)
+# --------------------------------------------------------------------------------------------
+
+#: bump when the layout of a stored program changes
+PROGRAM_FORMAT = 1
+#: packages whose code is traced into a program (their versions are part of its key)
+_TRACED_PACKAGES = ("jax", "jaxlib", "diffrax", "equinox", "lineax", "optimistix")
+_PROGRAMS: dict = {}
+
+
+class Program:
+    """A compiled program called with the pytree structure it was built for: flattens the
+    arguments, runs the executable, rebuilds the output tree."""
+
+    def __init__(self, compiled, specs: tuple, out_tree, exported: bool):
+        self._compiled = compiled
+        self._dtypes = tuple(s.dtype for s in specs)
+        self._out_tree = out_tree
+        #: True when the program came through `jax.export` (stored on disk, or loaded from it)
+        self.exported = exported
+
+    def __call__(self, *args):
+        leaves = jax.tree_util.tree_leaves(args)
+        leaves = [jnp.asarray(x, dtype=d) for x, d in zip(leaves, self._dtypes)]
+        return jax.tree_util.tree_unflatten(self._out_tree, self._compiled(*leaves))
+
+
+def program_cache_dir() -> Path | None:
+    """`programs/` inside JAX's persistent compilation cache directory; None when that cache is
+    off (then nothing is stored)."""
+    directory = jax.config.jax_compilation_cache_dir
+    return Path(directory) / "programs" if directory else None
+
+
+@functools.cache
+def _code_digest() -> str:
+    """sha256 of jaxbearing's own source and the versions of every package it traces: a program
+    stored by other code is never loaded."""
+    from importlib import metadata
+
+    h = hashlib.sha256(f"format {PROGRAM_FORMAT}".encode())
+    for package in _TRACED_PACKAGES:
+        try:
+            h.update(f"{package} {metadata.version(package)}".encode())
+        except metadata.PackageNotFoundError:
+            h.update(f"{package} -".encode())
+    root = Path(__file__).resolve().parents[1]
+    for path in sorted(root.rglob("*.py")):
+        h.update(str(path.relative_to(root)).encode())
+        h.update(path.read_bytes())
+    return h.hexdigest()
+
+
+def _program_key(name: str, in_tree, specs: tuple, static) -> str:
+    text = "\n".join(
+        [
+            _code_digest(),
+            name,
+            jax.default_backend(),
+            f"x64={jax.config.jax_enable_x64}",
+            str(in_tree),
+            repr([(s.shape, str(s.dtype)) for s in specs]),
+            repr(static),
+        ]
+    )
+    return hashlib.sha256(text.encode()).hexdigest()[:40]
+
+
+def _load(path: Path):
+    """(Exported, output tree) stored at `path`, or None (absent, unreadable or damaged: a
+    damaged file is removed and the program built again)."""
+    try:
+        entry = pickle.loads(path.read_bytes())
+        exported = jax.export.deserialize(bytearray(entry["exported"]))
+        return exported, jax.tree_util.tree_structure(entry["skeleton"])
+    except FileNotFoundError:
+        return None
+    except Exception:  # noqa: BLE001 - any damage means: build it again
+        with contextlib.suppress(OSError):
+            path.unlink()
+        return None
+
+
+def _store(path: Path, exported, out_tree) -> None:
+    """Write the program atomically (a temporary file renamed): whole or absent. A full or
+    read-only disk only costs the next process the tracing."""
+    skeleton = jax.tree_util.tree_unflatten(out_tree, [0] * out_tree.num_leaves)
+    data = pickle.dumps({"exported": bytes(exported.serialize()), "skeleton": skeleton})
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with tempfile.NamedTemporaryFile(dir=path.parent, prefix=path.name, suffix=".tmp", delete=False) as f:
+            f.write(data)
+        os.replace(f.name, path)
+    except OSError:
+        with contextlib.suppress(OSError, UnboundLocalError):
+            os.unlink(f.name)
+
+
+def _export(jitted, specs: tuple, box: dict):
+    """`jax.export` of the jitted flat function, or None where it cannot be exported (e.g. a
+    progress meter's host callback): then the program is compiled the usual way, from the same
+    trace (JAX caches it on the jitted function)."""
+    try:
+        exported = jax.export.export(jitted)(*specs)
+        exported.serialize()  # effects and custom calls without a stable ABI fail here
+    except Exception:  # noqa: BLE001 - the usual compilation re-raises a genuine error
+        return None
+    return exported, box["tree"]
+
+
+def _build(name: str, fn, in_tree, specs: tuple, static) -> Program:
+    box: dict = {}
+
+    def flat(*leaves):
+        out = fn(*jax.tree_util.tree_unflatten(in_tree, leaves))
+        out_leaves, box["tree"] = jax.tree_util.tree_flatten(out)
+        return out_leaves
+
+    jitted = jax.jit(flat)
+    directory = program_cache_dir()
+    if directory is not None:
+        path = directory / f"{name}-{_program_key(name, in_tree, specs, static)}.jaxexport"
+        entry = _load(path)
+        if entry is None:
+            entry = _export(jitted, specs, box)
+            if entry is not None:
+                _store(path, *entry)
+        if entry is not None:
+            exported, out_tree = entry
+            return Program(jax.jit(exported.call).lower(*specs).compile(), specs, out_tree, True)
+    compiled = jitted.lower(*specs).compile()
+    return Program(compiled, specs, box["tree"], False)
+
+
+def compiled_program(name: str, fn, args: tuple, static=()) -> Program:
+    """`fn(*args)` compiled once per process and traced once per machine.
+
+    In a process, the program is kept per (name, argument structure, shapes and dtypes,
+    `static`). On disk (`program_cache_dir`, when the persistent compilation cache is on), it is
+    stored as a `jax.export` artefact keyed on the same and on jaxbearing's source and the traced
+    packages' versions (`_code_digest`): a second process loads it instead of tracing `fn`, and
+    its compilation is then a hit of the persistent compilation cache. `static` is everything
+    `fn` closes over that changes the program (hashable, with a deterministic `repr`). `fn` must
+    be pure in its arguments. Programs that `jax.export` cannot store (host callbacks) are
+    compiled as usual.
+
+    The key covers jaxbearing's source, not what was traced: code that monkeypatches
+    jaxbearing's traced functions must run with the cache off (`JAXBEARING_CACHE_DIR=off`) or
+    in a cache directory of its own. `rm -r` of `program_cache_dir()` forgets every program.
+    """
+    leaves, in_tree = jax.tree_util.tree_flatten(args)
+    specs = tuple(jax.ShapeDtypeStruct(jnp.shape(x), jnp.result_type(x)) for x in leaves)
+    key = (name, in_tree, specs, static)
+    program = _PROGRAMS.get(key)
+    if program is None:
+        program = _PROGRAMS[key] = _build(name, fn, in_tree, specs, static)
+    return program

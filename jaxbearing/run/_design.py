@@ -63,6 +63,7 @@ from .._errors import UserInputError
 from ..flange import DEFAULT_FLANGE_LOAD, DesignVariables, check_design, design_zone
 from ..geometry import Bearing, OperatingPoint
 from ..io import SOLVER_ARGUMENTS, check_model_inputs, check_solver_arguments
+from ._compile_cache import compiled_program
 from ._initial import Perturbation
 from ._simulate import flange_functionals
 
@@ -228,6 +229,28 @@ def design_jacobian(
     _check_design_inputs(bearing, op, design, duration, solve_kwargs)
     if mode == "forward":
         solve_kwargs = dict(solve_kwargs, adjoint=diffrax.ForwardMode())
+    numbers, others = eqx.partition(solve_kwargs, eqx.is_inexact_array_like)
+    args = (bearing, op, design.as_array(), duration, numbers)
+    static = (mode, tuple(sorted(others.items())))
+    if not _concrete_and_hashable(args, static):  # traced by the caller (jit, vmap, grad)
+        return _design_jacobian(*args, others, mode)
+    run = lambda *a: _design_jacobian(*a, others, mode)
+    return compiled_program("design_jacobian", run, args, static)(*args)
+
+
+def _concrete_and_hashable(args, static) -> bool:
+    """Whether a call can use a stored program: no tracer among `args`, a hashable `static`."""
+    if any(isinstance(leaf, jax.core.Tracer) for leaf in jax.tree_util.tree_leaves(args)):
+        return False
+    try:
+        hash(static)
+    except TypeError:
+        return False
+    return True
+
+
+def _design_jacobian(bearing, op, x, duration, numbers, others, mode):
+    solve_kwargs = eqx.combine(numbers, others)
 
     def f(x):
         b = DesignVariables.from_array(x).apply(bearing)
@@ -236,7 +259,6 @@ def design_jacobian(
             kw = dict(kw, perturbation=seated_perturbation(b))
         return jnp.stack(flange_functionals(b, op, duration, **kw))
 
-    x = design.as_array()
     if mode == "forward":
         value, cols = forward_jacobian(f, x)
         return value, cols.T

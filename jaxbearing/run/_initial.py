@@ -63,6 +63,7 @@ from ..dynamics import (
     tangential_unit,
 )
 from ..geometry import Bearing, OperatingPoint, kinematic_cage_speed
+from ._compile_cache import compiled_program
 
 
 @dataclasses.dataclass(frozen=True)
@@ -162,17 +163,9 @@ def _skid(bearing, op, scatter):
     return SkidStart(state=eq.state, equilibrium=eq, time_constant=cage_time_constant(eq, params))
 
 
-_COMPILED: dict = {}
-
-
 def _static_skid_start(bearing: Bearing, op: OperatingPoint, perturbation: Perturbation | None) -> SkidStart:
-    scatter = traced_scatter(perturbation)
-    dyn = (bearing, op, scatter)
-    leaves, treedef = jax.tree_util.tree_flatten(dyn)
-    key = (treedef, tuple((jnp.shape(x), jnp.result_type(x)) for x in leaves))
-    if key not in _COMPILED:
-        _COMPILED[key] = jax.jit(_skid).lower(*dyn).compile()
-    static = _COMPILED[key](*dyn)
+    dyn = (bearing, op, traced_scatter(perturbation))
+    static = compiled_program("skid_start", _skid, dyn)(*dyn)
     return dataclasses.replace(static, plateau_speed=float(static.equilibrium.cage_speed))
 
 

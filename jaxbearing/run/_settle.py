@@ -49,7 +49,7 @@ from .._errors import UserInputError
 from ..dynamics import Functionals, Params, Scaling, State, state_scales
 from ..geometry import Bearing, OperatingPoint, kinematic_cage_speed, rad_s_to_rpm
 from ..io import require
-from ._compile_cache import checks_without_host_callbacks
+from ._compile_cache import checks_without_host_callbacks, compiled_program
 from ._ensemble import parallel_map
 from ._initial import STARTS, Perturbation, along_slow_mode, initial_state, skid_start
 from ._result import result_code
@@ -121,22 +121,14 @@ def solve_from(
     return hist, final, result_code(sol.result), jnp.asarray(sol.stats["num_steps"])
 
 
-_COMPILED: dict = {}
-
-
 def _compiled(params, start, num_saves, max_steps, solver=DEFAULT_SOLVER):
-    leaves, treedef = jax.tree_util.tree_flatten((params, start))
-    key = (treedef, tuple((jnp.shape(x), jnp.result_type(x)) for x in leaves), num_saves, max_steps, solver)
-    if key not in _COMPILED:
+    """`solve_from` compiled (`compiled_program`) for (params, start, duration, rtol, atol)."""
 
-        def run(p, s, d, r, a):
-            return solve_from(
-                p, s, d, num_saves=num_saves, rtol=r, atol=a, max_steps=max_steps, solver=solver
-            )
+    def run(p, s, d, r, a):
+        return solve_from(p, s, d, num_saves=num_saves, rtol=r, atol=a, max_steps=max_steps, solver=solver)
 
-        f = jnp.asarray(1.0)
-        _COMPILED[key] = jax.jit(run).lower(params, start, f, f, f).compile()
-    return _COMPILED[key]
+    f = jnp.asarray(1.0)
+    return compiled_program("solve_from", run, (params, start, f, f, f), (num_saves, max_steps, solver))
 
 
 def _integrator(params, num_saves, max_steps, rtol, atol, compile_times: list, solver=DEFAULT_SOLVER):

@@ -40,7 +40,7 @@ from ..dynamics import (
 )
 from ..geometry import Bearing, OperatingPoint, kinematic_cage_speed
 from ..io import SIMULATE_NUM_SAVES, check_solve_inputs
-from ._compile_cache import checks_without_host_callbacks
+from ._compile_cache import checks_without_host_callbacks, compiled_program
 from ._initial import Perturbation, initial_state, perturbation_of, traced_scatter
 from ._progress import SolveProgress
 from ._result import SimulationResult, Solution, result_code, simulation_result, smooth_functionals
@@ -237,39 +237,33 @@ def flange_functionals(bearing: Bearing, op: OperatingPoint, duration, **kwargs)
     return tuple(jnp.where(ok, v, jnp.nan) for v in values)
 
 
-_COMPILED: dict = {}
-
-
 def _compiled_solve(bearing, op, duration, rtol, atol, static: tuple):
-    """Ahead-of-time compiled `solve`, cached on the pytree structure, shapes and static
-    arguments, so arc and corner ends, other speeds, loads, tolerances and seeds of the initial
-    scatter reuse one compilation (the scatter's seed and amplitudes are traced)."""
+    """Ahead-of-time compiled `solve` (`compiled_program`: once per process, traced once per
+    machine), keyed on the pytree structure, shapes and static arguments, so arc and corner ends,
+    other speeds, loads, tolerances and seeds of the initial scatter reuse one compilation (the
+    scatter's seed and amplitudes are traced)."""
     num_saves, max_steps, progress, perturbation, functionals, solver = static
     scatter = traced_scatter(perturbation)
     dyn = (bearing, op, duration, rtol, atol, scatter)
     static = (num_saves, max_steps, progress, perturbation is None, functionals, solver)
-    leaves, treedef = jax.tree_util.tree_flatten(dyn)
-    key = (treedef, tuple((jnp.shape(x), jnp.result_type(x)) for x in leaves), static)
-    if key not in _COMPILED:
 
-        def run(b, o, d, r, a, sc):
-            pert = perturbation_of(sc)
-            return solve(
-                b,
-                o,
-                d,
-                num_saves=num_saves,
-                rtol=r,
-                atol=a,
-                max_steps=max_steps,
-                progress=progress,
-                perturbation=pert,
-                functionals=functionals,
-                solver=solver,
-            )
+    def run(b, o, d, r, a, sc):
+        pert = perturbation_of(sc)
+        return solve(
+            b,
+            o,
+            d,
+            num_saves=num_saves,
+            rtol=r,
+            atol=a,
+            max_steps=max_steps,
+            progress=progress,
+            perturbation=pert,
+            functionals=functionals,
+            solver=solver,
+        )
 
-        _COMPILED[key] = jax.jit(run).lower(*dyn).compile()
-    return functools.partial(_COMPILED[key], *dyn)
+    return functools.partial(compiled_program("simulate", run, dyn, static), *dyn)
 
 
 def simulate(

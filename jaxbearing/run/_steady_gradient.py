@@ -49,7 +49,7 @@ from ..dynamics import Functionals, Params, State, contact_loads
 from ..flange import DesignVariables, with_design
 from ..geometry import Bearing, OperatingPoint
 from ..io import require
-from ._compile_cache import checks_without_host_callbacks
+from ._compile_cache import checks_without_host_callbacks, compiled_program
 from ._design import forward_jacobian
 from ._ensemble import parallel_map
 from ._result import result_code
@@ -82,26 +82,20 @@ def window_integrals(bearing, op, start: State, x, duration, *, rtol, atol, max_
     return jnp.stack([jnp.sum(acc.pv_power), jnp.sum(acc.contact_time), (code == 0).astype(float)])
 
 
-_COMPILED: dict = {}
-
-
 def _compiled_jacobian(bearing, op, start, x, max_steps: int):
-    """(A, C, ok) and their forward-mode Jacobian in x, compiled once per structure."""
-    leaves, treedef = jax.tree_util.tree_flatten((bearing, op, start))
-    key = (treedef, tuple((jnp.shape(v), jnp.result_type(v)) for v in leaves), max_steps)
-    if key not in _COMPILED:
+    """(A, C, ok) and their forward-mode Jacobian in x, compiled once per structure
+    (`compiled_program`)."""
 
-        def run(b, o, s, x_, d, r, a):
-            def f(v):
-                return window_integrals(
-                    b, o, s, v, d, rtol=r, atol=a, max_steps=max_steps, adjoint=diffrax.ForwardMode()
-                )
+    def run(b, o, s, x_, d, r, a):
+        def f(v):
+            return window_integrals(
+                b, o, s, v, d, rtol=r, atol=a, max_steps=max_steps, adjoint=diffrax.ForwardMode()
+            )
 
-            return forward_jacobian(f, x_)
+        return forward_jacobian(f, x_)
 
-        f0 = jnp.asarray(1.0)
-        _COMPILED[key] = jax.jit(run).lower(bearing, op, start, x, f0, f0, f0).compile()
-    return _COMPILED[key]
+    f0 = jnp.asarray(1.0)
+    return compiled_program("window_jacobian", run, (bearing, op, start, x, f0, f0, f0), max_steps)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -321,22 +315,19 @@ class _FrozenSample:
 
     def __call__(self, state):
         x = jnp.asarray(self.x)
-        states, code = _trajectory_jit(self.bearing, self.op, state, self.duration, self.num_saves, self.rtol)
+        state = jax.tree_util.tree_map(jnp.asarray, state)
+        num_saves = self.num_saves
+        args = (self.bearing, self.op, state, jnp.asarray(self.duration), jnp.asarray(self.rtol))
+        trajectory = lambda b, o, s, d, r: trajectory_states(b, o, s, d, num_saves, rtol=r)
+        states, code = compiled_program("trajectory_states", trajectory, args, num_saves)(*args)
         if int(code) != 0:
             return np.full(2, np.nan), np.full((3, 2), np.nan)
-        val, jac = _frozen_jit(self.bearing, self.op, x, states)
+        args = (self.bearing, self.op, x, states)
+        val, jac = compiled_program("frozen_load_jacobian", _frozen_jacobian, args)(*args)
         return np.asarray(val), np.asarray(jac)
 
 
-def _trajectory(bearing, op, state, duration, num_saves, rtol):
-    return trajectory_states(bearing, op, state, duration, num_saves, rtol=rtol)
-
-
-_trajectory_jit = jax.jit(_trajectory, static_argnums=(4,))
-
-
-@jax.jit
-def _frozen_jit(bearing, op, x, states):
+def _frozen_jacobian(bearing, op, x, states):
     """Sum over the saved states of the frozen-load integrands and their Jacobian in x."""
     q0 = jax.vmap(lambda s: contact_loads(s, _design_params(bearing, op, x)).flange.normal_force)(states)
 

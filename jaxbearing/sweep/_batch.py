@@ -78,13 +78,39 @@ def stack_cases(cases: Sequence) -> Any:
 
 
 @functools.cache
-def batch_runner(num_saves: int, max_steps: int, devices: tuple):
-    """A jit-compiled `vmap(solve)` sharded with `jax.shard_map` over a 1-D mesh of `devices`
-    (axis "cases"): each device integrates its slice of the batch. Takes stacked
-    (bearing, op, duration, rtol, atol) whose leading axis is a multiple of len(devices)."""
-    import jax
-    from jax.sharding import Mesh, PartitionSpec
+class BatchRunner:
+    """The compiled batch of `batch_runner`: `runner(*stacked)` solves the cases,
+    `runner.compile(*stacked)` returns the compiled program alone (for timing)."""
 
+    def __init__(self, one, num_saves: int, max_steps: int, devices: tuple):
+        self._one, self._static, self._devices = one, (num_saves, max_steps), devices
+
+    def compile(self, *stacked):
+        import jax
+
+        from ..run import compiled_program
+
+        if len(self._devices) == 1 and jax.process_count() == 1 and self._devices[0] == jax.devices()[0]:
+            # one device: the plain vmap, stored by `compiled_program` (traced once per machine)
+            return compiled_program("sweep_batch", jax.vmap(self._one), stacked, self._static)
+        from jax.sharding import Mesh, PartitionSpec
+
+        mesh = Mesh(np.asarray(self._devices), ("cases",))
+        spec = PartitionSpec("cases")
+        sharded = jax.shard_map(
+            jax.vmap(self._one), mesh=mesh, in_specs=(spec,) * 5, out_specs=spec, check_vma=False
+        )
+        return jax.jit(sharded).lower(*stacked).compile()
+
+    def __call__(self, *stacked):
+        return self.compile(*stacked)(*stacked)
+
+
+def batch_runner(num_saves: int, max_steps: int, devices: tuple) -> BatchRunner:
+    """`vmap(solve)` of stacked (bearing, op, duration, rtol, atol) whose leading axis is a
+    multiple of len(devices): on one device the vmap itself (`compiled_program`: once per
+    process, traced once per machine), on several a `jax.shard_map` over a 1-D mesh of `devices`
+    (axis "cases"), each device integrating its slice of the batch."""
     from ..run import solve
 
     def one(bearing, op, duration, rtol, atol):
@@ -99,10 +125,7 @@ def batch_runner(num_saves: int, max_steps: int, devices: tuple):
             progress=False,
         )
 
-    mesh = Mesh(np.asarray(devices), ("cases",))
-    spec = PartitionSpec("cases")
-    sharded = jax.shard_map(jax.vmap(one), mesh=mesh, in_specs=(spec,) * 5, out_specs=spec, check_vma=False)
-    return jax.jit(sharded)
+    return BatchRunner(one, num_saves, max_steps, tuple(devices))
 
 
 def padded_size(batch_size: int, num_devices: int) -> int:

@@ -1,0 +1,162 @@
+"""Programs traced once per machine (`jaxbearing.run.compiled_program`, issue 12 item 5): a second
+process loads the `jax.export` artefact instead of tracing. A "second process" is simulated by
+forgetting the in-process programs; whether the function was traced is counted at trace time."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import textwrap
+
+import equinox as eqx
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+from jaxbearing.run import _compile_cache as cc
+
+
+class Pair(eqx.Module):
+    a: jax.Array
+    b: jax.Array
+
+
+@pytest.fixture
+def programs(monkeypatch, tmp_path):
+    """An empty program directory and no program in memory."""
+    monkeypatch.setattr(cc, "program_cache_dir", lambda: tmp_path / "programs")
+    monkeypatch.setattr(cc, "_PROGRAMS", {})
+    return tmp_path / "programs"
+
+
+def _traced_counter():
+    calls = []
+
+    def fn(pair: Pair, scale):
+        calls.append(1)  # runs at trace time only
+        return Pair(a=jnp.sin(pair.a) * scale, b=pair.b @ pair.b), {"sum": jnp.sum(pair.a)}
+
+    return fn, calls
+
+
+ARGS = (Pair(a=jnp.linspace(0.0, 1.0, 5), b=jnp.eye(3) * 2.0), 3.0)
+
+
+def _expected():
+    a, b = ARGS[0].a, ARGS[0].b
+    return np.sin(a) * 3.0, b @ b, np.sum(a)
+
+
+def _check(out):
+    pair, extra = out
+    sin_a, bb, s = _expected()
+    assert isinstance(pair, Pair)
+    np.testing.assert_allclose(pair.a, sin_a, rtol=1e-15)
+    np.testing.assert_allclose(pair.b, bb, rtol=1e-15)
+    np.testing.assert_allclose(extra["sum"], s, rtol=1e-15)
+
+
+def test_second_process_loads_the_program_without_tracing(programs, monkeypatch):
+    fn, calls = _traced_counter()
+    first = cc.compiled_program("demo", fn, ARGS, static=("k", 1))
+    _check(first(*ARGS))
+    assert first.exported and len(calls) == 1
+    assert len(list(programs.glob("demo-*.jaxexport"))) == 1
+
+    monkeypatch.setattr(cc, "_PROGRAMS", {})  # a new process: nothing in memory
+    second = cc.compiled_program("demo", fn, ARGS, static=("k", 1))
+    _check(second(*ARGS))
+    assert second.exported and len(calls) == 1  # not traced again
+
+    assert cc.compiled_program("demo", fn, ARGS, static=("k", 1)) is second  # once per process
+
+
+def test_other_static_arguments_or_shapes_make_another_program(programs):
+    fn, calls = _traced_counter()
+    cc.compiled_program("demo", fn, ARGS, static=1)
+    cc.compiled_program("demo", fn, ARGS, static=2)
+    longer = (Pair(a=jnp.zeros(6), b=jnp.eye(3)), 1.0)
+    cc.compiled_program("demo", fn, longer, static=1)
+    assert len(calls) == 3
+    assert len(list(programs.glob("demo-*.jaxexport"))) == 3
+
+
+def test_damaged_program_file_is_built_again(programs, monkeypatch):
+    fn, calls = _traced_counter()
+    cc.compiled_program("demo", fn, ARGS)
+    (path,) = programs.glob("demo-*.jaxexport")
+    path.write_bytes(b"cut short")
+    monkeypatch.setattr(cc, "_PROGRAMS", {})
+    _check(cc.compiled_program("demo", fn, ARGS)(*ARGS))
+    assert len(calls) == 2
+    assert path.stat().st_size > 100  # stored whole again
+
+
+def test_program_with_a_host_callback_is_compiled_as_usual_from_one_trace(programs):
+    calls = []
+
+    def fn(x):
+        calls.append(1)
+        jax.debug.callback(lambda v: None, x)
+        return 2 * x
+
+    program = cc.compiled_program("callback", fn, (jnp.arange(3.0),))
+    np.testing.assert_array_equal(program(jnp.arange(3.0)), [0.0, 2.0, 4.0])
+    assert not program.exported
+    assert len(calls) == 1  # the failed export's trace is reused
+    assert not list(programs.glob("*.jaxexport"))
+
+
+def test_cache_off_stores_nothing(monkeypatch):
+    monkeypatch.setattr(cc, "program_cache_dir", lambda: None)
+    monkeypatch.setattr(cc, "_PROGRAMS", {})
+    fn, calls = _traced_counter()
+    program = cc.compiled_program("demo", fn, ARGS)
+    _check(program(*ARGS))
+    assert not program.exported
+
+
+def test_a_genuine_error_of_the_function_is_raised(programs):
+    def fn(x):
+        raise ValueError("bad model input")
+
+    with pytest.raises(ValueError, match="bad model input"):
+        cc.compiled_program("broken", fn, (jnp.zeros(2),))
+
+
+def test_design_jacobian_in_a_second_process_is_not_traced(tmp_path):
+    """The library program end to end: two processes share a cache directory; the second loads
+    `design_jacobian`'s program (no trace of the vector field) and gives the same numbers."""
+    script = textwrap.dedent(
+        """
+        import json, sys
+        import numpy as np
+        import jaxbearing as jb
+        from jaxbearing.dynamics import _field
+        from jaxbearing.flange import DesignVariables
+        from jaxbearing.run import _compile_cache as cc
+
+        traces = []
+        original = _field._roller_rates
+        _field._roller_rates = lambda *a: (traces.append(1), original(*a))[1]
+        b, op = jb.reference_bearing(), jb.reference_operating_point()
+        v, j = jb.design_jacobian(b, op, DesignVariables.of(b), duration=2e-6, max_steps=1000)
+        print(json.dumps({"traces": len(traces), "v": np.asarray(v).tolist(), "j": np.asarray(j).tolist(),
+                          "files": len(list(cc.program_cache_dir().glob("design_jacobian-*")))}))
+        """
+    )
+    env = {"JAXBEARING_CACHE_DIR": str(tmp_path / "cache"), "PATH": "/usr/bin:/bin", "HOME": str(tmp_path)}
+    import json
+
+    outs = []
+    for _ in range(2):
+        done = subprocess.run(
+            [sys.executable, "-c", script], env=env, capture_output=True, text=True, timeout=600
+        )
+        assert done.returncode == 0, done.stderr[-2000:]
+        outs.append(json.loads(done.stdout.strip().splitlines()[-1]))
+    first, second = outs
+    assert first["traces"] >= 1 and first["files"] == 1
+    assert second["traces"] == 0
+    assert second["v"] == first["v"] and second["j"] == first["j"]
