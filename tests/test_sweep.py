@@ -19,6 +19,7 @@ import time
 import numpy as np
 import pytest
 
+from jaxbearing import UserInputError
 from jaxbearing.cli import main as cli_main
 from jaxbearing.sweep import (
     SweepSpecError,
@@ -201,6 +202,21 @@ def test_reference_dataset(reference):
     again = run_sweep(load_sweep_spec(SMALL), out, progress=False)
     assert sorted(computed_batches(out)) == [0, 1]
     assert_same_results(ds, again)
+
+
+def test_two_worker_processes_give_the_same_results(tmp_path, reference):
+    """Both cores (issue 12, item 4): the batches solved in two spawned workers, each batch file
+    written as it finishes, assemble to the single-process dataset bit for bit."""
+    _, ds = reference
+    two = run_sweep(load_sweep_spec(SMALL), tmp_path, progress=False, workers=2)
+    assert_same_results(ds, two)
+    assert sorted(computed_batches(tmp_path)) == [0, 1]
+
+
+@pytest.mark.parametrize("workers", [0, -1, 1.5])
+def test_bad_worker_count_is_one_line(tmp_path, workers):
+    with pytest.raises(UserInputError, match="workers"):
+        run_sweep(load_sweep_spec(SMALL), tmp_path, progress=False, workers=workers)
 
 
 def test_failed_case_is_recorded(tmp_path, reference):

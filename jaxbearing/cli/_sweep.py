@@ -60,8 +60,26 @@ def register(sub) -> None:
         action="store_true",
         help="validate the spec, list the axes and the number of cases and batches, compute nothing",
     )
+    p.add_argument(
+        "--workers",
+        type=int,
+        help="local worker processes that solve this process's batches (default: one per CPU on "
+        "a CPU platform, 1 on an accelerator); results are bitwise the same for any number",
+    )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.set_defaults(func=run)
+
+
+def default_workers(spec) -> int:
+    """One worker per CPU when the batches run on the CPU (one solve uses about one core), at
+    most one per batch; 1 on an accelerator, whose one device runs the vmapped batch."""
+    import jax
+
+    from ..run import available_cpus
+
+    if jax.default_backend() != "cpu" or jax.local_device_count() > 1:
+        return 1
+    return max(1, min(available_cpus(), spec.num_batches))
 
 
 def run(args) -> int:
@@ -83,14 +101,16 @@ def run(args) -> int:
     process_id, num_processes = initialize_distributed(args.coordinator, args.num_processes, args.process_id)
     import jax
 
+    workers = args.workers if args.workers is not None else default_workers(spec)
     print(
         f"process {process_id}/{num_processes}: {jax.local_device_count()} local device(s) "
-        f"({jax.local_devices()[0].platform})",
+        f"({jax.local_devices()[0].platform}), {workers} worker process(es)",
         file=sys.stderr,
     )
     ds = run_sweep(
         spec,
         args.out,
+        workers=workers,
         resume=args.resume,
         process_id=process_id,
         num_processes=num_processes,

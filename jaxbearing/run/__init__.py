@@ -24,6 +24,7 @@
   `compiled_program` (a program compiled once per process and traced once per machine:
   `jax.export` artefacts in `program_cache_dir`),
   `parallel_map` / `simulate_ensemble` (independent cases, one process per core),
+  `as_completed_map` (the same, each result as it finishes: the sweep's batches),
   `shared_workers` (one pool for every `parallel_map` of a block).
 
 May import: `jaxbearing._errors`, `contact`, `geometry`, `io`, `flange`, `forces`, `dynamics`.
@@ -41,7 +42,7 @@ from ._design import (
     forward_jacobian,
     seated_perturbation,
 )
-from ._ensemble import available_cpus, parallel_map, shared_workers, simulate_ensemble
+from ._ensemble import as_completed_map, available_cpus, parallel_map, shared_workers, simulate_ensemble
 from ._initial import STARTS, Perturbation, SkidStart, initial_state, skid_start
 from ._plots import plot_run
 from ._progress import SolveProgress
@@ -95,6 +96,7 @@ __all__ = [
     "steady_gradient",
     "tangent_growth",
     "prepare_from",
+    "as_completed_map",
     "available_cpus",
     "STARTS",
     "SkidStart",

@@ -20,6 +20,9 @@ process (no pool). A worker that dies (killed, out of memory, or a script withou
 with a one-line `UserInputError` instead of a pool that restarts workers for ever
 (`concurrent.futures.ProcessPoolExecutor` reports a broken pool; `multiprocessing.Pool` hangs).
 
+`as_completed_map(function, items, workers=N)` yields each result as it finishes (the sweep
+writes every batch file at once).
+
 `shared_workers(workers)` keeps one pool open for every `parallel_map` inside a `with` block (a
 search's ensembles and gradients), so the workers import JAX and load their programs once.
 
@@ -33,8 +36,8 @@ import contextlib
 import dataclasses
 import multiprocessing
 import os
-from collections.abc import Callable, Iterable, Sequence
-from concurrent.futures import ProcessPoolExecutor
+from collections.abc import Callable, Iterable, Iterator, Sequence
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any
 
@@ -92,11 +95,38 @@ def parallel_map(
             return list(pool.map(function, items))
     except BrokenProcessPool:
         _SHARED.pop(flags, None)
-        raise UserInputError(
-            f"workers = {workers}: a worker process died before finishing its case. In a script, "
-            'call this under `if __name__ == "__main__":` (each worker imports the main module '
-            "first), check the memory, or pass workers=1"
-        ) from None
+        raise _worker_died(workers) from None
+
+
+def as_completed_map(function: Callable[[Any], Any], items: Sequence[Any], *, workers: int) -> Iterator:
+    """(index, function(items[index])) as each case finishes, in `workers` processes (started
+    with `spawn`, this process's XLA flags; in this process, in order, when `workers` is 1): for
+    a caller that stores each result as soon as it exists (the sweep's batch files). Leaving the
+    loop early cancels the cases not yet started."""
+    workers = max(1, min(int(workers), len(items)))
+    if workers == 1:
+        for i, item in enumerate(items):
+            yield i, function(item)
+        return
+    pool = _pool(workers)
+    try:
+        futures = {pool.submit(function, item): i for i, item in enumerate(items)}
+        for future in as_completed(futures):
+            try:
+                result = future.result()
+            except BrokenProcessPool:
+                raise _worker_died(workers) from None
+            yield futures[future], result
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)
+
+
+def _worker_died(workers: int) -> UserInputError:
+    return UserInputError(
+        f"workers = {workers}: a worker process died before finishing its case. In a script, "
+        'call this under `if __name__ == "__main__":` (each worker imports the main module '
+        "first), check the memory, or pass workers=1"
+    )
 
 
 def _pool(workers: int) -> ProcessPoolExecutor:

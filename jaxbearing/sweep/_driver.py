@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import pathlib
 import sys
@@ -73,6 +74,7 @@ def run_sweep(
     wait_timeout_s: float = 24 * 3600.0,
     devices: Sequence | None = None,
     lock_wait_s: float = 0.0,
+    workers: int = 1,
 ):
     """Run (or finish) the sweep `spec` into `out_dir`; returns the assembled dataset (process 0)
     or None (other processes, or `assemble_results=False`).
@@ -85,9 +87,16 @@ def run_sweep(
     there raises `DirectoryInUse` at once, or after waiting `lock_wait_s` seconds), deletes
     temporary files left by killed writers, and moves batch files that do not load to
     DIR/batches/damaged/ and computes them again (`recover`).
+
+    `workers` > 1 solves this process's batches in that many local worker processes
+    (`jaxbearing.run.as_completed_map`; one per core on a CPU, where one solve uses about one
+    core): each batch is the same one-device program whichever worker runs it, so the results
+    are bitwise those of `workers=1`, and each batch file is written by this process as soon as
+    its batch finishes. `jaxbearing sweep` uses one per CPU on a CPU platform (`--workers`).
     """
     out_dir = pathlib.Path(out_dir)
     check_run_arguments(process_id, num_processes, wait_timeout_s, lock_wait_s)
+    check_arguments({"workers": workers}, {"workers": count(1)})
     with acquire_lock(out_dir, f"sweep.{process_id}.lock", wait_s=lock_wait_s, what="sweep") as lock:
         if lock.took_over:
             _say(
@@ -105,6 +114,7 @@ def run_sweep(
             assemble_results,
             wait_timeout_s,
             devices,
+            workers,
         )
 
 
@@ -152,8 +162,30 @@ def recover(out_dir: pathlib.Path, mine: list[int], process_id: int, num_process
     return [b for b, _, _ in moved]
 
 
+@dataclasses.dataclass(frozen=True)
+class _SolveBatch:
+    """Picklable `solve_batch` of one batch number: (summary rows, wall time [s])."""
+
+    spec: SweepSpec
+    devices: Sequence | None = None
+
+    def __call__(self, batch: int) -> tuple[dict, float]:
+        start = time.perf_counter()
+        data = solve_batch(self.spec, self.spec.batch_cases(batch), self.devices)
+        return data, time.perf_counter() - start
+
+
 def _run_locked(
-    spec, out_dir, resume, process_id, num_processes, progress, assemble_results, wait_timeout_s, devices
+    spec,
+    out_dir,
+    resume,
+    process_id,
+    num_processes,
+    progress,
+    assemble_results,
+    wait_timeout_s,
+    devices,
+    workers,
 ):
     prepare_dir(out_dir, spec, resume, process_id)
     mine = assigned_batches(spec, process_id, num_processes)
@@ -163,10 +195,13 @@ def _run_locked(
     n_todo = sum(len(spec.batch_cases(b)) for b in todo)
     prefix = f"sweep[{process_id}/{num_processes}] " if num_processes > 1 else "sweep "
     bar = _Progress(n_mine, n_mine - n_todo, progress, prefix)
-    for b in todo:
+    from ..run import as_completed_map
+
+    if devices is not None and workers > 1:
+        raise UserInputError(f"workers = {workers}: must be 1 when devices are given")
+    for i, (data, wall) in as_completed_map(_SolveBatch(spec, devices), todo, workers=workers):
+        b = todo[i]
         cases = spec.batch_cases(b)
-        start = time.perf_counter()
-        data = solve_batch(spec, cases, devices)
         write_batch(out_dir, spec, b, data)
         append_log(
             out_dir,
@@ -176,7 +211,7 @@ def _run_locked(
                 "process": process_id,
                 "cases": [int(cases[0]), int(cases[-1])],
                 "failed": int(np.sum(data["result_code"] != 0)),
-                "wall_s": round(time.perf_counter() - start, 3),
+                "wall_s": round(wall, 3),
             },
         )
         bar.update(len(cases))
