@@ -70,14 +70,15 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
-def default_workers(spec) -> int:
+def default_workers(spec, num_processes: int) -> int:
     """One worker per CPU when the batches run on the CPU (one solve uses about one core), at
-    most one per batch; 1 on an accelerator, whose one device runs the vmapped batch."""
+    most one per batch; 1 on an accelerator, whose one device runs the vmapped batch, and 1 when
+    the sweep is already split over `jax.distributed` processes."""
     import jax
 
     from ..run import available_cpus
 
-    if jax.default_backend() != "cpu" or jax.local_device_count() > 1:
+    if num_processes > 1 or jax.default_backend() != "cpu" or jax.local_device_count() > 1:
         return 1
     return max(1, min(available_cpus(), spec.num_batches))
 
@@ -101,7 +102,7 @@ def run(args) -> int:
     process_id, num_processes = initialize_distributed(args.coordinator, args.num_processes, args.process_id)
     import jax
 
-    workers = args.workers if args.workers is not None else default_workers(spec)
+    workers = args.workers if args.workers is not None else default_workers(spec, num_processes)
     print(
         f"process {process_id}/{num_processes}: {jax.local_device_count()} local device(s) "
         f"({jax.local_devices()[0].platform}), {workers} worker process(es)",
