@@ -52,6 +52,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import _common  # noqa: E402
 
 NAME = "bench_work_precision"
+#: `make bench` (run_all) time limit: the tight reference alone takes 12-20 minutes
+FULL_TIMEOUT_S = 2400
 SAMPLE_DT = 2e-6  # [s] spacing of the saved samples
 CONTACT_THRESHOLD = 1.0  # [N] a flange sample counts as in contact above this force
 NUM_BLOCKS = 8  # batch means for the confidence intervals

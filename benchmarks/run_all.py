@@ -35,6 +35,13 @@ import _common  # noqa: E402
 DEFAULT_TIMEOUT_S = {False: 900, True: 300}  # per benchmark: full, quick
 
 
+def timeout_for(name: str, quick: bool) -> float:
+    """A benchmark's time limit: its module's `FULL_TIMEOUT_S` in full mode where it declares one
+    (studies that take longer than the default by design), else `DEFAULT_TIMEOUT_S`."""
+    default = DEFAULT_TIMEOUT_S[quick]
+    return default if quick else float(getattr(load(name), "FULL_TIMEOUT_S", default))
+
+
 def discover(bench_dir: Path = BENCH_DIR) -> list[str]:
     """Names of the benchmark modules (bench_*.py), sorted."""
     return sorted(p.stem for p in bench_dir.glob("bench_*.py"))
@@ -132,7 +139,6 @@ def main(argv: list[str] | None = None) -> int:
             )
             return 2
         names = wanted
-    timeout = args.timeout if args.timeout is not None else DEFAULT_TIMEOUT_S[args.quick]
 
     machine = _common.machine_info()
     print(f"jaxbearing benchmarks ({'quick' if args.quick else 'full'}): {', '.join(names)}")
@@ -145,6 +151,7 @@ def main(argv: list[str] | None = None) -> int:
     statuses = []
     for name in names:
         print(f"=== {name} ===", flush=True)
+        timeout = args.timeout if args.timeout is not None else timeout_for(name, args.quick)
         status = run_one(name, args.quick, timeout)
         statuses.append(status)
         print(

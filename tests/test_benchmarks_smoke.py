@@ -112,3 +112,9 @@ def test_integrated_autocorrelation_time_of_ar1_is_its_closed_form():
         x = lfilter([1.0], [1.0, -phi], rng.normal(size=200_000))
         exact = (1 + phi) / (1 - phi)
         assert abs(integrated_autocorrelation_time(x) / exact - 1) < 0.1
+
+
+def test_long_studies_declare_their_own_time_limit():
+    assert run_all.timeout_for("bench_work_precision_settled", quick=False) == 2400
+    assert run_all.timeout_for("bench_work_precision_settled", quick=True) == run_all.DEFAULT_TIMEOUT_S[True]
+    assert run_all.timeout_for("bench_scipy", quick=False) == run_all.DEFAULT_TIMEOUT_S[False]

@@ -1,0 +1,478 @@
+"""Work-precision of the dynamic solve in SETTLED running: do the flange statistics computed
+with the default integrator agree with a tight reference solution within their confidence
+intervals, and what do cheaper tolerance settings give? (`bench_work_precision` measures the
+same on the start-up transient, [2, 8] ms from the quasi-static start; its statistics are
+imported from there.)
+
+Case: the reference bearing (`jaxbearing.reference_bearing()`) at its reference operating point
+(20,000 rpm, 1000 N), seeds 0-3 of the initial scatter (`jaxbearing.Perturbation(seed=s)`).
+
+Protocol.
+
+1. Settled start states: per seed, the library's own settled run
+   (`jaxbearing.run.simulate_steady`: skid start with its pre-start, settling detection over
+   cage revolutions, then the smallest allowed window of 2 revolutions; default integrator, one
+   seed at a time in this process), and its `SeedRun.final_state`. They are pickled under
+   `CACHE_DIR` (one file per seed), so that a rerun does not repeat the settling.
+2. From each seed's settled state, a window of W = `WINDOW_REVS` cage revolutions (W =
+   revolutions x 2 pi / the settled cage speed, the mean over seeds of the last settled
+   revolution's mean, rounded to whole samples; the same W for every seed) is integrated with
+   every integrator below from the same state, saving the flange quantities every `SAMPLE_DT`
+   = 2 us (the same instants for every integrator). The continuation is that of
+   `jaxbearing.run.solve_from` (`prepare_from`: scaled deviation state about the start's own
+   orbit, accumulators at zero), with the step controller built here as `prepare_from` builds it
+   (`step_controller(rtol, atol, raceway_normal_norm(y0_scaled, loosen))`), so that rtol, atol
+   and the raceway-normal loosening are chosen per integrator; the library is not changed.
+   Integrators (`VARIANTS`): the reference, Tsit5 with rtol 1e-7, atol 1e-10 and the plain max
+   norm (loosen 1); (b) the old default, Tsit5 rtol 1e-3, atol 1e-6, loosen 1; (c) the current
+   default, rtol 1e-3, atol 1e-6, loosen 100; (d) rtol 1e-2, loosen 100; (e) rtol 3e-3,
+   loosen 100; (f) SciPy `solve_ivp(RK45)` at rtol 1e-3, atol 1e-6 (RMS norm) on the same
+   compiled field (`_common.FlatField`, `bench_work_precision.ScipyRunner`'s samples).
+3. Statistics per run over the window (`bench_work_precision.window_statistics`): mean and p95
+   PV over flange samples with normal force > 1 N, mean sliding speed, cage slip
+   1 - mean(cage speed) / kinematic cage speed; per-seed 95 % half-widths from 8 batch means of
+   the reference run (`confidence_halfwidths`), and each integrator's per-seed error in those
+   half-widths (`errors`).
+4. The dynamics are chaotic (tangents grow e-fold in 16-80 us; roller-flange impacts), so the
+   trajectories of different integrators decorrelate within about 1 ms and per-seed
+   differences are mostly sampling noise. The main comparison is therefore over seeds
+   (`paired_over_seeds`): per integrator and statistic, the mean over seeds of (integrator -
+   reference) with its 95 % Student-t interval (n - 1 = 3 degrees of freedom), beside the
+   reference's ensemble mean with its Student-t 95 % half-width over seeds. An integrator
+   "agrees within CI" when the paired difference's interval contains 0 AND |mean difference| is
+   below the reference ensemble mean's half-width.
+5. Cost: field evaluations per simulated ms (Tsit5: `_common.fsal_rk_evaluations`, 6 per step
+   attempt + 1; SciPy: nfev), their ratio against the old and the current default, and wall time
+   per simulated ms (compile excluded; single runs on a shared 2-core machine: the evaluation
+   counts are the primary figure).
+
+`--quick`: seed 0, a 0.5 ms window, reference at rtol 1e-5 (a smoke test of the code path; the
+settling of seed 0 is shared with the full run through the cache). `--revs N` sets the window in
+cage revolutions (default 2). Results: `results/bench_work_precision_settled.json`.
+"""
+
+from __future__ import annotations
+
+import math
+import pickle
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import _common  # noqa: E402
+from bench_work_precision import (  # noqa: E402
+    REF_ATOL,
+    REF_RTOL,
+    SAMPLE_DT,
+    STATS,
+    ScipyRunner,
+    confidence_halfwidths,
+    errors,
+    window_statistics,
+)
+
+NAME = "bench_work_precision_settled"
+#: `make bench` (run_all) time limit: the tight reference alone takes 12-20 minutes
+FULL_TIMEOUT_S = 2400
+SEEDS = (0, 1, 2, 3)
+WINDOW_REVS = 2
+QUICK_WINDOW = 0.5e-3  # [s]
+QUICK_REF_RTOL = 1e-5
+MAX_STEPS = 2_000_000
+CACHE_DIR = Path(tempfile.gettempdir()) / "jaxbearing_bench_work_precision_settled"
+#: the saved quantities the statistics need
+SAVED = ("t", "flange_force", "flange_pv", "flange_sliding_speed", "cage_speed")
+OLD_DEFAULT, CURRENT_DEFAULT = "old default", "current default"
+
+#: (label, kind, rtol, atol, raceway_loosen); kind "tsit5" (diffrax, max norm with the
+#: raceway-normal tolerances `raceway_loosen` times looser) or "scipy" (solve_ivp RK45, RMS norm)
+VARIANTS = (
+    (f"{OLD_DEFAULT}: Tsit5, max norm, rtol 1e-3", "tsit5", 1e-3, 1e-6, 1.0),
+    (f"{CURRENT_DEFAULT}: Tsit5, raceway-normal x100, rtol 1e-3", "tsit5", 1e-3, 1e-6, 100.0),
+    ("Tsit5, raceway-normal x100, rtol 1e-2", "tsit5", 1e-2, 1e-6, 100.0),
+    ("Tsit5, raceway-normal x100, rtol 3e-3", "tsit5", 3e-3, 1e-6, 100.0),
+    ("SciPy RK45 (same field, RMS), rtol 1e-3", "scipy", 1e-3, 1e-6, 1.0),
+)
+
+
+# -- settled start states ----------------------------------------------------------------------
+def settled_start(bearing, op, seed: int) -> dict:
+    """Seed `seed`'s settled state (`SeedRun.final_state`) and how it was obtained, from the
+    cache or from `simulate_steady` (2 window revolutions, one process)."""
+    import jaxbearing as jb
+    from jaxbearing.run import simulate_steady
+
+    rpm, load = float(jb.rad_s_to_rpm(op.inner_speed)), float(op.radial_load)
+    path = CACHE_DIR / f"reference_{rpm:.0f}rpm_{load:.0f}N_seed{seed}.pkl"
+    if path.exists():
+        with path.open("rb") as fh:
+            out = pickle.load(fh)
+        out["info"]["cached"] = True
+        return out
+    _common.log(f"{NAME}: settling seed {seed} (simulate_steady, skid start)")
+    res = simulate_steady(bearing, op, seeds=1, perturbation=jb.Perturbation(seed=seed), window_revs=2)
+    run = res.runs[0]
+    if run.status != "ok":
+        raise RuntimeError(f"the settled run of seed {seed} failed: {run.status}")
+    info = {
+        "settled": bool(run.settled),
+        "settle_time_ms": 1e3 * run.settle_time,
+        "end_time_ms": 1e3 * run.revolution_ends[-1],
+        "last_revolution_cage_speed_rpm": run.revolution_speeds_rpm[-1],
+        "num_steps": int(run.num_steps),
+        "wall_s": res.wall_time_s,
+        "compile_s": res.compile_time_s,
+    }
+    out = {"state": run.final_state, "info": info}
+    CACHE_DIR.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_suffix(".tmp")
+    with tmp.open("wb") as fh:
+        pickle.dump(out, fh)
+    tmp.replace(path)
+    out["info"]["cached"] = False
+    return out
+
+
+# -- integrators -----------------------------------------------------------------------------
+def window_solve(params, start, duration, rtol, atol, loosen, *, num_saves: int):
+    """Tsit5 from the physical state `start` over [0, duration] as `solve_from` integrates, with
+    the error norm's raceway-normal loosening `loosen` chosen here: (samples of `SAVED` at
+    `num_saves` equally spaced instants including both ends, result code, step attempts,
+    rejected steps). jit-able."""
+    import diffrax
+    import jax.numpy as jnp
+
+    from jaxbearing.run import prepare_from, result_code
+    from jaxbearing.run._compile_cache import checks_without_host_callbacks
+    from jaxbearing.run._simulate import _diffeqsolve, _save
+    from jaxbearing.run._step_control import raceway_normal_norm, step_controller
+
+    _, args, y0_scaled, _ = prepare_from(params, start, rtol, atol)
+    controller = step_controller(rtol, atol, raceway_normal_norm(y0_scaled, loosen))
+    saveat = diffrax.SaveAt(
+        ts=jnp.linspace(0.0, duration, num_saves), fn=lambda t, y, a: {k: _save(t, y, a)[k] for k in SAVED}
+    )
+    with checks_without_host_callbacks():
+        sol = _diffeqsolve(y0_scaled, args, duration, saveat, controller, MAX_STEPS, None, False, "tsit5")
+    return sol.ys, result_code(sol.result), sol.stats["num_steps"], sol.stats["num_rejected_steps"]
+
+
+def compile_window_solve(params, start, num_saves: int):
+    """`window_solve` compiled for (params, start, duration, rtol, atol, loosen): one program
+    serves every seed, tolerance and loosening."""
+    import jax.numpy as jnp
+
+    def run(p, s, d, r, a, loosen):
+        return window_solve(p, s, d, r, a, loosen, num_saves=num_saves)
+
+    f = jnp.asarray
+    return _common.compile_jit(run, params, start, f(1e-3), f(1e-3), f(1e-6), f(1.0))
+
+
+def run_tsit5(compiled, params, start, duration, rtol, atol, loosen) -> dict:
+    import jax
+    import jax.numpy as jnp
+    import numpy as np
+
+    f = jnp.asarray
+    wall, (hist, code, steps, rejected) = _common.time_once(
+        lambda: compiled(params, start, f(duration), f(rtol), f(atol), f(loosen))
+    )
+    steps = int(steps)
+    return {
+        "ok": int(code) == 0,
+        "wall_s": wall,
+        "step_attempts": steps,
+        "rejected_steps": int(rejected),
+        "evaluations": _common.fsal_rk_evaluations(steps),
+        "hist": jax.tree_util.tree_map(np.asarray, hist),
+    }
+
+
+def run_scipy(runner: ScipyRunner, params, start, duration, num_saves, rtol, atol) -> dict:
+    """SciPy RK45 from the physical state `start` on the compiled flat field of `runner`, with
+    the continuation's scaling and arguments (`prepare_from`), ravelled as `runner`'s field."""
+    import jax
+    import numpy as np
+    from jax.flatten_util import ravel_pytree
+    from scipy.integrate import solve_ivp
+
+    from jaxbearing.run import prepare_from
+
+    _, args, y0_scaled, _ = prepare_from(params, start, rtol, atol)
+    y0, args_flat = (np.asarray(ravel_pytree(x)[0]) for x in (y0_scaled, args))
+    if y0.size != runner.field0.size or args_flat.size != runner.field0.args_flat.size:
+        raise RuntimeError("the continuation's state or arguments do not ravel like the flat field's")
+    field = runner.compiled_field
+    ts = np.linspace(0.0, duration, num_saves)
+    start_t = time.perf_counter()
+    sol = solve_ivp(
+        lambda t, y: np.asarray(field(t, y, args_flat)),
+        (0.0, duration),
+        y0,
+        method="RK45",
+        rtol=rtol,
+        atol=atol,
+        t_eval=ts,
+    )
+    wall = time.perf_counter() - start_t
+    hist = jax.tree_util.tree_map(np.asarray, runner.samples(sol.t, sol.y.T, args_flat))
+    return {
+        "ok": sol.status == 0,
+        "wall_s": wall,
+        "step_attempts": _common.rk45_attempts(sol.nfev),
+        "rejected_steps": None,  # t_eval given: sol.t does not list the accepted steps
+        "evaluations": int(sol.nfev),
+        "hist": hist,
+    }
+
+
+# -- statistics over seeds ---------------------------------------------------------------------
+def paired_over_seeds(values, reference) -> dict:
+    """Paired comparison over seeds (module docstring, 4): the reference's ensemble mean with its
+    95 % Student-t interval, the mean of (values - reference) with its 95 % Student-t interval,
+    and whether they agree (difference interval contains 0 and |mean difference| < the
+    reference's half-width; None with fewer than two seeds)."""
+    import numpy as np
+
+    from jaxbearing.run import student_t_interval
+
+    x, r = np.asarray(values, float), np.asarray(reference, float)
+    ref, diff = student_t_interval(r), student_t_interval(x - r)
+    out = {
+        "reference": {**ref.as_dict(), "half_width": _finite(ref.half_width)},
+        "difference": {**diff.as_dict(), "half_width": _finite(diff.half_width)},
+        "agrees": None,
+    }
+    if diff.n >= 2 and ref.n >= 2:
+        out["agrees"] = bool(diff.ci95_low <= 0.0 <= diff.ci95_high and abs(diff.value) < ref.half_width)
+    return out
+
+
+def _finite(x: float):
+    return float(x) if math.isfinite(x) else None
+
+
+# -- the benchmark -----------------------------------------------------------------------------
+def main(quick: bool = False, window_revs: int = WINDOW_REVS) -> dict:
+    import jax
+    import jax.numpy as jnp
+    import numpy as np
+
+    import jaxbearing as jb
+    from jaxbearing.dynamics import Functionals, Params
+
+    started = time.perf_counter()
+    seeds = SEEDS[:1] if quick else SEEDS
+    ref_rtol = QUICK_REF_RTOL if quick else REF_RTOL
+    bearing, op = jb.reference_bearing(), jb.reference_operating_point()
+    jb.validate_bearing(bearing, op)
+    params = Params(bearing=bearing, operating=op, functionals=Functionals())
+    omega_kin = float(jb.kinematic_cage_speed(bearing, op))
+
+    t_settle = time.perf_counter()
+    settled = {s: settled_start(bearing, op, s) for s in seeds}
+    settle_wall = time.perf_counter() - t_settle
+    starts = {s: jax.tree_util.tree_map(jnp.asarray, v["state"]) for s, v in settled.items()}
+    rpm = float(np.mean([v["info"]["last_revolution_cage_speed_rpm"] for v in settled.values()]))
+    window = QUICK_WINDOW if quick else window_revs * 60.0 / rpm
+    num_saves = int(round(window / SAMPLE_DT)) + 1
+    window = (num_saves - 1) * SAMPLE_DT
+    ms = window * 1e3
+
+    _common.log(f"{NAME}: compiling the window solve, {num_saves} samples over {ms:g} ms")
+    compiled, compile_s = compile_window_solve(params, starts[seeds[0]], num_saves)
+    compile_s = {"window_solve": compile_s}
+    scipy_runner = None
+    if any(v[1] == "scipy" for v in VARIANTS):
+        scipy_runner = ScipyRunner(bearing, op)
+        compile_s["scipy_field"] = scipy_runner.compile_s
+
+    def run(kind, seed, rtol, atol, loosen):
+        if kind == "scipy":
+            r = run_scipy(scipy_runner, params, starts[seed], window, num_saves, rtol, atol)
+        else:
+            r = run_tsit5(compiled, params, starts[seed], window, rtol, atol, loosen)
+        hist = r.pop("hist")
+        r["statistics"] = window_statistics(hist, 0.0, omega_kin)
+        r["evaluations_per_ms"] = r["evaluations"] / ms
+        r["wall_s_per_ms"] = r["wall_s"] / ms
+        return r, hist
+
+    reference = {}
+    for seed in seeds:
+        _common.log(f"{NAME}: reference (rtol {ref_rtol:g}), seed {seed}")
+        r, hist = run("tsit5", seed, ref_rtol, REF_ATOL, 1.0)
+        if not r["ok"]:
+            raise RuntimeError(f"the reference solve failed (seed {seed})")
+        r["ci_halfwidth"] = confidence_halfwidths(hist, 0.0, omega_kin)
+        reference[str(seed)] = r
+        _common.log(f"  {r['evaluations_per_ms']:.0f} evaluations/ms, {r['wall_s_per_ms']:.2f} s/ms")
+    ref_values = {s: [reference[str(seed)]["statistics"][s] for seed in seeds] for s in STATS}
+
+    rows = []
+    for label, kind, rtol, atol, loosen in VARIANTS:
+        per_seed = {}
+        for seed in seeds:
+            _common.log(f"{NAME}: {label}, seed {seed}")
+            r, _ = run(kind, seed, rtol, atol, loosen)
+            ref = reference[str(seed)]
+            r["errors"] = errors(r["statistics"], ref["statistics"], ref["ci_halfwidth"])
+            per_seed[str(seed)] = r
+        runs = list(per_seed.values())
+        rows.append(
+            {
+                "label": label,
+                "kind": kind,
+                "rtol": rtol,
+                "atol": atol,
+                "raceway_loosen": loosen,
+                "seeds": per_seed,
+                "all_ok": all(s["ok"] for s in runs),
+                "evaluations_per_ms": float(np.mean([s["evaluations_per_ms"] for s in runs])),
+                "wall_s_per_ms": float(np.mean([s["wall_s_per_ms"] for s in runs])),
+                "max_error_in_ci": max(s["errors"]["max_in_ci"] for s in runs),
+                "over_seeds": {
+                    s: paired_over_seeds([x["statistics"][s] for x in runs], ref_values[s]) for s in STATS
+                },
+            }
+        )
+        rows[-1]["agrees_all"] = all(rows[-1]["over_seeds"][s]["agrees"] for s in STATS)
+    old = next(r for r in rows if r["label"].startswith(OLD_DEFAULT))
+    current = next(r for r in rows if r["label"].startswith(CURRENT_DEFAULT))
+    for row in rows:
+        row["evaluation_ratio_vs_old_default"] = old["evaluations_per_ms"] / row["evaluations_per_ms"]
+        row["evaluation_ratio_vs_current_default"] = current["evaluations_per_ms"] / row["evaluations_per_ms"]
+    result = {
+        "benchmark": NAME,
+        "quick": quick,
+        "case": {
+            "bearing": "reference_bearing() (26 rollers, 31 slices, arc ends)",
+            "inner_speed_rpm": float(jb.rad_s_to_rpm(op.inner_speed)),
+            "radial_load_N": float(op.radial_load),
+            "seeds": list(seeds),
+            "window_revs": None if quick else window_revs,
+            "window_s": window,
+            "settled_cage_speed_rpm": rpm,
+            "kinematic_cage_speed_rpm": float(jb.rad_s_to_rpm(omega_kin)),
+            "sample_dt_s": SAMPLE_DT,
+            "num_saves": num_saves,
+            "reference": {"rtol": ref_rtol, "atol": REF_ATOL, "method": "Tsit5, max norm (loosen 1)"},
+            "agreement": "paired difference's 95 % Student-t interval over seeds contains 0 and "
+            "|mean difference| < the reference ensemble mean's 95 % Student-t half-width over seeds",
+            "note": "every integrator starts from the same settled state per seed (simulate_steady's "
+            "final_state); per-seed CI from 8 batch means of the reference over the window; cage slip "
+            "errors are absolute",
+        },
+        "settled_starts": {str(s): v["info"] for s, v in settled.items()},
+        "settle_wall_s": settle_wall,
+        "compile_s": compile_s,
+        "reference": reference,
+        "reference_over_seeds": {
+            s: paired_over_seeds(ref_values[s], ref_values[s])["reference"] for s in STATS
+        },
+        "variants": rows,
+        "benchmark_wall_s": time.perf_counter() - started,
+    }
+    result["table"] = _table(result)
+    print(result["table"])
+    _common.write_json(NAME, result)
+    return result
+
+
+#: (statistic, display name, factor to display units)
+_DISPLAY = {
+    "mean_pv": ("mean PV MPa m/s", 1e-6),
+    "p95_pv": ("p95 PV MPa m/s", 1e-6),
+    "mean_sliding_speed": ("mean u m/s", 1.0),
+    "cage_slip": ("slip %", 100.0),
+}
+
+
+def _pm(est: dict, factor: float) -> str:
+    hw = est["half_width"]
+    v = est["value"]
+    if v is None:
+        return "-"
+    return f"{v * factor:.4g}" + ("" if hw is None else f" +- {hw * factor:.3g}")
+
+
+def _table(r: dict) -> str:
+    import numpy as np
+
+    c = r["case"]
+    ms = c["window_s"] * 1e3
+    refs = r["reference"].values()
+    cost_rows = [
+        [
+            f"reference rtol {c['reference']['rtol']:g}",
+            float(np.mean([x["evaluations_per_ms"] for x in refs])),
+            None,
+            None,
+            float(np.mean([x["wall_s_per_ms"] for x in refs])),
+            None,
+            None,
+        ]
+    ]
+    for v in r["variants"]:
+        cost_rows.append(
+            [
+                v["label"],
+                v["evaluations_per_ms"],
+                v["evaluation_ratio_vs_old_default"],
+                v["evaluation_ratio_vs_current_default"],
+                v["wall_s_per_ms"],
+                v["max_error_in_ci"],
+                v["agrees_all"] if len(c["seeds"]) > 1 else None,
+            ]
+        )
+    title = (
+        f"Work-precision in settled running: reference bearing {c['inner_speed_rpm']:.0f} rpm, "
+        f"{c['radial_load_N']:.0f} N; window {ms:.3g} ms from each seed's settled state, seeds {c['seeds']}"
+    )
+    cost = _common.format_table(
+        title,
+        [
+            "integrator",
+            "evals/ms",
+            "x fewer vs old",
+            "x fewer vs current",
+            "wall s/ms",
+            "max err/CI",
+            "agree",
+        ],
+        cost_rows,
+    )
+    agree_rows = [
+        ["reference (ensemble)", *(_pm(r["reference_over_seeds"][s], _DISPLAY[s][1]) for s in STATS)]
+    ]
+    for v in r["variants"]:
+        cells = []
+        for s in STATS:
+            o = v["over_seeds"][s]
+            flag = {True: " yes", False: " NO", None: ""}[o["agrees"]]
+            cells.append(_pm(o["difference"], _DISPLAY[s][1]) + flag)
+        agree_rows.append([v["label"], *cells])
+    agree = _common.format_table(
+        "Reference ensemble mean +- 95 % half-width over seeds; per integrator: mean paired difference "
+        "(integrator - reference) +- 95 % half-width over seeds, and whether it agrees",
+        ["integrator", *(_DISPLAY[s][0] for s in STATS)],
+        agree_rows,
+    )
+    return cost + "\n\n" + agree
+
+
+def self_check() -> None:
+    """The agreement rule on synthetic numbers (no model compile; the Student-t interval itself:
+    tests/test_bench_work_precision_settled.py)."""
+    ref = [1.0, 2.0, 3.0, 4.0]
+    assert paired_over_seeds([2.0, 3.0, 4.0, 5.0], ref)["agrees"] is False  # interval excludes 0
+    assert paired_over_seeds([1.0], [1.0])["agrees"] is None  # one seed: no interval
+
+
+if __name__ == "__main__":
+    revs = int(sys.argv[sys.argv.index("--revs") + 1]) if "--revs" in sys.argv else WINDOW_REVS
+    main(quick="--quick" in sys.argv, window_revs=revs)

@@ -1,0 +1,34 @@
+"""The over-seeds paired comparison of benchmarks/bench_work_precision_settled.py on synthetic
+numbers, against hand-computed Student-t intervals (the benchmark itself is not run here)."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+
+from bench_work_precision_settled import paired_over_seeds  # noqa: E402
+
+T_975_3DOF = 3.182446  # Student t quantile 0.975, 3 degrees of freedom
+
+
+def test_paired_difference_and_reference_intervals():
+    ref = [1.0, 2.0, 3.0, 4.0]  # mean 2.5, s = sqrt(5/3)
+    out = paired_over_seeds([1.1, 2.3, 2.9, 4.1], ref)  # differences 0.1, 0.3, -0.1, 0.1
+    d, r = out["difference"], out["reference"]
+    assert d["value"] == pytest.approx(0.1) and d["n"] == 4
+    assert d["half_width"] == pytest.approx(T_975_3DOF * (0.12 / 4.5) ** 0.5 / 2.0, rel=1e-6)
+    assert d["ci95_low"] == pytest.approx(0.1 - d["half_width"])
+    assert r["value"] == pytest.approx(2.5)
+    assert r["half_width"] == pytest.approx(T_975_3DOF * (5.0 / 3.0) ** 0.5 / 2.0, rel=1e-6)
+    assert out["agrees"] is True
+
+
+def test_agreement_needs_the_difference_below_the_reference_half_width():
+    ref = [1.0, 1.001, 0.999, 1.0]  # half-width ~1.3e-3
+    out = paired_over_seeds([1.5, 0.701, 1.399, 0.8], ref)  # differences 0.5, -0.3, 0.4, -0.2
+    assert out["difference"]["ci95_low"] < 0.0 < out["difference"]["ci95_high"]
+    assert out["agrees"] is False
