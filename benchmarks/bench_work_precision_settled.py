@@ -26,7 +26,7 @@ Protocol.
    Integrators (`VARIANTS`): the reference, Tsit5 with rtol 1e-7, atol 1e-10 and the plain max
    norm (loosen 1); (b) the old default, Tsit5 rtol 1e-3, atol 1e-6, loosen 1; (c) the current
    default, rtol 1e-3, atol 1e-6, loosen 100; (d) rtol 1e-2, loosen 100; (e) rtol 3e-3,
-   loosen 100; (f) SciPy `solve_ivp(RK45)` at rtol 1e-3, atol 1e-6 (RMS norm) on the same
+   loosen 100; (e') rtol 3e-2, loosen 100; (f) SciPy `solve_ivp(RK45)` at rtol 1e-3, atol 1e-6 (RMS norm) on the same
    compiled field (`_common.FlatField`, `bench_work_precision.ScipyRunner`'s samples).
 3. Statistics per run over the window (`bench_work_precision.window_statistics`): mean and p95
    PV over flange samples with normal force > 1 N, mean sliding speed, cage slip
@@ -46,7 +46,9 @@ Protocol.
    per simulated ms (compile excluded; single runs on a shared 2-core machine: the evaluation
    counts are the primary figure).
 
-`--quick`: seed 0, a 0.5 ms window, reference at rtol 1e-5 (a smoke test of the code path; the
+`--reuse-reference` takes the reference runs from the stored results when they were made for the
+same case (the reference is 12 of the 18 minutes). `--quick`: seed 0, a 0.5 ms window, reference
+at rtol 1e-5 (a smoke test of the code path; the
 settling of seed 0 is shared with the full run through the cache). `--revs N` sets the window in
 cage revolutions (default 2). Results: `results/bench_work_precision_settled.json`.
 """
@@ -94,6 +96,7 @@ VARIANTS = (
     (f"{CURRENT_DEFAULT}: Tsit5, raceway-normal x100, rtol 1e-3", "tsit5", 1e-3, 1e-6, 100.0),
     ("Tsit5, raceway-normal x100, rtol 1e-2", "tsit5", 1e-2, 1e-6, 100.0),
     ("Tsit5, raceway-normal x100, rtol 3e-3", "tsit5", 3e-3, 1e-6, 100.0),
+    ("Tsit5, raceway-normal x100, rtol 3e-2", "tsit5", 3e-2, 1e-6, 100.0),
     ("SciPy RK45 (same field, RMS), rtol 1e-3", "scipy", 1e-3, 1e-6, 1.0),
 )
 
@@ -257,7 +260,23 @@ def _finite(x: float):
 
 
 # -- the benchmark -----------------------------------------------------------------------------
-def main(quick: bool = False, window_revs: int = WINDOW_REVS) -> dict:
+def stored_reference(case: dict) -> dict | None:
+    """The reference runs of the stored results when they were made for `case` (seeds, window,
+    samples, reference tolerances): `--reuse-reference` runs only the integrators (the reference
+    is 12 of the study's 18 minutes)."""
+    import json
+
+    path = _common.RESULTS_DIR / f"{NAME}.json"
+    if not path.exists():
+        return None
+    old = json.loads(path.read_text())
+    keys = ("seeds", "window_s", "num_saves", "reference", "inner_speed_rpm", "radial_load_N")
+    if old.get("quick") or any(old["case"].get(k) != case[k] for k in keys):
+        return None
+    return old["reference"]
+
+
+def main(quick: bool = False, window_revs: int = WINDOW_REVS, reuse_reference: bool = False) -> dict:
     import jax
     import jax.numpy as jnp
     import numpy as np
@@ -302,8 +321,30 @@ def main(quick: bool = False, window_revs: int = WINDOW_REVS) -> dict:
         r["wall_s_per_ms"] = r["wall_s"] / ms
         return r, hist
 
-    reference = {}
+    case = {
+        "bearing": "reference_bearing() (26 rollers, 31 slices, arc ends)",
+        "inner_speed_rpm": float(jb.rad_s_to_rpm(op.inner_speed)),
+        "radial_load_N": float(op.radial_load),
+        "seeds": list(seeds),
+        "window_revs": None if quick else window_revs,
+        "window_s": window,
+        "settled_cage_speed_rpm": rpm,
+        "kinematic_cage_speed_rpm": float(jb.rad_s_to_rpm(omega_kin)),
+        "sample_dt_s": SAMPLE_DT,
+        "num_saves": num_saves,
+        "reference": {"rtol": ref_rtol, "atol": REF_ATOL, "method": "Tsit5, max norm (loosen 1)"},
+        "agreement": "paired difference's 95 % Student-t interval over seeds contains 0 and "
+        "|mean difference| < the reference ensemble mean's 95 % Student-t half-width over seeds",
+        "note": "every integrator starts from the same settled state per seed (simulate_steady's "
+        "final_state); per-seed CI from 8 batch means of the reference over the window; cage slip "
+        "errors are absolute",
+    }
+    reference = (stored_reference(case) if reuse_reference else None) or {}
+    if reference:
+        _common.log(f"{NAME}: reference runs from the stored results (--reuse-reference)")
     for seed in seeds:
+        if str(seed) in reference:
+            continue
         _common.log(f"{NAME}: reference (rtol {ref_rtol:g}), seed {seed}")
         r, hist = run("tsit5", seed, ref_rtol, REF_ATOL, 1.0)
         if not r["ok"]:
@@ -349,24 +390,7 @@ def main(quick: bool = False, window_revs: int = WINDOW_REVS) -> dict:
     result = {
         "benchmark": NAME,
         "quick": quick,
-        "case": {
-            "bearing": "reference_bearing() (26 rollers, 31 slices, arc ends)",
-            "inner_speed_rpm": float(jb.rad_s_to_rpm(op.inner_speed)),
-            "radial_load_N": float(op.radial_load),
-            "seeds": list(seeds),
-            "window_revs": None if quick else window_revs,
-            "window_s": window,
-            "settled_cage_speed_rpm": rpm,
-            "kinematic_cage_speed_rpm": float(jb.rad_s_to_rpm(omega_kin)),
-            "sample_dt_s": SAMPLE_DT,
-            "num_saves": num_saves,
-            "reference": {"rtol": ref_rtol, "atol": REF_ATOL, "method": "Tsit5, max norm (loosen 1)"},
-            "agreement": "paired difference's 95 % Student-t interval over seeds contains 0 and "
-            "|mean difference| < the reference ensemble mean's 95 % Student-t half-width over seeds",
-            "note": "every integrator starts from the same settled state per seed (simulate_steady's "
-            "final_state); per-seed CI from 8 batch means of the reference over the window; cage slip "
-            "errors are absolute",
-        },
+        "case": case,
         "settled_starts": {str(s): v["info"] for s, v in settled.items()},
         "settle_wall_s": settle_wall,
         "compile_s": compile_s,
@@ -475,4 +499,4 @@ def self_check() -> None:
 
 if __name__ == "__main__":
     revs = int(sys.argv[sys.argv.index("--revs") + 1]) if "--revs" in sys.argv else WINDOW_REVS
-    main(quick="--quick" in sys.argv, window_revs=revs)
+    main(quick="--quick" in sys.argv, window_revs=revs, reuse_reference="--reuse-reference" in sys.argv)
