@@ -8,7 +8,9 @@ samples. Each mode runs the whole sweep into a new directory: wall time from `ru
 assembled dataset, worker start, import and program load included (the first, untimed sweep
 fills the persistent cache and the stored programs, as a user's earlier run would). The two
 modes are interleaved (full: 2 rounds, best of each kept) and their datasets must be bitwise
-equal. Throughput = cases / wall; target: workers=2 >= 1.5x workers=1.
+equal. Throughput = cases / wall; target: workers=2 >= 1.5x workers=1. Also timed: the
+quasi-static start of one case alone and per case inside a vmap of 8 (`quasi_static_start_cost`),
+against a case's share of the sweep's wall time: what moving it out of the vmap could save.
 
     python benchmarks/bench_sweep_workers.py [--quick]
 """
@@ -50,6 +52,25 @@ def _sweep(spec_path: Path, workers: int):
         return time.perf_counter() - start, ds.load()
 
 
+def quasi_static_start_cost(batch: int = 8, repeats: int = 3) -> dict:
+    """Wall time of the quasi-static start (`jaxbearing.run.initial_state`, Newton's method) of
+    one case, and per case inside a vmap of `batch` (as in a sweep batch), compiled, best of
+    `repeats`: what running it outside the vmap could save."""
+    import jax
+    import jax.numpy as jnp
+
+    import jaxbearing as jb
+    from jaxbearing.run import initial_state
+
+    b, op = jb.reference_bearing(), jb.reference_operating_point()
+    one = jax.jit(lambda b, o: initial_state(b, o, jb.Perturbation(seed=0)))
+    many = jax.jit(jax.vmap(lambda b, o: initial_state(b, o, jb.Perturbation(seed=0))))
+    stacked = jax.tree_util.tree_map(lambda x: jnp.stack([x] * batch), (b, op))
+    alone = min(_common.time_repeats(lambda: jax.block_until_ready(one(b, op)), repeats))
+    batched = min(_common.time_repeats(lambda: jax.block_until_ready(many(*stacked)), repeats))
+    return {"one_case_s": alone, "per_case_in_vmap_s": batched / batch, "batch": batch}
+
+
 def main(quick: bool = False) -> dict:
     import numpy as np
 
@@ -69,6 +90,7 @@ def main(quick: bool = False) -> dict:
                 wall, ds = _sweep(spec_path, workers)
                 walls[workers].append(wall)
                 datasets[workers] = ds
+    start_cost = quasi_static_start_cost()
     one, two = datasets[1], datasets[2]
     identical = all(
         np.array_equal(one[v].values, two[v].values, equal_nan=one[v].dtype.kind == "f")
@@ -91,6 +113,8 @@ def main(quick: bool = False) -> dict:
         "ratio_two_workers": ratio,
         "datasets_bitwise_equal": bool(identical),
         "failed_cases": int(np.sum(one["result_code"].values != 0)),
+        "quasi_static_start": start_cost,
+        "quasi_static_start_share_of_a_case": start_cost["per_case_in_vmap_s"] / (best[1] / cases),
         "load_average_at_end": list(os.getloadavg()),
         "targets": {
             "two_core_sweep": _common.target(
@@ -109,6 +133,11 @@ def main(quick: bool = False) -> dict:
     )
     print(result["table"])
     print(f"datasets bitwise equal: {identical}")
+    print(
+        f"quasi-static start: {start_cost['one_case_s'] * 1e3:.1f} ms alone, "
+        f"{start_cost['per_case_in_vmap_s'] * 1e3:.1f} ms per case in a vmap of {start_cost['batch']} "
+        f"({100 * result['quasi_static_start_share_of_a_case']:.1f} % of a case's sweep wall time)"
+    )
     _common.write_json(NAME, result)
     return result
 

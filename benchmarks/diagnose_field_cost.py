@@ -9,6 +9,8 @@ Programs, on the reference bearing at 20,000 rpm and 1000 N, at the seeded quasi
 * the field `physical_rates` (what the solve evaluates 7 times per Tsit5 step attempt);
 * its parts: the inner and the outer raceway contacts of all rollers, the four flange contacts
   of all rollers (only the roller forces and moments, as the field uses them);
+* the outer raceway, the traction law and the slice law (all slices of one raceway) with one
+  tangent: where a tangent's operations go;
 * the forward-mode field of `design_jacobian` / `bench_gradients`: `jax.jvp` of the field with
   three tangents (vmapped) in the design variables (R_end, theta_f, Delta_bf) AND in the state,
   as inside a solve under `diffrax.ForwardMode()` (the tangents ride on the state), and with
@@ -49,10 +51,12 @@ def programs() -> dict:
     import jax.numpy as jnp
 
     import jaxbearing as jb
+    from jaxbearing.contact import traction_force
     from jaxbearing.dynamics import Params, physical_rates
     from jaxbearing.dynamics._field import inner_ring_pose
     from jaxbearing.flange import DesignVariables, all_flange_contacts
     from jaxbearing.forces import raceway_contact
+    from jaxbearing.forces._raceway import slice_loads_from_interference
 
     bearing, op = jb.reference_bearing(), jb.reference_operating_point()
     y = jb.run.initial_state(bearing, op, jb.Perturbation(seed=0))
@@ -95,6 +99,21 @@ def programs() -> dict:
         return c.force_on_roller, c.moment_on_roller
 
     basis = jnp.eye(3)
+    slices = (bearing.num_rollers, bearing.num_slices)
+    sliding = jnp.full(slices + (3,), 0.3)
+    loads = jnp.full(slices, 10.0)
+    interference = jnp.full(slices, 5e-6)
+
+    def with_tangent(fn, *args):
+        """fn and its JVP along ones on every argument (one tangent)."""
+        ones = jax.tree_util.tree_map(jnp.ones_like, args)
+        return lambda *a: jax.jvp(fn, a, ones)
+
+    def traction(u, q):
+        return traction_force(u, q, bearing.lubricant)
+
+    def slice_law(d):
+        return slice_loads_from_interference(bearing, d)
 
     def tangents_state_and_design(x, state):
         ones = jax.tree_util.tree_map(lambda a: jnp.ones((3,) + a.shape), state)
@@ -110,6 +129,11 @@ def programs() -> dict:
         "flange contacts": (flange, bodies),
         "field + 3 tangents (state and design, as in a solve)": (tangents_state_and_design, (x0, y)),
         "field + 3 tangents (design only)": (tangents_design_only, (x0, y)),
+        "outer raceway + 1 tangent": (with_tangent(outer, *bodies), bodies),
+        "traction law, all slices of one raceway": (traction, (sliding, loads)),
+        "traction law + 1 tangent": (with_tangent(traction, sliding, loads), (sliding, loads)),
+        "slice law, all slices of one raceway": (slice_law, (interference,)),
+        "slice law + 1 tangent": (with_tangent(slice_law, interference), (interference,)),
     }
 
 

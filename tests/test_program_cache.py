@@ -4,6 +4,7 @@ forgetting the in-process programs; whether the function was traced is counted a
 
 from __future__ import annotations
 
+import json
 import subprocess
 import sys
 import textwrap
@@ -125,30 +126,27 @@ def test_a_genuine_error_of_the_function_is_raised(programs):
         cc.compiled_program("broken", fn, (jnp.zeros(2),))
 
 
-def test_design_jacobian_in_a_second_process_is_not_traced(tmp_path):
-    """The library program end to end: two processes share a cache directory; the second loads
-    `design_jacobian`'s program (no trace of the vector field) and gives the same numbers."""
+def test_simulate_in_a_second_process_is_not_traced(tmp_path):
+    """The library end to end: two processes share a cache directory; the second loads
+    `simulate`'s program (no trace of the vector field) and gives the same numbers."""
     script = textwrap.dedent(
         """
-        import json, sys
+        import json
         import numpy as np
         import jaxbearing as jb
         from jaxbearing.dynamics import _field
-        from jaxbearing.flange import DesignVariables
         from jaxbearing.run import _compile_cache as cc
 
         traces = []
         original = _field._roller_rates
         _field._roller_rates = lambda *a: (traces.append(1), original(*a))[1]
         b, op = jb.reference_bearing(), jb.reference_operating_point()
-        v, j = jb.design_jacobian(b, op, DesignVariables.of(b), duration=2e-6, max_steps=1000)
-        print(json.dumps({"traces": len(traces), "v": np.asarray(v).tolist(), "j": np.asarray(j).tolist(),
-                          "files": len(list(cc.program_cache_dir().glob("design_jacobian-*")))}))
+        r = jb.simulate(b, op, duration=2e-6, num_saves=3, max_steps=1000)
+        print(json.dumps({"traces": len(traces), "cage": np.asarray(r.histories["cage_speed"]).tolist(),
+                          "files": len(list(cc.program_cache_dir().glob("simulate-*")))}))
         """
     )
     env = {"JAXBEARING_CACHE_DIR": str(tmp_path / "cache"), "PATH": "/usr/bin:/bin", "HOME": str(tmp_path)}
-    import json
-
     outs = []
     for _ in range(2):
         done = subprocess.run(
@@ -159,4 +157,28 @@ def test_design_jacobian_in_a_second_process_is_not_traced(tmp_path):
     first, second = outs
     assert first["traces"] >= 1 and first["files"] == 1
     assert second["traces"] == 0
-    assert second["v"] == first["v"] and second["j"] == first["j"]
+    assert second["cage"] == first["cage"]
+
+
+def test_design_jacobian_with_concrete_values_uses_a_stored_program(monkeypatch):
+    """Concrete arguments go through `compiled_program` (its values are those of the traced
+    path, which tests/test_design.py checks against central differences); under jit they do not."""
+    import jaxbearing as jb
+    from jaxbearing.flange import DesignVariables
+    from jaxbearing.run import _design
+
+    seen = []
+
+    def stand_in(name, fn, args, static=()):
+        seen.append((name, static))
+        return lambda *a: "stored program"
+
+    monkeypatch.setattr(_design, "compiled_program", stand_in)
+    b, op = jb.reference_bearing(), jb.reference_operating_point()
+    design = DesignVariables.of(b)
+    assert jb.design_jacobian(b, op, design, duration=1e-4, max_steps=10) == "stored program"
+    assert seen[0][0] == "design_jacobian" and seen[0][1][0] == "forward"
+    traced = jax.eval_shape(
+        lambda x: jb.design_jacobian(b, op, DesignVariables.from_array(x), duration=1e-4), design.as_array()
+    )
+    assert len(seen) == 1 and traced[1].shape == (3, 3)

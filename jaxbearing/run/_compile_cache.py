@@ -125,6 +125,8 @@ class Program:
 
     def __call__(self, *args):
         leaves = jax.tree_util.tree_leaves(args)
+        if len(leaves) != len(self._dtypes):
+            raise TypeError(f"expected {len(self._dtypes)} array leaves, got {len(leaves)}")
         leaves = [jnp.asarray(x, dtype=d) for x, d in zip(leaves, self._dtypes)]
         return jax.tree_util.tree_unflatten(self._out_tree, self._compiled(*leaves))
 
