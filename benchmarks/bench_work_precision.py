@@ -310,7 +310,6 @@ class ScipyRunner:
 
 # -- the benchmark -----------------------------------------------------------------------------
 def main(quick: bool = False, imex: bool = False) -> dict:
-    import numpy as np
 
     import jaxbearing as jb
 
@@ -372,19 +371,11 @@ def main(quick: bool = False, imex: bool = False) -> dict:
             r["statistics"] = window_statistics(hist, t0, omega_kin)
             r["errors"] = errors(r["statistics"], ref["statistics"], ref["ci_halfwidth"])
             r["evaluations_per_ms"] = r["evaluations"] / (duration * 1e3)
+            r["wall_s_per_ms"] = r["wall_s"] / (duration * 1e3)
             per_seed[str(seed)] = r
         rows.append(
             {
-                "label": label,
-                "kind": kind,
-                "rtol": rtol,
-                "atol": atol,
-                "raceway_loosen": loosen,
-                "seeds": per_seed,
-                "all_ok": all(s["ok"] for s in per_seed.values()),
-                "evaluations_per_ms": float(np.mean([s["evaluations_per_ms"] for s in per_seed.values()])),
-                "wall_s_per_ms": float(np.mean([s["wall_s"] for s in per_seed.values()])) / (duration * 1e3),
-                "max_error_in_ci": max(s["errors"]["max_in_ci"] for s in per_seed.values()),
+                **variant_row(label, kind, rtol, atol, loosen, per_seed),
                 "max_relative_error_pv_speed": max(
                     s["errors"]["max_relative_pv_speed"] for s in per_seed.values()
                 ),
@@ -420,6 +411,26 @@ def main(quick: bool = False, imex: bool = False) -> dict:
     print(result["table"])
     _common.write_json(NAME + ("_imex" if imex else ""), result)
     return result
+
+
+def variant_row(label: str, kind: str, rtol: float, atol: float, loosen: float, per_seed: dict) -> dict:
+    """One integrator's summary over its seeds (`per_seed`: {seed: run with "ok",
+    "evaluations_per_ms", "wall_s_per_ms" and "errors"}); `bench_work_precision_settled` too."""
+    import numpy as np
+
+    runs = list(per_seed.values())
+    return {
+        "label": label,
+        "kind": kind,
+        "rtol": rtol,
+        "atol": atol,
+        "raceway_loosen": loosen,
+        "seeds": per_seed,
+        "all_ok": all(s["ok"] for s in runs),
+        "evaluations_per_ms": float(np.mean([s["evaluations_per_ms"] for s in runs])),
+        "wall_s_per_ms": float(np.mean([s["wall_s_per_ms"] for s in runs])),
+        "max_error_in_ci": max(s["errors"]["max_in_ci"] for s in runs),
+    }
 
 
 def _table(r: dict) -> str:

@@ -73,6 +73,7 @@ from bench_work_precision import (  # noqa: E402
     ScipyRunner,
     confidence_halfwidths,
     errors,
+    variant_row,
     window_statistics,
 )
 
@@ -366,16 +367,7 @@ def main(quick: bool = False, window_revs: int = WINDOW_REVS, reuse_reference: b
         runs = list(per_seed.values())
         rows.append(
             {
-                "label": label,
-                "kind": kind,
-                "rtol": rtol,
-                "atol": atol,
-                "raceway_loosen": loosen,
-                "seeds": per_seed,
-                "all_ok": all(s["ok"] for s in runs),
-                "evaluations_per_ms": float(np.mean([s["evaluations_per_ms"] for s in runs])),
-                "wall_s_per_ms": float(np.mean([s["wall_s_per_ms"] for s in runs])),
-                "max_error_in_ci": max(s["errors"]["max_in_ci"] for s in runs),
+                **variant_row(label, kind, rtol, atol, loosen, per_seed),
                 "over_seeds": {
                     s: paired_over_seeds([x["statistics"][s] for x in runs], ref_values[s]) for s in STATS
                 },
