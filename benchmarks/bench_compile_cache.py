@@ -11,6 +11,9 @@ heights and their derivatives in the 3 design variables over `GRADIENT_HORIZON`,
 `bench_gradients`; its compile time is the first call's wall time less the second's) and one
 sweep batch (`jaxbearing.sweep.batch_runner`, 2 cases).
 
+Each program's results (a sha256 of its outputs) are compared between the first process, the
+second and a third with the caches off (`JAXBEARING_CACHE_DIR=off`: plain `jax.jit`).
+
 What a second process skips: the compilation (JAX's persistent compilation cache) and, for the
 programs built by `jaxbearing.run.compiled_program`, the tracing too (a `jax.export` artefact
 stored beside that cache).
@@ -36,12 +39,25 @@ NAME = "bench_compile_cache"
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def _program_simulate() -> float:
+def _digest(tree) -> str:
+    """sha256 of every array of a result: equal digests mean bitwise-equal results."""
+    import hashlib
+
+    import jax
+    import numpy as np
+
+    h = hashlib.sha256()
+    for leaf in jax.tree_util.tree_leaves(tree):
+        h.update(np.ascontiguousarray(np.asarray(leaf)).tobytes())
+    return h.hexdigest()
+
+
+def _program_simulate() -> tuple[float, str]:
     import jaxbearing as jb
 
     res = jb.simulate(jb.reference_bearing(), jb.reference_operating_point(), duration=0.05e-3)
     assert res.ok, res.status
-    return res.compile_time_s
+    return res.compile_time_s, _digest(res.histories)
 
 
 def _program_gradient() -> float:
@@ -57,9 +73,9 @@ def _program_gradient() -> float:
     times = []
     for _ in range(2):  # the first call compiles and runs, the second only runs
         start = time.perf_counter()
-        jax.block_until_ready(design_jacobian(bearing, op, design, **kwargs))
+        out = jax.block_until_ready(design_jacobian(bearing, op, design, **kwargs))
         times.append(time.perf_counter() - start)
-    return times[0] - times[1]
+    return times[0] - times[1], _digest(out)
 
 
 def _program_sweep() -> float:
@@ -74,8 +90,9 @@ def _program_sweep() -> float:
     inputs = jax.tree_util.tree_map(lambda *xs: np.stack([np.asarray(x, float) for x in xs]), *cases)
     runner = batch_runner(50, 100_000, tuple(jax.local_devices()))
     start = time.perf_counter()
-    runner.compile(*inputs)
-    return time.perf_counter() - start
+    compiled = runner.compile(*inputs)
+    seconds = time.perf_counter() - start
+    return seconds, _digest(compiled(*inputs))
 
 
 PROGRAMS = {
@@ -86,16 +103,17 @@ PROGRAMS = {
 
 
 def _child(program: str) -> None:
-    seconds = PROGRAMS[program]()
-    print(json.dumps({"compile_s": seconds}))
+    seconds, digest = PROGRAMS[program]()
+    print(json.dumps({"compile_s": seconds, "digest": digest}))
 
 
-def _run_process(program: str, cache_dir: str) -> float:
+def _run_process(program: str, cache_dir: str) -> dict:
+    """{"compile_s", "digest"} of `program` in a fresh process with `cache_dir` ("off": no cache)."""
     env = dict(os.environ, JAXBEARING_CACHE_DIR=cache_dir, PYTHONPATH=str(ROOT))
     out = subprocess.run(
         [sys.executable, __file__, "--child", program], env=env, capture_output=True, text=True, check=True
     )
-    return json.loads(out.stdout.strip().splitlines()[-1])["compile_s"]
+    return json.loads(out.stdout.strip().splitlines()[-1])
 
 
 def main(quick: bool = False) -> dict:
@@ -109,11 +127,16 @@ def main(quick: bool = False) -> dict:
             files = sum(1 for _ in Path(cache).rglob("*") if _.is_file())
             _common.log(f"{NAME}: {program}: second process")
             second = _run_process(program, cache)
+        _common.log(f"{NAME}: {program}: a process with the caches off (plain jax.jit)")
+        plain = _run_process(program, "off")
         rows[program] = {
-            "first_process_compile_s": first,
-            "second_process_compile_s": second,
-            "ratio": second / first,
+            "first_process_compile_s": first["compile_s"],
+            "second_process_compile_s": second["compile_s"],
+            "ratio": second["compile_s"] / first["compile_s"],
             "cache_files": files,
+            "results_bitwise_equal_first_second_plain_jit": first["digest"]
+            == second["digest"]
+            == plain["digest"],
         }
     worst = max(r["ratio"] for r in rows.values())
     result = {
@@ -132,9 +155,16 @@ def main(quick: bool = False) -> dict:
     }
     result["table"] = _common.format_table(
         "Compile once: first vs second process, shared persistent cache",
-        ["program", "first s", "second s", "second/first", "cache files"],
+        ["program", "first s", "second s", "second/first", "cache files", "bitwise = plain jit"],
         [
-            [k, r["first_process_compile_s"], r["second_process_compile_s"], r["ratio"], r["cache_files"]]
+            [
+                k,
+                r["first_process_compile_s"],
+                r["second_process_compile_s"],
+                r["ratio"],
+                r["cache_files"],
+                r["results_bitwise_equal_first_second_plain_jit"],
+            ]
             for k, r in rows.items()
         ],
     )
