@@ -187,11 +187,11 @@ def _load(path: Path):
         return None
 
 
-def _store(path: Path, exported, out_tree) -> None:
-    """Write the program atomically (a temporary file renamed): whole or absent. A full or
-    read-only disk only costs the next process the tracing."""
+def _store(path: Path, serialized: bytes, out_tree) -> None:
+    """Write the serialized program atomically (a temporary file renamed): whole or absent. A
+    full or read-only disk only costs the next process the tracing."""
     skeleton = jax.tree_util.tree_unflatten(out_tree, [0] * out_tree.num_leaves)
-    data = pickle.dumps({"exported": bytes(exported.serialize()), "skeleton": skeleton})
+    data = pickle.dumps({"exported": serialized, "skeleton": skeleton})
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         with tempfile.NamedTemporaryFile(dir=path.parent, prefix=path.name, suffix=".tmp", delete=False) as f:
@@ -203,15 +203,15 @@ def _store(path: Path, exported, out_tree) -> None:
 
 
 def _export(jitted, specs: tuple, box: dict):
-    """`jax.export` of the jitted flat function, or None where it cannot be exported (e.g. a
-    progress meter's host callback): then the program is compiled the usual way, from the same
-    trace (JAX caches it on the jitted function)."""
+    """(Exported, its serialized bytes, output tree) of the jitted flat function, or None where
+    it cannot be exported (e.g. a progress meter's host callback): then the program is compiled
+    the usual way, from the same trace (JAX caches it on the jitted function)."""
     try:
         exported = jax.export.export(jitted)(*specs)
-        exported.serialize()  # effects and custom calls without a stable ABI fail here
+        serialized = bytes(exported.serialize())  # effects and custom calls without a stable ABI fail here
     except Exception:  # noqa: BLE001 - the usual compilation re-raises a genuine error
         return None
-    return exported, box["tree"]
+    return exported, serialized, box["tree"]
 
 
 def _build(name: str, fn, in_tree, specs: tuple, static) -> Program:
@@ -228,9 +228,10 @@ def _build(name: str, fn, in_tree, specs: tuple, static) -> Program:
         path = directory / f"{name}-{_program_key(name, in_tree, specs, static)}.jaxexport"
         entry = _load(path)
         if entry is None:
-            entry = _export(jitted, specs, box)
-            if entry is not None:
-                _store(path, *entry)
+            exported = _export(jitted, specs, box)
+            if exported is not None:
+                _store(path, *exported[1:])
+                entry = exported[0], exported[2]
         if entry is not None:
             exported, out_tree = entry
             return Program(jax.jit(exported.call).lower(*specs).compile(), specs, out_tree, True)
