@@ -8,11 +8,14 @@ full setting (unset) reproduces the study and writes docs/figures/. Each noteboo
 with `sys.executable`), with MPLBACKEND=Agg, from the notebooks/ folder, so `import _short`
 works as it does in Jupyter. New notebooks are picked up by the glob.
 
-Compile time. Each kernel compiles the whole-bearing solve afresh (10-60 s on 2 cores). To share
-it between notebooks, the kernels get a JAX persistent compilation cache in a session temporary
-folder (or the caller's JAX_COMPILATION_CACHE_DIR) and EQX_ON_ERROR=nan: equinox's runtime
-checks otherwise compile to host callbacks, and XLA does not persist executables that contain
-them. The notebooks assert `result.ok` after every solve, so a failed solve still fails here.
+Compile time. Each kernel would compile the whole-bearing solve afresh (10-60 s on 2 cores).
+The kernels use the persistent caches every other test uses: jaxbearing's own (`$JAXBEARING_CACHE_DIR`,
+default `~/.cache/jaxbearing/xla`, with its stored programs, `jaxbearing.run.compiled_program`),
+or the caller's JAX_COMPILATION_CACHE_DIR when one is set. So a second run of the suite on a
+machine, or a notebook whose programs another test built, does not trace and compile them again.
+EQX_ON_ERROR=nan: equinox's runtime checks otherwise compile to host callbacks, and XLA does not
+persist executables that contain them. The notebooks assert `result.ok` after every solve, so a
+failed solve still fails here.
 """
 
 from __future__ import annotations
@@ -59,9 +62,10 @@ def test_outputs_stripped(path):
 
 
 @pytest.fixture(scope="session")
-def compilation_cache(tmp_path_factory) -> str:
-    """Folder of the JAX persistent compilation cache shared by the notebook kernels."""
-    return os.environ.get("JAX_COMPILATION_CACHE_DIR") or str(tmp_path_factory.mktemp("jax_cache"))
+def compilation_cache() -> str | None:
+    """The caller's JAX_COMPILATION_CACHE_DIR, or None: the kernels then use jaxbearing's
+    default persistent cache, like the test processes (module docstring)."""
+    return os.environ.get("JAX_COMPILATION_CACHE_DIR")
 
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=_ids)
@@ -70,7 +74,8 @@ def test_notebook_runs(path, monkeypatch, compilation_cache):
     (nbclient raises CellExecutionError with the cell's traceback)."""
     monkeypatch.setenv("JAXBEARING_NOTEBOOK_SHORT", "1")
     monkeypatch.setenv("MPLBACKEND", "Agg")
-    monkeypatch.setenv("JAX_COMPILATION_CACHE_DIR", compilation_cache)
+    if compilation_cache:
+        monkeypatch.setenv("JAX_COMPILATION_CACHE_DIR", compilation_cache)
     monkeypatch.setenv("EQX_ON_ERROR", "nan")
     nb = nbformat.read(path, as_version=4)
     client = nbclient.NotebookClient(
