@@ -219,6 +219,17 @@ def test_bad_worker_count_is_one_line(tmp_path, workers):
         run_sweep(load_sweep_spec(SMALL), tmp_path, progress=False, workers=workers)
 
 
+def test_cli_bad_worker_count_is_the_only_line(tmp_path, capsys):
+    """`jaxbearing sweep --workers 0`: one error line naming the option, nothing printed or
+    created before it, exit status 2."""
+    out = tmp_path / "out"
+    assert cli_main(["sweep", str(SMALL), "--out", str(out), "--workers", "0"]) == 2
+    captured = capsys.readouterr()
+    err = captured.err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("jaxbearing sweep: error: workers = 0"), err
+    assert not captured.out and not out.exists()
+
+
 def test_failed_case_is_recorded(tmp_path, reference):
     """A case hitting max_steps is recorded with its status and NaNs; the sweep goes on."""
     ds = run_sweep(load_sweep_spec(SWEEPS / "failing.toml"), tmp_path, progress=False)

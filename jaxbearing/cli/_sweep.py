@@ -84,8 +84,11 @@ def default_workers(spec, num_processes: int) -> int:
 
 
 def run(args) -> int:
+    from ..io import check_arguments, count
     from ..sweep import initialize_distributed, load_sweep_spec, run_sweep
 
+    if args.workers is not None:  # before anything is printed or started
+        check_arguments({"workers": args.workers}, {"workers": count(1)})
     spec = load_sweep_spec(args.spec)
     if args.batch_size is not None:
         spec = spec.with_batch_size(args.batch_size)
