@@ -109,6 +109,34 @@ def test_program_with_a_host_callback_is_compiled_as_usual_from_one_trace(progra
     assert not list(programs.glob("*.jaxexport"))
 
 
+def test_least_recently_used_programs_are_evicted_beyond_the_bound(tmp_path):
+    """`_evict`: oldest first until the folder fits; the program just stored stays even when it
+    is the oldest; other files are not touched."""
+    import os
+
+    paths = [tmp_path / f"p{i}.jaxexport" for i in range(4)]
+    for i, path in enumerate(paths):
+        path.write_bytes(b"x" * 100)
+        os.utime(path, (1000 + i, 1000 + i))
+    other = tmp_path / "notes.txt"
+    other.write_bytes(b"y" * 1000)
+    cc._evict(tmp_path, keep=paths[0], max_bytes=250)
+    assert [p.exists() for p in paths] == [True, False, False, True]
+    assert other.exists()
+
+
+def test_loading_a_program_marks_it_used(programs):
+    """A program read by a second process becomes the most recently used (`_load` touches it)."""
+    import os
+
+    cc.compiled_program("touch", _traced_counter()[0], ARGS)
+    (path,) = programs.glob("touch-*.jaxexport")
+    os.utime(path, (1000, 1000))
+    cc._PROGRAMS.clear()
+    cc.compiled_program("touch", _traced_counter()[0], ARGS)
+    assert path.stat().st_mtime > 1e9
+
+
 def test_cache_off_stores_nothing(monkeypatch):
     monkeypatch.setattr(cc, "program_cache_dir", lambda: None)
     monkeypatch.setattr(cc, "_PROGRAMS", {})

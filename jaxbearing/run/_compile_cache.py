@@ -46,6 +46,10 @@ import jax.numpy as jnp
 
 #: environment variable naming the cache directory (or switching the cache off)
 CACHE_ENV = "JAXBEARING_CACHE_DIR"
+#: most bytes the stored programs keep (`programs/`): beyond it the least recently used are
+#: removed when a new one is stored. A program is 0.3-1 MB, and every change of jaxbearing's
+#: source makes new keys, so without a bound the folder grows with every version.
+PROGRAM_CACHE_MAX_BYTES = 256 * 2**20
 _OFF = {"", "0", "off", "false", "no", "none"}
 
 
@@ -178,6 +182,8 @@ def _load(path: Path):
     try:
         entry = pickle.loads(path.read_bytes())
         exported = jax.export.deserialize(bytearray(entry["exported"]))
+        with contextlib.suppress(OSError):
+            os.utime(path)  # used now: the last to be evicted (`_evict`)
         return exported, jax.tree_util.tree_structure(entry["skeleton"])
     except FileNotFoundError:
         return None
@@ -200,6 +206,28 @@ def _store(path: Path, serialized: bytes, out_tree) -> None:
     except OSError:
         with contextlib.suppress(OSError, UnboundLocalError):
             os.unlink(f.name)
+        return
+    _evict(path.parent, keep=path, max_bytes=PROGRAM_CACHE_MAX_BYTES)
+
+
+def _evict(directory: Path, *, keep: Path, max_bytes: int) -> None:
+    """Remove the least recently used programs (oldest modification time: `_load` touches the
+    files it reads) until those in `directory` take at most `max_bytes`; `keep` stays. Files
+    another process removes meanwhile are skipped."""
+    files = []
+    for path in directory.glob("*.jaxexport"):
+        with contextlib.suppress(OSError):
+            st = path.stat()
+            files.append((st.st_mtime, st.st_size, path))
+    total = sum(size for _, size, _ in files)
+    for _, size, path in sorted(files, key=lambda f: f[0]):
+        if total <= max_bytes:
+            break
+        if path == keep:
+            continue
+        with contextlib.suppress(OSError):
+            path.unlink()
+        total -= size
 
 
 def _export(jitted, specs: tuple, box: dict):
@@ -253,7 +281,8 @@ def compiled_program(name: str, fn, args: tuple, static=()) -> Program:
 
     The key covers jaxbearing's source, not what was traced: code that monkeypatches
     jaxbearing's traced functions must run with the cache off (`JAXBEARING_CACHE_DIR=off`) or
-    in a cache directory of its own. `rm -r` of `program_cache_dir()` forgets every program.
+    in a cache directory of its own. The folder keeps at most `PROGRAM_CACHE_MAX_BYTES`, least
+    recently used programs first out; `rm -r` of `program_cache_dir()` forgets every program.
     """
     leaves, in_tree = jax.tree_util.tree_flatten(args)
     specs = tuple(jax.ShapeDtypeStruct(jnp.shape(x), jnp.result_type(x)) for x in leaves)
