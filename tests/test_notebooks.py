@@ -9,10 +9,11 @@ with `sys.executable`), with MPLBACKEND=Agg, from the notebooks/ folder, so `imp
 works as it does in Jupyter. New notebooks are picked up by the glob.
 
 Compile time. Each kernel would compile the whole-bearing solve afresh (10-60 s on 2 cores).
-The kernels use the persistent caches every other test uses: jaxbearing's own (`$JAXBEARING_CACHE_DIR`,
-default `~/.cache/jaxbearing/xla`, with its stored programs, `jaxbearing.run.compiled_program`),
-or the caller's JAX_COMPILATION_CACHE_DIR when one is set. So a second run of the suite on a
-machine, or a notebook whose programs another test built, does not trace and compile them again.
+The kernels inherit this process's environment and so use the persistent caches every other
+test uses: jaxbearing's own (`$JAXBEARING_CACHE_DIR`, default `~/.cache/jaxbearing/xla`, with
+its stored programs, `jaxbearing.run.compiled_program`), or the caller's
+JAX_COMPILATION_CACHE_DIR when one is set. So a second run of the suite on a machine, or a
+notebook whose programs another test built, does not trace and compile them again.
 EQX_ON_ERROR=nan: equinox's runtime checks otherwise compile to host callbacks, and XLA does not
 persist executables that contain them. The notebooks assert `result.ok` after every solve, so a
 failed solve still fails here.
@@ -20,7 +21,6 @@ failed solve still fails here.
 
 from __future__ import annotations
 
-import os
 import pathlib
 
 import pytest
@@ -61,21 +61,12 @@ def test_outputs_stripped(path):
     )
 
 
-@pytest.fixture(scope="session")
-def compilation_cache() -> str | None:
-    """The caller's JAX_COMPILATION_CACHE_DIR, or None: the kernels then use jaxbearing's
-    default persistent cache, like the test processes (module docstring)."""
-    return os.environ.get("JAX_COMPILATION_CACHE_DIR")
-
-
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=_ids)
-def test_notebook_runs(path, monkeypatch, compilation_cache):
+def test_notebook_runs(path, monkeypatch):
     """Execute the notebook top to bottom in the short setting; any cell error fails the test
     (nbclient raises CellExecutionError with the cell's traceback)."""
     monkeypatch.setenv("JAXBEARING_NOTEBOOK_SHORT", "1")
     monkeypatch.setenv("MPLBACKEND", "Agg")
-    if compilation_cache:
-        monkeypatch.setenv("JAX_COMPILATION_CACHE_DIR", compilation_cache)
     monkeypatch.setenv("EQX_ON_ERROR", "nan")
     nb = nbformat.read(path, as_version=4)
     client = nbclient.NotebookClient(
