@@ -13,7 +13,8 @@ at, below and above zero penetration and at zero sliding (MODEL.md section 4).
   `line_power` (the slice law's power with a hand-written tangent).
 - Smoothing: `smooth_penetration`, `smooth_power`, `hertz_force`, `safe_norm`,
   `smooth_direction`.
-- Traction and friction: `traction_coefficient`, `traction_force`, `friction_force`.
+- Traction and friction: `traction_coefficient`, `traction_force` (and its `traction_factor`),
+  `friction_force` (and its `friction_factor`).
 - Normal damping (Hunt & Crossley 1975): `hunt_crossley_force`, `hunt_crossley_factor`,
   `restitution_coefficient`, `HUNT_CROSSLEY_ALPHA`.
 - Lubricated point contact: Hamrock & Dowson (1977) film thickness `minimum_film_thickness`,
@@ -79,7 +80,13 @@ from ._smooth import (
     smooth_penetration,
     smooth_power,
 )
-from ._traction import friction_force, traction_coefficient, traction_force
+from ._traction import (
+    friction_factor,
+    friction_force,
+    traction_coefficient,
+    traction_factor,
+    traction_force,
+)
 
 __all__ = [
     "ASPERITY_EXPONENT",
@@ -106,6 +113,7 @@ __all__ = [
     "entrainment_radii",
     "entrainment_velocity",
     "film_parameter",
+    "friction_factor",
     "friction_force",
     "hamrock_brewe_parameters",
     "hertz_force",
@@ -130,6 +138,7 @@ __all__ = [
     "smooth_penetration",
     "smooth_power",
     "traction_coefficient",
+    "traction_factor",
     "traction_force",
     "viscosity_at_temperature",
 ]

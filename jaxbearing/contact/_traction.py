@@ -42,12 +42,6 @@ def traction_coefficient(
     return (a + b * du) * jnp.exp(-c * du) + d
 
 
-def _regularised_speed(u, speed_eps):
-    u = jnp.asarray(u)
-    eps2 = jnp.asarray(speed_eps)[..., None] ** 2
-    return u, jnp.sqrt(jnp.sum(u * u, axis=-1, keepdims=True) + eps2)
-
-
 def traction_force(
     sliding_velocity: Float[ArrayLike, "*batch dim"],
     normal_load: Float[ArrayLike, "*#batch"],
@@ -67,9 +61,22 @@ def traction_force(
         lubricant: traction curve (`traction_coefficient`).
         speed_eps: u_eps [m/s], default `SLIDING_EPS`.
     """
-    u, s = _regularised_speed(sliding_velocity, speed_eps)
-    kappa = traction_coefficient(s, lubricant)
-    return -jnp.asarray(normal_load)[..., None] * kappa * u / s
+    u = jnp.asarray(sliding_velocity)
+    factor = traction_factor(jnp.sum(u * u, axis=-1), normal_load, lubricant, speed_eps)
+    return factor[..., None] * u
+
+
+def traction_factor(
+    sliding_speed_squared: Float[ArrayLike, "*batch"],
+    normal_load: Float[ArrayLike, "*#batch"],
+    lubricant: Lubricant,
+    speed_eps: Float[ArrayLike, "*#batch"] = SLIDING_EPS,
+) -> Float[Array, "*batch"]:
+    """-Q kappa(s) / s, s = sqrt(|u|^2 + u_eps^2) [N s/m]: the traction force of
+    `traction_force` is this factor times the sliding velocity u. Takes |u|^2, so that a caller
+    holding u by components (the sliced raceway contact) needs no stacked 3-vector."""
+    s = jnp.sqrt(jnp.asarray(sliding_speed_squared) + jnp.asarray(speed_eps) ** 2)
+    return -jnp.asarray(normal_load) * traction_coefficient(s, lubricant) / s
 
 
 def friction_force(
@@ -89,6 +96,18 @@ def friction_force(
         coefficient: mu.
         speed_eps: u_eps [m/s].
     """
-    u, s = _regularised_speed(sliding_velocity, speed_eps)
-    mu_q = jnp.asarray(coefficient) * jnp.asarray(normal_load)
-    return -mu_q[..., None] * u / s
+    u = jnp.asarray(sliding_velocity)
+    factor = friction_factor(jnp.sum(u * u, axis=-1), normal_load, coefficient, speed_eps)
+    return factor[..., None] * u
+
+
+def friction_factor(
+    sliding_speed_squared: Float[ArrayLike, "*batch"],
+    normal_load: Float[ArrayLike, "*#batch"],
+    coefficient: Float[ArrayLike, "*#batch"],
+    speed_eps: Float[ArrayLike, "*#batch"] = SLIDING_EPS,
+) -> Float[Array, "*batch"]:
+    """-mu Q / sqrt(|u|^2 + u_eps^2) [N s/m]: `friction_force` is this factor times u (takes
+    |u|^2, like `traction_factor`)."""
+    s = jnp.sqrt(jnp.asarray(sliding_speed_squared) + jnp.asarray(speed_eps) ** 2)
+    return -jnp.asarray(coefficient) * jnp.asarray(normal_load) / s

@@ -1,0 +1,203 @@
+"""Field evaluation speed against a baseline commit, measured in the same run (issue 12, item 3).
+
+What it compares: this working tree's `jaxbearing` against the one at `--baseline` (a git
+revision, default 92d850e: before the sliced contacts were written by components). The baseline
+is checked out into a temporary git worktree; each measurement runs in a fresh process with
+`PYTHONPATH` pointing at one tree and the compilation caches off, and the processes alternate
+(baseline, current, baseline, ...) `--repeats` times, so that the shared machine's load falls
+on both alike. The minimum over the repeats is reported, and the ratio baseline / current.
+
+Measured in each process, on the reference bearing at 20,000 rpm and 1000 N from the seeded
+quasi-static start:
+
+* ``field_us``: one evaluation of `physical_rates` inside a compiled `lax.fori_loop` of
+  `EVALS` evaluations (no dispatch), wall / EVALS;
+* ``tangents_us``: the same with three forward-mode tangents in the state and the design
+  (R_end, theta_f, Delta_bf), as inside a `diffrax.ForwardMode` solve;
+* ``solve_s_per_ms``: `jaxbearing.solve` (Tsit5, default tolerances, 2 saves) over `DURATION`,
+  compile excluded, wall per simulated ms, with its step attempts (the two trees differ in
+  rounding only, so their step counts agree to a few per cent);
+* ``flops``: XLA's operation count of the field and of the field with 3 tangents (independent
+  of the load).
+
+    python benchmarks/bench_field_speed.py [--baseline REV] [--repeats N] [--quick]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import _common  # noqa: E402
+
+NAME = "bench_field_speed"
+BASELINE = "92d850e"
+EVALS = 400
+DURATION = 0.5e-3  # [s]
+REPO = Path(__file__).resolve().parent.parent
+
+
+def _loop_time(fn, repeats: int = 7) -> float:
+    """min over `repeats` of the wall time of the compiled no-argument `fn`, per evaluation."""
+    fn().block_until_ready()
+    best = float("inf")
+    for _ in range(repeats):
+        t = time.perf_counter()
+        fn().block_until_ready()
+        best = min(best, time.perf_counter() - t)
+    return best / EVALS
+
+
+def child() -> dict:
+    """The measurements of the module docstring for the `jaxbearing` on `sys.path`."""
+    import jax
+    import jax.numpy as jnp
+
+    import jaxbearing as jb
+    from jaxbearing.dynamics import Params, physical_rates
+    from jaxbearing.flange import DesignVariables
+
+    bearing, op = jb.reference_bearing(), jb.reference_operating_point()
+    y0 = jb.run.initial_state(bearing, op, jb.Perturbation(seed=0))
+    x0 = DesignVariables.of(bearing).as_array()
+
+    def field(x, y):
+        b = DesignVariables.from_array(x).apply(bearing)
+        return physical_rates(0.0, y, Params(bearing=b, operating=op))
+
+    def tangents(x, y):
+        basis = jnp.eye(3)
+        ones = jax.tree_util.tree_map(lambda a: jnp.ones((3,) + a.shape), y)
+        return jax.vmap(lambda d, t: jax.jvp(field, (x, y), (d, t)), out_axes=(None, 0))(basis, ones)
+
+    def looped(fn):
+        def body(i, acc):
+            y = jax.tree_util.tree_map(lambda a: a + 1e-30 * acc, y0)
+            out = fn(x0, y)
+            return acc + 1e-30 * sum(jnp.sum(leaf) for leaf in jax.tree_util.tree_leaves(out))
+
+        return jax.jit(lambda: jax.lax.fori_loop(0, EVALS, body, jnp.asarray(0.0)))
+
+    def flops(fn):
+        cost = jax.jit(fn).lower(x0, y0).compile().cost_analysis()
+        return float((cost[0] if isinstance(cost, list) else cost)["flops"])
+
+    solve = jax.jit(
+        lambda b: jb.run.solve(b, op, DURATION, num_saves=2, perturbation=jb.Perturbation(seed=0))
+    )
+    sol = solve(bearing)
+    jax.block_until_ready(sol)
+    walls = []
+    for _ in range(3):
+        t = time.perf_counter()
+        sol = solve(bearing)
+        jax.block_until_ready(sol)
+        walls.append(time.perf_counter() - t)
+    return {
+        "field_us": 1e6 * _loop_time(looped(field)),
+        "tangents_us": 1e6 * _loop_time(looped(tangents)),
+        "solve_s_per_ms": min(walls) / (DURATION * 1e3),
+        "solve_step_attempts": int(sol.num_steps),
+        "solve_ok": int(sol.result) == 0,
+        "field_flops": flops(field),
+        "tangents_flops": flops(tangents),
+    }
+
+
+def _run_child(tree: Path) -> dict:
+    env = dict(os.environ, PYTHONPATH=str(tree), JAXBEARING_CACHE_DIR="off")
+    out = subprocess.run(
+        [sys.executable, __file__, "--child"], env=env, cwd=tree, capture_output=True, text=True, check=False
+    )
+    if out.returncode != 0:
+        raise RuntimeError(f"{NAME}: the measurement in {tree} failed:\n{out.stderr[-3000:]}")
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def main(baseline: str = BASELINE, repeats: int = 3) -> dict:
+    runs: dict[str, list[dict]] = {"baseline": [], "current": []}
+    with tempfile.TemporaryDirectory() as tmp:
+        tree = Path(tmp) / "baseline"
+        subprocess.run(
+            ["git", "-C", str(REPO), "worktree", "add", "--detach", "-q", str(tree), baseline], check=True
+        )
+        try:
+            for i in range(repeats):
+                for which, path in (("baseline", tree), ("current", REPO)):
+                    _common.log(f"{NAME}: {which}, repeat {i + 1} of {repeats}")
+                    runs[which].append(_run_child(path))
+        finally:
+            subprocess.run(["git", "-C", str(REPO), "worktree", "remove", "--force", str(tree)], check=False)
+    best = {
+        w: {k: min(r[k] for r in rs) for k in ("field_us", "tangents_us", "solve_s_per_ms")}
+        for w, rs in runs.items()
+    }
+    for w, rs in runs.items():
+        best[w].update(
+            {k: rs[0][k] for k in ("field_flops", "tangents_flops", "solve_step_attempts", "solve_ok")}
+        )
+    ratios = {
+        k: best["baseline"][k] / best["current"][k]
+        for k in ("field_us", "tangents_us", "solve_s_per_ms", "field_flops", "tangents_flops")
+    }
+    for w in best:
+        best[w]["tangents_vs_field"] = best[w]["tangents_us"] / best[w]["field_us"]
+    result = {
+        "benchmark": NAME,
+        "baseline": baseline,
+        "case": "reference bearing, 20,000 rpm, 1000 N; seeded quasi-static start",
+        "repeats": repeats,
+        "best": best,
+        "baseline_over_current": ratios,
+        "runs": runs,
+        "machine": _common.machine_info(),
+    }
+    rows = [
+        [k, best["baseline"][k], best["current"][k], ratios[k]]
+        for k in ("field_us", "tangents_us", "solve_s_per_ms", "field_flops", "tangents_flops")
+    ]
+    rows.append(
+        [
+            "field + 3 tangents / field",
+            best["baseline"]["tangents_vs_field"],
+            best["current"]["tangents_vs_field"],
+            "",
+        ]
+    )
+    rows.append(
+        [
+            "solve step attempts",
+            best["baseline"]["solve_step_attempts"],
+            best["current"]["solve_step_attempts"],
+            "",
+        ]
+    )
+    result["table"] = _common.format_table(
+        f"Field speed, this tree against {baseline} (min of {repeats} alternating processes)",
+        ["quantity", "baseline", "current", "baseline / current"],
+        rows,
+    )
+    print(result["table"])
+    _common.write_json(NAME, result)
+    return result
+
+
+if __name__ == "__main__":
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--baseline", default=BASELINE, help="git revision to compare against")
+    parser.add_argument("--repeats", type=int, default=3, help="alternating processes per tree")
+    parser.add_argument("--quick", action="store_true", help="one process per tree")
+    parser.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
+    a = parser.parse_args()
+    if a.child:
+        print(json.dumps(child()))
+    else:
+        main(a.baseline, 1 if a.quick else a.repeats)
