@@ -14,7 +14,7 @@ at, below and above zero penetration and at zero sliding (MODEL.md section 4).
 - Smoothing: `smooth_penetration`, `smooth_power`, `hertz_force`, `safe_norm`,
   `smooth_direction`.
 - Traction and friction: `traction_coefficient`, `traction_force` (and its `traction_factor`),
-  `friction_force` (and its `friction_factor`).
+  `friction_force`.
 - Normal damping (Hunt & Crossley 1975): `hunt_crossley_force`, `hunt_crossley_factor`,
   `restitution_coefficient`, `HUNT_CROSSLEY_ALPHA`.
 - Lubricated point contact: Hamrock & Dowson (1977) film thickness `minimum_film_thickness`,
@@ -81,7 +81,6 @@ from ._smooth import (
     smooth_power,
 )
 from ._traction import (
-    friction_factor,
     friction_force,
     traction_coefficient,
     traction_factor,
@@ -113,7 +112,6 @@ __all__ = [
     "entrainment_radii",
     "entrainment_velocity",
     "film_parameter",
-    "friction_factor",
     "friction_force",
     "hamrock_brewe_parameters",
     "hertz_force",

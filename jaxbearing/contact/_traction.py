@@ -42,6 +42,12 @@ def traction_coefficient(
     return (a + b * du) * jnp.exp(-c * du) + d
 
 
+def _regularised_speed(u, speed_eps):
+    u = jnp.asarray(u)
+    eps2 = jnp.asarray(speed_eps)[..., None] ** 2
+    return u, jnp.sqrt(jnp.sum(u * u, axis=-1, keepdims=True) + eps2)
+
+
 def traction_force(
     sliding_velocity: Float[ArrayLike, "*batch dim"],
     normal_load: Float[ArrayLike, "*#batch"],
@@ -96,18 +102,6 @@ def friction_force(
         coefficient: mu.
         speed_eps: u_eps [m/s].
     """
-    u = jnp.asarray(sliding_velocity)
-    factor = friction_factor(jnp.sum(u * u, axis=-1), normal_load, coefficient, speed_eps)
-    return factor[..., None] * u
-
-
-def friction_factor(
-    sliding_speed_squared: Float[ArrayLike, "*batch"],
-    normal_load: Float[ArrayLike, "*#batch"],
-    coefficient: Float[ArrayLike, "*#batch"],
-    speed_eps: Float[ArrayLike, "*#batch"] = SLIDING_EPS,
-) -> Float[Array, "*batch"]:
-    """-mu Q / sqrt(|u|^2 + u_eps^2) [N s/m]: `friction_force` is this factor times u (takes
-    |u|^2, like `traction_factor`)."""
-    s = jnp.sqrt(jnp.asarray(sliding_speed_squared) + jnp.asarray(speed_eps) ** 2)
-    return -jnp.asarray(coefficient) * jnp.asarray(normal_load) / s
+    u, s = _regularised_speed(sliding_velocity, speed_eps)
+    mu_q = jnp.asarray(coefficient) * jnp.asarray(normal_load)
+    return -mu_q[..., None] * u / s

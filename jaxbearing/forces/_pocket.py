@@ -57,13 +57,13 @@ from ..contact import (
     PENETRATION_WIDTH,
     SLIDING_EPS,
     effective_modulus,
-    friction_factor,
     hunt_crossley_factor,
     line_contact_stiffness,
     line_slice_loads,
+    safe_norm,
+    smooth_direction,
 )
 from ..geometry import Bearing
-from ._components import components, dot, expand, relative_velocity, resultants, safe_unit
 from ._raceway import slice_positions
 
 #: Default number of slices of the roller-pocket line contact.
@@ -121,48 +121,51 @@ def pocket_contact(
     pocket centre c_p and unit tangential direction t_c (wall normals +/- t_c); cage velocity
     v_c, angular velocity Omega_c (3,) and centre c_c. `num_slices` is static. Vmap over rollers.
     """
-    p, e = components(roller_centre), components(roller_axis)
-    t, c_p, c_c = components(pocket_tangent), components(pocket_centre), components(cage_centre)
+    p = jnp.asarray(roller_centre)
+    e = jnp.asarray(roller_axis)
+    t = jnp.asarray(pocket_tangent)
+    c_p = jnp.asarray(pocket_centre)
+    c_c = jnp.asarray(cage_centre)
     d = bearing.roller.diameter
     wall = (d + bearing.cage.pocket_clearance) / 2
-    xi = pocket_slice_positions(bearing, num_slices)  # (N,)
-    side = jnp.array([1.0, -1.0])[:, None]  # +wall, -wall, (2, 1)
 
-    # tangential offsets of the slice centres q = p + xi e: (q - c_p).t = (p - c_p).t + xi (e.t)
-    t_e = dot(t, e)
-    y = dot(tuple(a - b for a, b in zip(p, c_p, strict=True)), t)[..., None] + xi * t_e[..., None]
-    u_len, u_hat = safe_unit(tuple(tc - t_e * ec for tc, ec in zip(t, e, strict=True)), t)
-    delta = side * y[..., None, :] + (d / 2 * u_len)[..., None, None] - wall  # (2, N)
+    xi = pocket_slice_positions(bearing, num_slices)  # (N,)
+    q = p + xi[:, None] * e  # (N, 3) slice centres
+    y = (q - c_p) @ t  # (N,) tangential offsets
+
+    u = t - jnp.dot(t, e) * e
+    u_len = safe_norm(u)
+    ok = u_len > 0
+    u_hat = jnp.where(ok, u / jnp.where(ok, u_len, 1.0), t)
+    support = d / 2 * u_len
+
+    side = jnp.array([1.0, -1.0])  # +wall, -wall
+    delta = side[:, None] * y[None, :] + support - wall  # (2, N)
+    normal = side[:, None] * t  # (2, 3), outward: roller -> wall
+    extreme = q[None, :, :] + side[:, None, None] * (d / 2) * u_hat  # (2, N, 3)
+    x = extreme - 0.5 * delta[..., None] * normal[:, None, :]  # middle of the overlap
+
     q_el = line_slice_loads(delta, pocket_stiffness(bearing), num_slices, penetration_width)
 
-    # lever arms x - p of the contact points (middle of the overlap), normal side t outwards
-    t_s, u_s = expand(expand(t)), expand(expand(u_hat))
-    arm = tuple(
-        xi * ec[..., None, None] + side * (d / 2 * uc - 0.5 * delta * tc)
-        for ec, uc, tc in zip(e, u_s, t_s, strict=True)
-    )
-    # v_rel = (v + w x arm) - (v_c + Omega_c x (x - c_c)), with x - c_c = (p - c_c) + arm
-    lever = tuple(a - b for a, b in zip(p, c_c, strict=True))  # p - c_c
-    v_rel = relative_velocity(
-        components(roller_velocity),
-        components(roller_angular_velocity),
-        components(cage_velocity),
-        components(cage_angular_velocity),
-        lever,
-        arm,
-    )
-    v_t = dot(v_rel, t_s)
-    approach_rate = side * v_t  # d(delta)/dt along the outward normal side t
-    n_load = q_el * hunt_crossley_factor(approach_rate, damping)  # (2, N)
-    slide = tuple(v - v_t * tc for v, tc in zip(v_rel, t_s, strict=True))
-    mu = friction_factor(dot(slide, slide), n_load, bearing.pocket_friction, speed_eps)
-    f_slices = tuple(-n_load * side * tc + mu * sc for tc, sc in zip(t_s, slide, strict=True))
-    force, moment, moment_about_cage = resultants(f_slices, arm, lever, 2)
-    signed = jnp.sum(n_load[..., 1, :], axis=-1) - jnp.sum(n_load[..., 0, :], axis=-1)
+    v_roller = roller_velocity + jnp.cross(roller_angular_velocity, x - p)
+    v_cage = cage_velocity + jnp.cross(cage_angular_velocity, x - c_c)
+    v_rel = v_roller - v_cage  # (2, N, 3)
+    approach_rate = jnp.sum(v_rel * normal[:, None, :], axis=-1)  # d(delta)/dt
+    factor = hunt_crossley_factor(approach_rate, damping)
+    n_load = q_el * factor  # (2, N)
+
+    slide = v_rel - approach_rate[..., None] * normal[:, None, :]
+    friction = -bearing.pocket_friction * n_load[..., None] * smooth_direction(slide, speed_eps)
+    f_slices = -n_load[..., None] * normal[:, None, :] + friction  # on the roller, (2, N, 3)
+
+    force = jnp.sum(f_slices, axis=(0, 1))
+    moment = jnp.sum(jnp.cross(x - p, f_slices), axis=(0, 1))
+    cage_moment = -jnp.sum(jnp.cross(x - c_c, f_slices), axis=(0, 1))
+    signed = jnp.sum(n_load[1]) - jnp.sum(n_load[0])
     return PocketContact(
         normal_force=signed,
         force_on_roller=force,
         moment_on_roller=moment,
         force_on_cage=-force,
-        moment_on_cage=-moment_about_cage,
+        moment_on_cage=cage_moment,
     )
