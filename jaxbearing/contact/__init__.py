@@ -13,8 +13,7 @@ at, below and above zero penetration and at zero sliding (MODEL.md section 4).
   `line_power` (the slice law's power with a hand-written tangent).
 - Smoothing: `smooth_penetration`, `smooth_power`, `hertz_force`, `safe_norm`,
   `smooth_direction`.
-- Traction and friction: `traction_coefficient`, `traction_force` (and its `traction_factor`),
-  `friction_force`.
+- Traction and friction: `traction_coefficient`, `traction_force`, `friction_force`.
 - Normal damping (Hunt & Crossley 1975): `hunt_crossley_force`, `hunt_crossley_factor`,
   `restitution_coefficient`, `HUNT_CROSSLEY_ALPHA`.
 - Lubricated point contact: Hamrock & Dowson (1977) film thickness `minimum_film_thickness`,
@@ -80,12 +79,7 @@ from ._smooth import (
     smooth_penetration,
     smooth_power,
 )
-from ._traction import (
-    friction_force,
-    traction_coefficient,
-    traction_factor,
-    traction_force,
-)
+from ._traction import friction_force, traction_coefficient, traction_force
 
 __all__ = [
     "ASPERITY_EXPONENT",
@@ -136,7 +130,6 @@ __all__ = [
     "smooth_penetration",
     "smooth_power",
     "traction_coefficient",
-    "traction_factor",
     "traction_force",
     "viscosity_at_temperature",
 ]

@@ -67,22 +67,9 @@ def traction_force(
         lubricant: traction curve (`traction_coefficient`).
         speed_eps: u_eps [m/s], default `SLIDING_EPS`.
     """
-    u = jnp.asarray(sliding_velocity)
-    factor = traction_factor(jnp.sum(u * u, axis=-1), normal_load, lubricant, speed_eps)
-    return factor[..., None] * u
-
-
-def traction_factor(
-    sliding_speed_squared: Float[ArrayLike, "*batch"],
-    normal_load: Float[ArrayLike, "*#batch"],
-    lubricant: Lubricant,
-    speed_eps: Float[ArrayLike, "*#batch"] = SLIDING_EPS,
-) -> Float[Array, "*batch"]:
-    """-Q kappa(s) / s, s = sqrt(|u|^2 + u_eps^2) [N s/m]: the traction force of
-    `traction_force` is this factor times the sliding velocity u. Takes |u|^2, so that a caller
-    holding u by components (the sliced raceway contact) needs no stacked 3-vector."""
-    s = jnp.sqrt(jnp.asarray(sliding_speed_squared) + jnp.asarray(speed_eps) ** 2)
-    return -jnp.asarray(normal_load) * traction_coefficient(s, lubricant) / s
+    u, s = _regularised_speed(sliding_velocity, speed_eps)
+    kappa = traction_coefficient(s, lubricant)
+    return -jnp.asarray(normal_load)[..., None] * kappa * u / s
 
 
 def friction_force(

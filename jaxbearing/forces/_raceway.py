@@ -91,15 +91,23 @@ from ..contact import (
     hunt_crossley_factor,
     line_contact_stiffness,
     line_slice_loads,
-    traction_factor,
+    safe_norm,
+    traction_force,
 )
 from ..geometry import Bearing, Roller, sag
-from ._components import Vec, components, dot, expand, relative_velocity, resultants, safe_unit, stack
 
 #: load weight added to each slice in the load-weighted mean sliding speed [N] (avoids 0/0).
 _MEAN_WEIGHT_EPS = 1e-12
 
 _AXIS = np.array([1.0, 0.0, 0.0])
+
+
+def _safe_unit(v: Array, fallback: Array) -> tuple[Array, Array]:
+    """(|v|, v/|v|) with the double-where pattern; `fallback` where |v| = 0."""
+    n = safe_norm(v, axis=-1, keepdims=True)
+    ok = n > 0
+    u = jnp.where(ok, v / jnp.where(ok, n, 1.0), fallback)
+    return n[..., 0], u
 
 
 def slice_positions(bearing: Bearing, num_slices: int | None = None) -> Float[Array, " N_s"]:
@@ -171,46 +179,6 @@ def _check_ring_sign(ring_sign) -> None:
         )
 
 
-class _SliceGeometry(eqx.Module):
-    """`raceway_slice_geometry` by components: delta_j, the normals g n_j and the lever arms
-    x_j - p of the contact points from the roller centre."""
-
-    interference: Array
-    normals: Vec
-    arms: Vec
-
-
-def _slice_geometry(bearing, g, raceway_radius, roller_centre, roller_axis, ring_centre, ring_axis):
-    """The module docstring's geometry, slice by slice: rho_j = rho_0 + xi_j e_perp with
-    rho_0 = (p - c_r) - ((p - c_r).a) a and e_perp = e - (e.a) a taken once per roller."""
-    e, a = components(roller_axis), components(_AXIS if ring_axis is None else ring_axis)
-    rel = tuple(pc - cc for pc, cc in zip(components(roller_centre), components(ring_centre), strict=True))
-    rel_a, e_a = dot(rel, a), dot(e, a)
-    xi = slice_positions(bearing)
-    rho = tuple(
-        (r - rel_a * ac)[..., None] + xi * (ec - e_a * ac)[..., None]
-        for r, ec, ac in zip(rel, e, a, strict=True)
-    )
-    zero, one = jnp.zeros_like(rho[0]), jnp.ones_like(rho[0])
-    dist, n_r = safe_unit(rho, (zero, zero, one))
-    e_s = expand(e)
-
-    # support of the slice disc (normal e, radius r) in the direction n_r: r |n_r - (e.n_r) e|
-    cos_tilt = dot(n_r, e_s)
-    perp = tuple(n - cos_tilt * ec for n, ec in zip(n_r, e_s, strict=True))
-    support_factor, u_ext = safe_unit(perp, n_r)
-    radius = bearing.roller.diameter / 2 - crown_drop(bearing.roller, xi)
-    interference = radius * support_factor + g * (raceway_radius - dist)
-
-    normals = tuple(g * n for n in n_r)
-    # disc point deepest into the raceway, moved back by delta/2 along the normal
-    arms = tuple(
-        xi * ec - g * radius * u + 0.5 * interference * n
-        for ec, u, n in zip(e_s, u_ext, normals, strict=True)
-    )
-    return _SliceGeometry(interference=interference, normals=normals, arms=arms)
-
-
 def raceway_slice_geometry(
     bearing: Bearing,
     ring_sign: ArrayLike,
@@ -232,9 +200,26 @@ def raceway_slice_geometry(
     """
     _check_ring_sign(ring_sign)
     g = jnp.asarray(ring_sign, dtype=float)
-    geo = _slice_geometry(bearing, g, raceway_radius, roller_centre, roller_axis, ring_centre, ring_axis)
-    points = tuple(pc[..., None] + arm for pc, arm in zip(components(roller_centre), geo.arms, strict=True))
-    return geo.interference, stack(points), stack(geo.normals)
+    e = roller_axis
+    a = _AXIS if ring_axis is None else ring_axis
+    xi = slice_positions(bearing)
+    q = roller_centre + xi[:, None] * e  # slice centres on the roller axis
+    rel = q - ring_centre
+    rho = rel - (rel @ a)[:, None] * a  # radial offset from the ring axis
+    fallback_n = jnp.broadcast_to(jnp.array([0.0, 0.0, 1.0]), rho.shape)
+    dist, n_r = _safe_unit(rho, fallback_n)
+
+    # support of the slice disc (normal e, radius r) in the direction n_r: r |n_r - (e.n_r) e|
+    cos_tilt = n_r @ e
+    perp = n_r - cos_tilt[:, None] * e
+    support_factor, u_ext = _safe_unit(perp, n_r)
+    radius = bearing.roller.diameter / 2 - crown_drop(bearing.roller, xi)
+    interference = radius * support_factor + g * (raceway_radius - dist)
+
+    normals = g * n_r
+    extreme = q - g * radius[:, None] * u_ext  # disc point deepest into the raceway
+    contact_points = extreme + 0.5 * interference[:, None] * normals
+    return interference, contact_points, normals
 
 
 class RacewayContact(eqx.Module):
@@ -281,49 +266,43 @@ def raceway_contact(
     Vectorised over slices; vmap it over rollers.
     """
     _check_ring_sign(ring_sign)
-    g = jnp.asarray(ring_sign, dtype=float)
-    geo = _slice_geometry(bearing, g, raceway_radius, roller_centre, roller_axis, ring_centre, ring_axis)
-    delta, n, arm = geo.interference, geo.normals, geo.arms
+    delta, x, n = raceway_slice_geometry(
+        bearing, ring_sign, raceway_radius, roller_centre, roller_axis, ring_centre, ring_axis=ring_axis
+    )
     q_el = slice_loads_from_interference(bearing, delta, penetration_width)
 
-    # v_rel = (v_b + w_b x arm) - (v_r + w_r x (x - c_r)), with x - c_r = (p - c_r) + arm
-    p = components(roller_centre)
-    lever = tuple(a - b for a, b in zip(p, components(ring_centre), strict=True))  # p - c_r
-    v_rel = relative_velocity(
-        components(roller_velocity),
-        components(roller_angular_velocity),
-        components(ring_velocity),
-        components(ring_angular_velocity),
-        lever,
-        arm,
-    )
-    v_n = dot(v_rel, n)
+    v_roller = roller_velocity + jnp.cross(roller_angular_velocity, x - roller_centre)
+    v_ring = ring_velocity + jnp.cross(ring_angular_velocity, x - ring_centre)
+    v_rel = v_roller - v_ring
+    v_n = jnp.sum(v_rel * n, axis=-1)
     approach_rate = -v_n  # d(delta)/dt: positive while the bodies close in
-    normal = q_el * hunt_crossley_factor(approach_rate, damping)
+    factor = hunt_crossley_factor(approach_rate, damping)
+    normal = q_el * factor
 
-    u = tuple(v - v_n * nc for v, nc in zip(v_rel, n, strict=True))
-    u_sq = dot(u, u)
-    traction = tuple(traction_factor(u_sq, normal, bearing.lubricant, speed_eps) * uc for uc in u)
+    u = v_rel - v_n[:, None] * n
+    lub = bearing.lubricant
+    traction = traction_force(u, normal, lub, speed_eps)
 
-    f_slices = tuple(normal * nc + t for nc, t in zip(n, traction, strict=True))
-    force, moment, moment_about_ring = resultants(f_slices, arm, lever, 1)
+    f_slices = normal[:, None] * n + traction
+    force = jnp.sum(f_slices, axis=0)
+    moment = jnp.sum(jnp.cross(x - roller_centre, f_slices), axis=0)
+    ring_moment = -jnp.sum(jnp.cross(x - ring_centre, f_slices), axis=0)
 
-    speed = jnp.where(u_sq > 0, jnp.sqrt(jnp.where(u_sq > 0, u_sq, 1.0)), 0.0)
+    speed = safe_norm(u, axis=-1)
     weight = normal + _MEAN_WEIGHT_EPS
-    mean_speed = jnp.sum(weight * speed, axis=-1) / jnp.sum(weight, axis=-1)
-    points = tuple(pc[..., None] + a for pc, a in zip(p, arm, strict=True))
+    mean_speed = jnp.sum(weight * speed) / jnp.sum(weight)
     return RacewayContact(
         interference=delta,
         slice_loads=normal,
         elastic_slice_loads=q_el,
-        normal_load=jnp.sum(normal, axis=-1),
-        contact_points=stack(points),
-        normals=stack(n),
-        sliding_velocity=stack(u),
-        slice_traction=stack(traction),
+        normal_load=jnp.sum(normal),
+        contact_points=x,
+        normals=n,
+        sliding_velocity=u,
+        slice_traction=traction,
         mean_sliding_speed=mean_speed,
         force_on_roller=force,
         moment_on_roller=moment,
         force_on_ring=-force,
-        moment_on_ring=-moment_about_ring,
+        moment_on_ring=ring_moment,
     )
