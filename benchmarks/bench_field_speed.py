@@ -133,22 +133,30 @@ def _run_child(tree: Path) -> dict:
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
-def check_revision(rev: str) -> None:
-    """ValueError naming `rev` unless git resolves it to a commit of this repository."""
-    out = subprocess.run(
-        ["git", "-C", str(REPO), "rev-parse", "--verify", "--quiet", f"{rev}^{{commit}}"],
-        capture_output=True,
-        check=False,
-    )
-    if out.returncode != 0:
-        raise ValueError(f"revision {rev!r} is not a commit of {REPO} (git rev-parse --verify failed)")
+class UsageError(ValueError):
+    """An argument of `main` out of range (the command line prints it as a usage error)."""
+
+
+def check_arguments(baseline: str, current: str | None, repeats: int) -> None:
+    """UsageError naming the argument unless `repeats` >= 1 and git resolves `baseline` and
+    `current` (when given) to commits of this repository."""
+    if repeats < 1:
+        raise UsageError(f"--repeats = {repeats}: must be at least 1")
+    for name, rev in (("--baseline", baseline), ("--current", current)):
+        if rev is None:
+            continue
+        out = subprocess.run(
+            ["git", "-C", str(REPO), "rev-parse", "--verify", "--quiet", f"{rev}^{{commit}}"],
+            capture_output=True,
+            check=False,
+        )
+        if out.returncode != 0:
+            raise UsageError(f"{name} = {rev!r}: not a commit of {REPO} (git rev-parse --verify failed)")
 
 
 def main(quick: bool = False, baseline: str = BASELINE, current: str | None = None, repeats: int = 3) -> dict:
     repeats = 1 if quick else repeats
-    for rev in (baseline, current):
-        if rev is not None:
-            check_revision(rev)
+    check_arguments(baseline, current, repeats)
     runs: dict[str, list[dict]] = {"baseline": [], "current": []}
     revisions = {"baseline": baseline, "current": current}
     with tempfile.TemporaryDirectory() as tmp:
@@ -236,15 +244,10 @@ if __name__ == "__main__":
     parser.add_argument("--quick", action="store_true", help="one process per tree")
     parser.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
     a = parser.parse_args()
-    if a.repeats < 1:
-        parser.error(f"--repeats = {a.repeats}: must be at least 1")
-    for name, rev in (("--baseline", a.baseline), ("--current", a.current)):
-        try:
-            if rev is not None:
-                check_revision(rev)
-        except ValueError as err:
-            parser.error(f"{name}: {err}")
     if a.child:
         print(json.dumps(child()))
     else:
-        main(a.quick, a.baseline, a.current, a.repeats)
+        try:
+            main(a.quick, a.baseline, a.current, a.repeats)
+        except UsageError as err:
+            parser.error(str(err))
