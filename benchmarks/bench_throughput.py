@@ -48,15 +48,21 @@ def _inputs(batch: int, duration: float):
 
 
 def measure(
-    batch: int, duration: float, num_saves: int = 50, max_steps: int = 100_000, repeats: int = 1
+    batch: int,
+    duration: float,
+    num_saves: int = 50,
+    max_steps: int = 100_000,
+    repeats: int = 1,
+    devices: tuple | None = None,
 ) -> dict:
-    """Compile time, best wall time and cases/s of one vmapped, sharded batch of `batch`."""
+    """Compile time, best wall time and cases/s of one vmapped, sharded batch of `batch` over
+    `devices` (default: every local device of the default backend)."""
     import jax
     import numpy as np
 
     from jaxbearing.sweep import batch_runner, padded_size
 
-    devices = tuple(jax.local_devices())
+    devices = tuple(jax.local_devices() if devices is None else devices)
     size = padded_size(batch, len(devices))
     inputs = _inputs(size, duration)
     runner = batch_runner(num_saves, max_steps, devices)
@@ -74,6 +80,7 @@ def measure(
         "batch_size": batch,
         "padded_to": size,
         "devices": len(devices),
+        "platform": devices[0].platform,
         "simulated_time_ms": duration * 1e3,
         "compile_s": round(compile_s, 3),
         "wall_s": round(wall, 4),

@@ -118,3 +118,54 @@ def test_long_studies_declare_their_own_time_limit():
     assert run_all.timeout_for("bench_work_precision_settled", quick=False) == 2400
     assert run_all.timeout_for("bench_work_precision_settled", quick=True) == run_all.DEFAULT_TIMEOUT_S[True]
     assert run_all.timeout_for("bench_scipy", quick=False) == run_all.DEFAULT_TIMEOUT_S[False]
+
+
+def test_accelerator_throughput_checks_its_arguments_and_needs_an_accelerator(capsys, monkeypatch):
+    import accelerator_throughput as at
+
+    for argv in (["--sizes", "0,8"], ["--sizes", "a"], ["--cpu-sizes", "8"], ["--members", "0"]):
+        with pytest.raises(SystemExit) as exc:
+            at._parse(argv)
+        assert exc.value.code == 2
+        assert argv[0] in capsys.readouterr().err
+    monkeypatch.delenv("JAXBEARING_BENCH_GPU_ON_CPU", raising=False)
+    if at.accelerator() is None:
+        with pytest.raises(at.UsageError, match="no accelerator"):
+            at.main()
+
+
+def test_accelerator_throughput_copies_differ_by_the_nudge_alone():
+    import accelerator_throughput as at
+    import jax
+    import numpy as np
+
+    import jaxbearing as jb
+    from jaxbearing.run import initial_state
+
+    bearing = jb.reference_bearing()
+    shape = jax.eval_shape(lambda: initial_state(bearing, jb.reference_operating_point(), None))
+    state = jax.tree_util.tree_map(lambda s: np.ones(s.shape, s.dtype), shape)
+    copies = at._copies(state, 3)
+    axial = np.asarray(copies.rollers.axial)
+    assert axial.shape == (3, bearing.num_rollers)
+    np.testing.assert_array_equal(axial[0], 1.0)  # copy 0 is the state itself
+    assert 0 < np.max(np.abs(axial[1:] - 1.0)) <= at.COPY_NUDGE
+    assert not np.array_equal(axial[1], axial[2])
+    # every other coordinate is the state's, in every copy
+    nudged = jax.tree_util.tree_map(lambda _: False, copies)
+    nudged = _mark_axial(nudged)
+    for leaf, ref, is_axial in zip(
+        jax.tree_util.tree_leaves(copies),
+        jax.tree_util.tree_leaves(state),
+        jax.tree_util.tree_leaves(nudged),
+        strict=True,
+    ):
+        if not is_axial:
+            np.testing.assert_array_equal(np.asarray(leaf), np.broadcast_to(ref, np.shape(leaf)))
+
+
+def _mark_axial(tree):
+    """`tree` with the roller axial-position leaf set to True."""
+    import equinox as eqx
+
+    return eqx.tree_at(lambda t: t.rollers.axial, tree, True)
