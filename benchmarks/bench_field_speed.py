@@ -17,10 +17,14 @@ quasi-static start:
 * ``solve_s_per_ms``: `jaxbearing.solve` (Tsit5, default tolerances, 2 saves) over `DURATION`,
   compile excluded, wall per simulated ms, with its step attempts (the two trees differ in
   rounding only, so their step counts agree to a few per cent);
+* ``sampled_solve_compile_s`` and ``sampled_solve_s_per_ms``: the same solve with `SAMPLES`
+  samples, the time from tracing to the compiled program (caches off) and the run's wall per
+  simulated ms;
 * ``flops``: XLA's operation count of the field and of the field with 3 tangents (independent
   of the load).
 
     python benchmarks/bench_field_speed.py [--baseline REV] [--current REV] [--repeats N] [--quick]
+        [--output NAME]
 
 Measured (results/bench_field_speed.json): the raceway slices written by components, tuples of
 (x, y, z) arrays over rollers x slices with the forces and moments summed by one stacked
@@ -39,6 +43,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -53,7 +58,10 @@ NAME = "bench_field_speed"
 BASELINE = "92d850e"
 EVALS = 400
 DURATION = 0.5e-3  # [s]
+SAMPLES = 500  # samples of the sampled solve (`sampled_solve_*`)
 REPO = Path(__file__).resolve().parent.parent
+#: the timings of a child process (the minimum over processes is reported)
+TIMED = ("field_us", "tangents_us", "solve_s_per_ms", "sampled_solve_compile_s", "sampled_solve_s_per_ms")
 
 
 def _loop_time(fn, repeats: int = 7) -> float:
@@ -101,21 +109,36 @@ def child() -> dict:
         cost = jax.jit(fn).lower(x0, y0).compile().cost_analysis()
         return float((cost[0] if isinstance(cost, list) else cost)["flops"])
 
-    solve = jax.jit(
-        lambda b: jb.run.solve(b, op, DURATION, num_saves=2, perturbation=jb.Perturbation(seed=0))
-    )
-    sol = solve(bearing)
-    jax.block_until_ready(sol)
-    walls = []
-    for _ in range(3):
+    def timed_solve(num_saves: int):
+        """(compile s, trace to compiled program; min run wall of 3; the solution)"""
         t = time.perf_counter()
-        sol = solve(bearing)
-        jax.block_until_ready(sol)
-        walls.append(time.perf_counter() - t)
+        compiled = (
+            jax.jit(
+                lambda b: jb.run.solve(
+                    b, op, DURATION, num_saves=num_saves, perturbation=jb.Perturbation(seed=0)
+                )
+            )
+            .lower(bearing)
+            .compile()
+        )
+        compile_s = time.perf_counter() - t
+        jax.block_until_ready(compiled(bearing))
+        walls = []
+        for _ in range(3):
+            t = time.perf_counter()
+            sol = compiled(bearing)
+            jax.block_until_ready(sol)
+            walls.append(time.perf_counter() - t)
+        return compile_s, min(walls), sol
+
+    _, wall, sol = timed_solve(2)
+    sampled_compile_s, sampled_wall, _ = timed_solve(SAMPLES)
     return {
         "field_us": 1e6 * _loop_time(looped(field)),
         "tangents_us": 1e6 * _loop_time(looped(tangents)),
-        "solve_s_per_ms": min(walls) / (DURATION * 1e3),
+        "solve_s_per_ms": wall / (DURATION * 1e3),
+        "sampled_solve_compile_s": sampled_compile_s,
+        "sampled_solve_s_per_ms": sampled_wall / (DURATION * 1e3),
         "solve_step_attempts": int(sol.num_steps),
         "solve_ok": int(sol.result) == 0,
         "field_flops": flops(field),
@@ -137,11 +160,14 @@ class UsageError(ValueError):
     """An argument of `main` out of range (the command line prints it as a usage error)."""
 
 
-def check_arguments(baseline: str, current: str | None, repeats: int) -> None:
-    """UsageError naming the argument unless `repeats` >= 1 and git resolves `baseline` and
-    `current` (when given) to commits of this repository."""
+def check_arguments(baseline: str, current: str | None, repeats: int, output: str = NAME) -> None:
+    """UsageError naming the argument unless `repeats` >= 1, `output` is a plain file name
+    (letters, digits, '_', '-') and git resolves `baseline` and `current` (when given) to
+    commits of this repository."""
     if repeats < 1:
         raise UsageError(f"--repeats = {repeats}: must be at least 1")
+    if not re.fullmatch(r"[A-Za-z0-9_-]+", output):
+        raise UsageError(f"--output = {output!r}: must be a file name of letters, digits, '_' and '-'")
     for name, rev in (("--baseline", baseline), ("--current", current)):
         if rev is None:
             continue
@@ -154,9 +180,16 @@ def check_arguments(baseline: str, current: str | None, repeats: int) -> None:
             raise UsageError(f"{name} = {rev!r}: not a commit of {REPO} (git rev-parse --verify failed)")
 
 
-def main(quick: bool = False, baseline: str = BASELINE, current: str | None = None, repeats: int = 3) -> dict:
+def main(
+    quick: bool = False,
+    baseline: str = BASELINE,
+    current: str | None = None,
+    repeats: int = 3,
+    output: str = NAME,
+) -> dict:
+    """Measure, print the table, write `results/<output>.json` (module docstring)."""
     repeats = 1 if quick else repeats
-    check_arguments(baseline, current, repeats)
+    check_arguments(baseline, current, repeats, output)
     runs: dict[str, list[dict]] = {"baseline": [], "current": []}
     revisions = {"baseline": baseline, "current": current}
     with tempfile.TemporaryDirectory() as tmp:
@@ -179,18 +212,12 @@ def main(quick: bool = False, baseline: str = BASELINE, current: str | None = No
                 subprocess.run(
                     ["git", "-C", str(REPO), "worktree", "remove", "--force", str(tree)], check=False
                 )
-    best = {
-        w: {k: min(r[k] for r in rs) for k in ("field_us", "tangents_us", "solve_s_per_ms")}
-        for w, rs in runs.items()
-    }
+    best = {w: {k: min(r[k] for r in rs) for k in TIMED} for w, rs in runs.items()}
     for w, rs in runs.items():
         best[w].update(
             {k: rs[0][k] for k in ("field_flops", "tangents_flops", "solve_step_attempts", "solve_ok")}
         )
-    ratios = {
-        k: best["baseline"][k] / best["current"][k]
-        for k in ("field_us", "tangents_us", "solve_s_per_ms", "field_flops", "tangents_flops")
-    }
+    ratios = {k: best["baseline"][k] / best["current"][k] for k in (*TIMED, "field_flops", "tangents_flops")}
     for w in best:
         best[w]["tangents_vs_field"] = best[w]["tangents_us"] / best[w]["field_us"]
     result = {
@@ -206,7 +233,7 @@ def main(quick: bool = False, baseline: str = BASELINE, current: str | None = No
     }
     rows = [
         [k, best["baseline"][k], best["current"][k], ratios[k]]
-        for k in ("field_us", "tangents_us", "solve_s_per_ms", "field_flops", "tangents_flops")
+        for k in (*TIMED, "field_flops", "tangents_flops")
     ]
     rows.append(
         [
@@ -230,7 +257,7 @@ def main(quick: bool = False, baseline: str = BASELINE, current: str | None = No
         rows,
     )
     print(result["table"])
-    _common.write_json(NAME, result)
+    _common.write_json(output, result)
     return result
 
 
@@ -242,12 +269,15 @@ if __name__ == "__main__":
     )
     parser.add_argument("--repeats", type=int, default=3, help="alternating processes per tree")
     parser.add_argument("--quick", action="store_true", help="one process per tree")
+    parser.add_argument(
+        "--output", default=NAME, help=f"results file name in benchmarks/results (default {NAME})"
+    )
     parser.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
     a = parser.parse_args()
     if a.child:
         print(json.dumps(child()))
     else:
         try:
-            main(a.quick, a.baseline, a.current, a.repeats)
+            main(a.quick, a.baseline, a.current, a.repeats, a.output)
         except UsageError as err:
             parser.error(str(err))

@@ -54,7 +54,7 @@ from ._ensemble import parallel_map
 from ._initial import STARTS, Perturbation, along_slow_mode, initial_state, skid_start
 from ._result import result_code
 from ._rosenbrock import DEFAULT_SOLVER, check_solver
-from ._simulate import SolveArgs, _diffeqsolve, _save
+from ._simulate import SolveArgs, _diffeqsolve, _histories, _saved_state
 from ._simulate import simulate as _simulate_fixed
 from ._statistics import steady_statistics
 from ._step_control import raceway_normal_norm, step_controller
@@ -104,19 +104,22 @@ def solve_from(
     solver=DEFAULT_SOLVER,
 ):
     """Integrate from the physical state `start` over [0, duration] with `solver` ("tsit5" or
-    "ros34pw2"): (histories, final state, diffrax result code, steps). Accumulators restart
-    from zero. jit-able; `adjoint` as in `solve` (`diffrax.ForwardMode()` for forward-mode
+    "ros34pw2"): (histories, final state, diffrax result code, steps); the histories are those
+    of `solve` (`_histories`), the final state carries the accumulators, which restart from zero. jit-able; `adjoint` as in `solve` (`diffrax.ForwardMode()` for forward-mode
     derivatives; `num_saves = 0` keeps only the final state)."""
     scaling, args, y0_scaled, controller = prepare_from(params, start, rtol, atol)
     last = diffrax.SubSaveAt(t1=True)
     if num_saves:
-        saves = diffrax.SubSaveAt(ts=jnp.linspace(0.0, duration, num_saves + 1)[:-1], fn=_save)
+        saves = diffrax.SubSaveAt(ts=jnp.linspace(0.0, duration, num_saves + 1)[:-1], fn=_saved_state)
         saveat = diffrax.SaveAt(subs=[saves, last])
     else:
         saveat = diffrax.SaveAt(subs=[last])
     with checks_without_host_callbacks():  # the same integrator and error norm as `solve`
         sol = _diffeqsolve(y0_scaled, args, duration, saveat, controller, max_steps, adjoint, False, solver)
-    hist, final = sol.ys if num_saves else ({}, sol.ys[0])
+    if num_saves:
+        hist, final = _histories(sol.ts[0], sol.ys[0], args), sol.ys[1]
+    else:
+        hist, final = {}, sol.ys[0]
     final = scaling.unscale(duration, jax.tree_util.tree_map(lambda a: a[-1], final))
     return hist, final, result_code(sol.result), jnp.asarray(sol.stats["num_steps"])
 
@@ -250,7 +253,7 @@ def _run_seed(
         if measuring and not windows:
             window_start = state
         hist, final, code, n = compiled(params, state, jnp.asarray(rev), jnp.asarray(rtol), jnp.asarray(atol))
-        hist = {k: np.asarray(v) for k, v in hist.items() if k != "accumulators"}
+        hist = {k: np.asarray(v) for k, v in hist.items()}
         steps += int(n)
         if int(code) != 0 or not np.all(np.isfinite(hist["cage_speed"])):
             status = (

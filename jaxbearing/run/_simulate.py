@@ -10,8 +10,12 @@
   tolerances `raceway_loosen` = 100 times looser (`_step_control`: their 62 kHz ringing need not
   be resolved to rtol); `max_steps` explicit. `solver="ros34pw2"` selects the linearly implicit
   Rosenbrock-W method with per-roller Jacobian blocks instead (`_rosenbrock`; slower, README).
-* Outputs through `SaveAt(ts=..., fn=...)`: only the flange-contact quantities, cage speed and
-  roller loads are kept, so memory does not grow with the state.
+* Outputs: the solve keeps only the scaled state at the sample times (`SaveAt(ts=...,
+  fn=_saved_state)`, without the accumulators), and the flange-contact quantities, cage speed
+  and roller loads are evaluated from those states after the loop (`_histories`), so memory
+  grows with the samples, not with the state, and the contacts are compiled once for the
+  samples instead of inside diffrax's saving (about 12 % less time to compile; README,
+  Performance).
 * Smooth peak functionals (p-norm of PV, log-sum-exp of the contact height) are integrated in the
   state and are differentiable with respect to every float parameter.
 * A failed solve (step limit, step size collapse on non-finite states) returns a result whose
@@ -20,6 +24,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import time
 
@@ -62,7 +67,45 @@ def scaled_field(t, y_scaled, args: SolveArgs):
     return args.scaling.scale_rate(physical_rates(t, y, args.params))
 
 
+#: samples whose outputs `_histories` evaluates at once (a vmapped chunk; a sweep's vmap over
+#: cases multiplies it, so it stays small)
+HISTORY_CHUNK = 8
+
+
+def _saved_state(t, y_scaled, args: SolveArgs):
+    """What the solve keeps at a sample time: the scaled state without its accumulators."""
+    return dataclasses.replace(y_scaled, accumulators=None)
+
+
+def _histories(ts, saved, args: SolveArgs) -> dict:
+    """The sampled outputs (`_save`) at the times `ts` from the states the solve kept
+    (`_saved_state`), evaluated after the loop, `HISTORY_CHUNK` samples at a time
+    (`jax.lax.map` over the samples padded to whole chunks; the padding is dropped).
+
+    Evaluating `_save` inside diffrax's saving instead (`SaveAt(fn=_save)`) gives the same
+    samples to rounding (4e-12 relative): the states are the same interpolants, and the
+    trajectory does not depend on what is saved. Here XLA compiles the contacts of the outputs
+    once, which takes about 12 % less time to compile a solve with samples (README)."""
+    n = ts.shape[0]
+    chunk = min(HISTORY_CHUNK, n)
+    m = -(-n // chunk) * chunk
+
+    def pad(a):
+        return jnp.concatenate([a, jnp.broadcast_to(a[-1:], (m - n, *a.shape[1:]))]) if m > n else a
+
+    no_integrals = jax.tree_util.tree_map(jnp.zeros_like, args.scaling.nominal.accumulators)
+
+    def one(sample):
+        t, y = sample
+        return _save(t, dataclasses.replace(y, accumulators=no_integrals), args)
+
+    out = jax.lax.map(one, (pad(ts), jax.tree_util.tree_map(pad, saved)), batch_size=chunk)
+    return jax.tree_util.tree_map(lambda a: a[:n], out)
+
+
 def _save(t, y_scaled, args: SolveArgs):
+    """The sampled outputs at time t of the scaled state `y_scaled` (flange contacts, cage,
+    inner ring, roller loads, axial positions and skew)."""
     y = args.scaling.unscale(t, y_scaled)
     loads = contact_loads(y, args.params)
     fl = loads.flange
@@ -94,7 +137,6 @@ def _save(t, y_scaled, args: SolveArgs):
         roller_outer_load=loads.outer.normal_load,
         roller_axial=y.rollers.axial,
         roller_skew=jnp.sum(e * tangential_unit(y.rollers.azimuth), axis=-1),
-        accumulators=y.accumulators,
     )
 
 
@@ -192,7 +234,8 @@ def solve(
     args = SolveArgs(params=Params(bearing=bearing, operating=op, functionals=functionals), scaling=scaling)
     y0_scaled = scaling.scale_state(0.0, y0)
     if num_saves:
-        saveat = diffrax.SaveAt(ts=jnp.linspace(0.0, duration, num_saves), fn=_save, t1=True)
+        samples = diffrax.SubSaveAt(ts=jnp.linspace(0.0, duration, num_saves), fn=_saved_state)
+        saveat = diffrax.SaveAt(subs=[samples, diffrax.SubSaveAt(t1=True, fn=_save_functionals)])
     else:
         saveat = diffrax.SaveAt(t1=True, fn=_save_functionals)
     norm = error_norm if error_norm is not None else raceway_normal_norm(y0_scaled, raceway_loosen)
@@ -210,9 +253,9 @@ def solve(
             solver,
         )
     if num_saves:
-        ys = dict(sol.ys)
-        acc = jax.tree_util.tree_map(lambda a: a[-1], ys.pop("accumulators"))
-        hist = jax.tree_util.tree_map(lambda a: a[:-1], ys)
+        saved, integrals = sol.ys
+        hist = _histories(sol.ts[0], saved, args)
+        acc = jax.tree_util.tree_map(lambda a: a[-1], integrals)
     else:
         hist, acc = {}, jax.tree_util.tree_map(lambda a: a[-1], sol.ys)
     return Solution(
