@@ -104,8 +104,9 @@ def solve_from(
     solver=DEFAULT_SOLVER,
 ):
     """Integrate from the physical state `start` over [0, duration] with `solver` ("tsit5" or
-    "ros34pw2"): (histories, final state, diffrax result code, steps); the histories are those
-    of `solve` (`_histories`), the final state carries the accumulators, which restart from zero. jit-able; `adjoint` as in `solve` (`diffrax.ForwardMode()` for forward-mode
+    "ros34pw2"): (histories, final state, diffrax result code, steps). The histories are
+    those of `solve` (`_histories`); the final state carries the accumulators, which restart
+    from zero. jit-able; `adjoint` as in `solve` (`diffrax.ForwardMode()` for forward-mode
     derivatives; `num_saves = 0` keeps only the final state)."""
     scaling, args, y0_scaled, controller = prepare_from(params, start, rtol, atol)
     last = diffrax.SubSaveAt(t1=True)
