@@ -27,13 +27,25 @@ Two parts (`--part sweep`, `--part ensemble`, or both):
    difference is under the reference's half-width). The same window of seed 0 is run once on
    the host CPU for the throughput ratio.
 
-    python benchmarks/accelerator_throughput.py [--part sweep|ensemble|all]
+3. **Steady gradient samples** (`--part gradient`). The short-window gradient estimator
+   (`jaxbearing.run.steady_gradient`, `optimise --estimator window`; the search's default is the
+   frozen-load estimator, which does not differentiate the trajectory) integrates, from each settled state, a short window
+   (`GRADIENT_WINDOW`, 1 ms) with three forward-mode tangents in (R_end, theta_f, Delta_bf)
+   (`window_integrals` under `forward_jacobian`, as its per-sample program does), one process
+   per core. Here the same copies of the 4 settled states (`--members` per seed) run as one
+   vmapped program on the accelerator, and the samples are combined by the estimator's own
+   ratio and jackknife (`_combine`); seed 0's state runs once on the host CPU, for the
+   throughput ratio and for the difference of its (A, C) integrals and their Jacobian from
+   the accelerator's member 0 (the same state).
+
+    python benchmarks/accelerator_throughput.py [--part sweep|ensemble|gradient|all]
         [--sizes 1,8,64,512,4096] [--cpu-sizes 1,8] [--duration-ms 1] [--members 64]
         [--repeats 2] [--output PATH]
 
 writes `results/accelerator_throughput.json` (or PATH) and prints a table. The committed results
 came from `--part sweep --output benchmarks/results/accelerator_sweep.json` and `--part ensemble
---members 128 --output benchmarks/results/accelerator_ensemble.json` on an H100 (README, On a
+--members 128 --output benchmarks/results/accelerator_ensemble.json` and `--part gradient
+--members 128 --output benchmarks/results/accelerator_gradient.json` on an H100 (README, On a
 GPU). Without an accelerator it stops with one line. It is not a `bench_*.py`, so `make bench`
 (which runs where CI runs, on CPUs) does not run it.
 """
@@ -273,6 +285,100 @@ def ensemble_part(members: int) -> dict:
     }
 
 
+# -- steady gradient samples ---------------------------------------------------------------------
+def gradient_part(members: int) -> dict:
+    import diffrax
+    import jax
+    import jax.numpy as jnp
+    import numpy as np
+    from bench_work_precision_settled import settled_start
+
+    import jaxbearing as jb
+    from jaxbearing.flange import DesignVariables
+    from jaxbearing.run import GRADIENT_WINDOW, forward_jacobian
+    from jaxbearing.run._steady_gradient import _combine, window_integrals
+
+    gpu, cpu = accelerator(), jax.devices("cpu")[0]
+    bearing, op = jb.reference_bearing(), jb.reference_operating_point()
+    x = jnp.asarray(DesignVariables.of(bearing).as_array(), float)
+    settled = {s: settled_start(bearing, op, s) for s in SEEDS}
+    stacked = jax.tree_util.tree_map(
+        lambda *xs: np.concatenate(xs), *[_copies(settled[s]["state"], members) for s in SEEDS]
+    )
+    window = GRADIENT_WINDOW
+
+    def one(b, o, start, v):
+        def f(w):
+            return window_integrals(
+                b, o, start, w, window, rtol=1e-3, atol=1e-6, max_steps=200_000, adjoint=diffrax.ForwardMode()
+            )
+
+        return forward_jacobian(f, v)
+
+    def timed(fn, *args):
+        t0 = time.perf_counter()
+        compiled = jax.jit(fn).lower(*args).compile()
+        compile_s = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        out = jax.device_get(jax.block_until_ready(compiled(*args)))
+        return out, compile_s, time.perf_counter() - t0
+
+    args_gpu = jax.device_put((bearing, op, stacked, x), gpu)
+    (vals, jacs), compile_gpu, wall_gpu = timed(jax.vmap(one, in_axes=(None, None, 0, None)), *args_gpu)
+    n = len(SEEDS) * members
+    _common.log(
+        f"{NAME}: {n} gradient samples on the accelerator in {wall_gpu:.1f} s (compile {compile_gpu:.1f} s)"
+    )
+    first = jax.tree_util.tree_map(lambda a: a[0], stacked)
+    (val_cpu, jac_cpu), compile_cpu, wall_cpu = timed(one, *jax.device_put((bearing, op, first, x), cpu))
+    _common.log(f"{NAME}: one gradient sample on the CPU in {wall_cpu:.1f} s (compile {compile_cpu:.1f} s)")
+
+    vals, jacs = np.asarray(vals), np.asarray(jacs)  # (n, 3), (n, 3 variables, 3 outputs)
+    est = _combine(
+        [(v[:2] if v[2] > 0.5 else np.full(2, np.nan), j[:, :2]) for v, j in zip(vals, jacs)], window
+    )
+    per_seed = [
+        _combine(
+            [
+                (v[:2], j[:, :2])
+                for v, j in zip(vals[k * members : (k + 1) * members], jacs[k * members : (k + 1) * members])
+            ],
+            window,
+        )
+        for k in range(len(SEEDS))
+    ]
+
+    def rel(a, b):
+        a, b = np.asarray(a, float), np.asarray(b, float)
+        return float(np.max(np.abs(a - b)) / np.max(np.abs(b)))
+
+    return {
+        "seeds": list(SEEDS),
+        "members_per_seed": members,
+        "window_ms": window * 1e3,
+        "samples_ok": int(np.sum(vals[:, 2] > 0.5)),
+        "compile_s": {"accelerator_batch": compile_gpu, "cpu_one": compile_cpu},
+        "wall_s": {"accelerator_batch": wall_gpu, "cpu_one": wall_cpu},
+        "throughput": {
+            "accelerator_samples_per_s": n / wall_gpu,
+            "cpu_samples_per_s": 1.0 / wall_cpu,
+            "ratio": n * wall_cpu / wall_gpu,
+        },
+        "estimate": {
+            "value_Pa_m_s": est.value,
+            "value_stderr": est.value_stderr,
+            "gradient": est.gradient,
+            "gradient_stderr": est.gradient_stderr,
+            "num_samples": est.num_samples,
+        },
+        "per_seed_gradient": [e.gradient for e in per_seed],
+        "cpu_vs_accelerator_member0": {
+            "integrals_relative_difference": rel(vals[0, :2], np.asarray(val_cpu)[:2]),
+            "jacobian_relative_difference": rel(jacs[0, :, :2], np.asarray(jac_cpu)[:, :2]),
+        },
+    }
+
+
 # -- table -------------------------------------------------------------------------------------
 def _table(result: dict) -> str:
     lines = []
@@ -353,6 +459,19 @@ def _table(result: dict) -> str:
                 rows,
             )
         )
+    if "gradient" in result:
+        gr = result["gradient"]
+        e = gr["estimate"]
+        lines.append(
+            f"steady gradient samples: {len(gr['seeds'])} seeds x {gr['members_per_seed']} members, window "
+            f"{gr['window_ms']:g} ms, 3 forward-mode tangents; accelerator {gr['wall_s']['accelerator_batch']:.1f} s "
+            f"for the batch ({gr['samples_ok']} ok), CPU {gr['wall_s']['cpu_one']:.1f} s for one sample: "
+            f"{gr['throughput']['ratio']:.1f}x the CPU's samples per second\n"
+            f"  estimate J = {e['value_Pa_m_s']:.4g} +- {e['value_stderr']:.2g} Pa m/s, dJ/dx = "
+            + ", ".join(f"{g:.3g} +- {s:.2g}" for g, s in zip(e["gradient"], e["gradient_stderr"]))
+            + f"\n  member 0 against the CPU: integrals {gr['cpu_vs_accelerator_member0']['integrals_relative_difference']:.1e},"
+            f" Jacobian {gr['cpu_vs_accelerator_member0']['jacobian_relative_difference']:.1e} relative"
+        )
     return "\n".join(lines)
 
 
@@ -382,6 +501,8 @@ def main(
         result["sweep"] = sweep_part(sizes, cpu_sizes, duration_ms * 1e-3, repeats)
     if part in ("ensemble", "all"):
         result["ensemble"] = ensemble_part(members)
+    if part in ("gradient", "all"):
+        result["gradient"] = gradient_part(members)
     result["table"] = _table(result)
     path = Path(output) if output else _common.RESULTS_DIR / f"{NAME}.json"
     _common.write_json(path.stem, result, path.parent)
@@ -391,7 +512,7 @@ def main(
 
 def _parse(argv):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--part", choices=("sweep", "ensemble", "all"), default="all")
+    parser.add_argument("--part", choices=("sweep", "ensemble", "gradient", "all"), default="all")
     parser.add_argument("--sizes", default="1,8,64,512,4096")
     parser.add_argument("--cpu-sizes", default="1,8")
     parser.add_argument("--duration-ms", type=float, default=1.0)
