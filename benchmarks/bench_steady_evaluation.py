@@ -2,11 +2,13 @@
 
 From the settled states of start 0 of the default `optimise run` (its checkpoint,
 out/bench_optimise_steady/run/checkpoint.pkl, written by `benchmarks/bench_optimise_steady.py`):
-`steady_design_metrics` (4 seeds, settle auto, 2-revolution window; continuation) then
+`steady_design_metrics` (4 seeds, the run's, settle auto, 2-revolution window; continuation) then
 `frozen_load_gradient` (8 x 1 ms), on 2 workers, twice in a row (the second call is the one a
 search iteration pays once compiled), first with a process pool per call, then inside one
 `jaxbearing.run.shared_workers` block. Reported: wall seconds of each part and simulated ms per
-second (`--quick`: one call each). Results: benchmarks/results/bench_steady_evaluation.json.
+second (`--quick`: one call each, from the quick run's checkpoint, run_quick/, when the full
+run's is missing, as on a fresh clone under `run_all.py --quick`). Results:
+benchmarks/results/bench_steady_evaluation.json.
 """
 
 from __future__ import annotations
@@ -20,9 +22,10 @@ sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import _common  # noqa: E402
 
 NAME = "bench_steady_evaluation"
-CHECKPOINT = (
-    pathlib.Path(__file__).resolve().parents[1] / "out" / "bench_optimise_steady" / "run" / "checkpoint.pkl"
-)
+_RUNS = pathlib.Path(__file__).resolve().parents[1] / "out" / "bench_optimise_steady"
+CHECKPOINT = _RUNS / "run" / "checkpoint.pkl"
+#: `--quick` without the full run's checkpoint: that of `bench_optimise_steady.py --quick`
+QUICK_CHECKPOINT = _RUNS / "run_quick" / "checkpoint.pkl"
 WORKERS = 2
 
 
@@ -41,7 +44,7 @@ def _timed(problem, u, chain, repeats: int = 2) -> list[dict]:
             problem.bearing,
             op,
             design,
-            seeds=4,
+            seeds=len(chain),  # 4 in the default run, 2 in the quick one
             window_revs=2,
             settle="auto",
             flange_load=problem.flange_load,
@@ -64,9 +67,13 @@ def main(quick: bool = False) -> dict:
     from jaxbearing.run import shared_workers
     from optimise import make_problem
 
-    if not CHECKPOINT.exists():
-        raise SystemExit(f"{CHECKPOINT}: missing; run benchmarks/bench_optimise_steady.py first")
-    with open(CHECKPOINT, "rb") as f:
+    checkpoint = QUICK_CHECKPOINT if quick and not CHECKPOINT.exists() else CHECKPOINT
+    if not checkpoint.exists():
+        raise SystemExit(
+            f"{checkpoint}: missing; run benchmarks/bench_optimise_steady.py"
+            f"{' --quick' if quick else ''} first"
+        )
+    with open(checkpoint, "rb") as f:
         state = pickle.load(f)["state"]
     problem = make_problem(jb.reference_bearing(), jb.reference_operating_point())
     u, chain = state["u"][0], state["chains"][0][0]
@@ -76,6 +83,7 @@ def main(quick: bool = False) -> dict:
         shared = _timed(problem, u, chain, repeats)
     out = {
         "benchmark": NAME,
+        "checkpoint": str(checkpoint.relative_to(_RUNS.parents[1])),
         "machine": _common.machine_info(),
         "pool_per_call": per_call,
         "shared_pool": shared,
