@@ -164,26 +164,43 @@ def sweep_part(sizes, cpu_sizes, duration: float, repeats: int) -> dict:
 def _copies(state, members: int):
     """`members` copies of one settled state; copy k > 0 with every roller's axial position
     moved by a uniform +-COPY_NUDGE (numpy seed k)."""
+    import dataclasses
+
     import jax
     import numpy as np
 
     out = []
     for k in range(members):
-        nudge = (
-            0.0
-            if k == 0
-            else np.random.default_rng(k).uniform(-COPY_NUDGE, COPY_NUDGE, state.rollers.axial.shape)
-        )
-        rollers = type(state.rollers)(
-            **{f: getattr(state.rollers, f) for f in state.rollers.__dataclass_fields__}
-            | {"axial": np.asarray(state.rollers.axial) + nudge}
-        )
-        out.append(
-            type(state)(
-                rollers=rollers, cage=state.cage, inner_ring=state.inner_ring, accumulators=state.accumulators
-            )
-        )
+        axial = np.asarray(state.rollers.axial)
+        if k > 0:
+            axial = axial + np.random.default_rng(k).uniform(-COPY_NUDGE, COPY_NUDGE, axial.shape)
+        out.append(dataclasses.replace(state, rollers=dataclasses.replace(state.rollers, axial=axial)))
     return jax.tree_util.tree_map(lambda *xs: np.stack([np.asarray(x) for x in xs]), *out)
+
+
+def _settled_copies(bearing, op, members: int):
+    """(settled starts of `SEEDS` from `bench_work_precision_settled.settled_start`, their
+    `members` copies each stacked seed after seed along one leading axis)."""
+    import jax
+    import numpy as np
+    from bench_work_precision_settled import settled_start
+
+    settled = {s: settled_start(bearing, op, s) for s in SEEDS}
+    copies = [_copies(settled[s]["state"], members) for s in SEEDS]
+    return settled, jax.tree_util.tree_map(lambda *xs: np.concatenate(xs), *copies)
+
+
+def _compile_and_run(fn, *args):
+    """(outputs on the host, compile s, run s) of `jax.jit(fn)` on `args` (placed on a device:
+    the program runs there)."""
+    import jax
+
+    t0 = time.perf_counter()
+    compiled = jax.jit(fn).lower(*args).compile()
+    compile_s = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    out = jax.device_get(jax.block_until_ready(compiled(*args)))
+    return out, compile_s, time.perf_counter() - t0
 
 
 def ensemble_part(members: int) -> dict:
@@ -193,7 +210,7 @@ def ensemble_part(members: int) -> dict:
     import jax.numpy as jnp
     import numpy as np
     from bench_work_precision import SAMPLE_DT, window_statistics
-    from bench_work_precision_settled import paired_over_seeds, settled_start, window_solve
+    from bench_work_precision_settled import paired_over_seeds, window_solve
 
     import jaxbearing as jb
     from jaxbearing.dynamics import Functionals, Params
@@ -203,12 +220,10 @@ def ensemble_part(members: int) -> dict:
     bearing, op = jb.reference_bearing(), jb.reference_operating_point()
     params = Params(bearing=bearing, operating=op, functionals=Functionals())
     omega_kin = float(jb.kinematic_cage_speed(bearing, op))
-    settled = {s: settled_start(bearing, op, s) for s in SEEDS}
+    settled, stacked = _settled_copies(bearing, op, members)
     rpm = float(np.mean([v["info"]["last_revolution_cage_speed_rpm"] for v in settled.values()]))
     num_saves = int(round(2 * 60.0 / rpm / SAMPLE_DT)) + 1
     window = (num_saves - 1) * SAMPLE_DT
-    starts = [_copies(settled[s]["state"], members) for s in SEEDS]
-    stacked = jax.tree_util.tree_map(lambda *xs: np.concatenate(xs), *starts)
     f = jnp.asarray
 
     def one(p, s):
@@ -217,26 +232,16 @@ def ensemble_part(members: int) -> dict:
         )
         return hist, code, steps
 
-    on_gpu, on_cpu = (jax.device_put((params, stacked), d) for d in (gpu, cpu))
-    batched, single = jax.jit(jax.vmap(one, in_axes=(None, 0))), jax.jit(one)
-    params, stacked = on_gpu
-    t0 = time.perf_counter()
-    batched_c = batched.lower(params, stacked).compile()
-    compile_gpu = time.perf_counter() - t0
-    _common.log(f"{NAME}: ensemble of {len(SEEDS) * members} compiled in {compile_gpu:.1f} s; running")
-    t0 = time.perf_counter()
-    hist, code, steps = jax.device_get(jax.block_until_ready(batched_c(params, stacked)))
-    wall_gpu = time.perf_counter() - t0
-    _common.log(f"{NAME}: ensemble ran in {wall_gpu:.1f} s")
-
-    params, stacked = on_cpu
-    one_start = jax.tree_util.tree_map(lambda x: x[0], stacked)
-    t0 = time.perf_counter()
-    single_c = single.lower(params, one_start).compile()
-    compile_cpu = time.perf_counter() - t0
-    t0 = time.perf_counter()
-    hist_cpu, code_cpu, steps_cpu = jax.device_get(jax.block_until_ready(single_c(params, one_start)))
-    wall_cpu = time.perf_counter() - t0
+    (hist, code, steps), compile_gpu, wall_gpu = _compile_and_run(
+        jax.vmap(one, in_axes=(None, 0)), *jax.device_put((params, stacked), gpu)
+    )
+    _common.log(
+        f"{NAME}: ensemble of {len(SEEDS) * members} in {wall_gpu:.1f} s (compile {compile_gpu:.1f} s)"
+    )
+    first = jax.tree_util.tree_map(lambda x: x[0], stacked)
+    (hist_cpu, code_cpu, steps_cpu), compile_cpu, wall_cpu = _compile_and_run(
+        one, *jax.device_put((params, first), cpu)
+    )
     _common.log(f"{NAME}: one window on the CPU in {wall_cpu:.1f} s")
 
     n = len(SEEDS) * members
@@ -291,7 +296,6 @@ def gradient_part(members: int) -> dict:
     import jax
     import jax.numpy as jnp
     import numpy as np
-    from bench_work_precision_settled import settled_start
 
     import jaxbearing as jb
     from jaxbearing.flange import DesignVariables
@@ -301,10 +305,7 @@ def gradient_part(members: int) -> dict:
     gpu, cpu = accelerator(), jax.devices("cpu")[0]
     bearing, op = jb.reference_bearing(), jb.reference_operating_point()
     x = jnp.asarray(DesignVariables.of(bearing).as_array(), float)
-    settled = {s: settled_start(bearing, op, s) for s in SEEDS}
-    stacked = jax.tree_util.tree_map(
-        lambda *xs: np.concatenate(xs), *[_copies(settled[s]["state"], members) for s in SEEDS]
-    )
+    _, stacked = _settled_copies(bearing, op, members)
     window = GRADIENT_WINDOW
 
     def one(b, o, start, v):
@@ -315,38 +316,25 @@ def gradient_part(members: int) -> dict:
 
         return forward_jacobian(f, v)
 
-    def timed(fn, *args):
-        t0 = time.perf_counter()
-        compiled = jax.jit(fn).lower(*args).compile()
-        compile_s = time.perf_counter() - t0
-        t0 = time.perf_counter()
-        out = jax.device_get(jax.block_until_ready(compiled(*args)))
-        return out, compile_s, time.perf_counter() - t0
-
     args_gpu = jax.device_put((bearing, op, stacked, x), gpu)
-    (vals, jacs), compile_gpu, wall_gpu = timed(jax.vmap(one, in_axes=(None, None, 0, None)), *args_gpu)
+    (vals, jacs), compile_gpu, wall_gpu = _compile_and_run(
+        jax.vmap(one, in_axes=(None, None, 0, None)), *args_gpu
+    )
     n = len(SEEDS) * members
     _common.log(
         f"{NAME}: {n} gradient samples on the accelerator in {wall_gpu:.1f} s (compile {compile_gpu:.1f} s)"
     )
     first = jax.tree_util.tree_map(lambda a: a[0], stacked)
-    (val_cpu, jac_cpu), compile_cpu, wall_cpu = timed(one, *jax.device_put((bearing, op, first, x), cpu))
+    (val_cpu, jac_cpu), compile_cpu, wall_cpu = _compile_and_run(
+        one, *jax.device_put((bearing, op, first, x), cpu)
+    )
     _common.log(f"{NAME}: one gradient sample on the CPU in {wall_cpu:.1f} s (compile {compile_cpu:.1f} s)")
 
     vals, jacs = np.asarray(vals), np.asarray(jacs)  # (n, 3), (n, 3 variables, 3 outputs)
-    est = _combine(
-        [(v[:2] if v[2] > 0.5 else np.full(2, np.nan), j[:, :2]) for v, j in zip(vals, jacs)], window
-    )
-    per_seed = [
-        _combine(
-            [
-                (v[:2], j[:, :2])
-                for v, j in zip(vals[k * members : (k + 1) * members], jacs[k * members : (k + 1) * members])
-            ],
-            window,
-        )
-        for k in range(len(SEEDS))
-    ]
+    # as `steady_gradient` combines them: a failed sample's integrals are NaN (left out)
+    samples = [(v[:2] if v[2] > 0.5 else np.full(2, np.nan), j[:, :2]) for v, j in zip(vals, jacs)]
+    est = _combine(samples, window)
+    per_seed = [_combine(samples[k * members : (k + 1) * members], window) for k in range(len(SEEDS))]
 
     def rel(a, b):
         a, b = np.asarray(a, float), np.asarray(b, float)

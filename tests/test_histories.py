@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 import jaxbearing as jb
-from jaxbearing.dynamics import Params, Scaling, state_scales
-from jaxbearing.run import Perturbation, initial_state
-from jaxbearing.run._simulate import HISTORY_CHUNK, SolveArgs, _histories, _save, _saved_state
+from jaxbearing.dynamics import Params
+from jaxbearing.run import Perturbation, initial_state, prepare_from
+from jaxbearing.run._simulate import HISTORY_CHUNK, _histories, _save, _saved_state
 
 
 @pytest.fixture(scope="module")
@@ -20,14 +20,10 @@ def samples():
     """Args of a solve and 2 chunks + 3 scaled states near the start (random deviations)."""
     b, op = jb.reference_bearing(), jb.reference_operating_point()
     y0 = initial_state(b, op, Perturbation(seed=3))
-    scaling = Scaling(
-        nominal=y0, scale=state_scales(b.num_rollers, b.pitch_diameter / 2), orbit_speed=op.inner_speed * 0.45
-    )
-    args = SolveArgs(params=Params(bearing=b, operating=op), scaling=scaling)
+    _, args, y0s, _ = prepare_from(Params(bearing=b, operating=op), y0, 1e-3, 1e-6)
     n = 2 * HISTORY_CHUNK + 3
     ts = jnp.linspace(0.0, 1e-4, n)
     rng = np.random.default_rng(0)
-    y0s = scaling.scale_state(0.0, y0)
     states = jax.tree_util.tree_map(lambda a: a + 0.3 * rng.standard_normal((n, *np.shape(a))), y0s)
     return ts, states, args
 
