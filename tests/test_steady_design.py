@@ -19,8 +19,10 @@ def small():
 def test_steady_design_metrics_report_intervals_and_margins(small):
     b, op = small
     design = DesignVariables(end_radius=0.08, layback_angle=1.6 * math.pi / 180, axial_clearance=0.15e-3)
+    # a settling time given as text is a settling time (it once ran as "auto", two revolutions more)
     m = jb.steady_design_metrics(b, op, design, seeds=2, window_revs=2, settle="0.5", first_seed=5)
     assert m.seeds == [5, 6] and m.settled
+    assert m.summary["settle_mode"] == "fixed" and m.summary["settle_time_ms"] == pytest.approx(0.5)
     for est in (m.mean_pv, m.p95_pv, m.corner_contact_share, m.corner_margin):
         assert est["ci95_low"] <= est["value"] <= est["ci95_high"] and est["n"] == 2
     assert 0 < m.mean_pv["value"] < m.p95_pv["value"]

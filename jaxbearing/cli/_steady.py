@@ -62,7 +62,7 @@ def options(args) -> dict | None:
         return None
     from ..run import check_steady_options
 
-    settle = args.settle if args.settle in ("auto", "off") else args.settle
+    settle = args.settle
     names = {
         "settle": "--settle",
         "window_revs": "--window-revs",

@@ -413,6 +413,7 @@ def simulate_steady(
     check_solver(solver)
     validate_bearing(bearing, op)
     check_steady_options(settle, window_revs, seeds, tolerance, settle_cap_ms, start=start, workers=workers)
+    settle = settle if isinstance(settle, str) and settle in ("auto", "off") else float(settle)
     kwargs = dict(
         settle=settle,
         window_revs=window_revs,
