@@ -62,7 +62,6 @@ def options(args) -> dict | None:
         return None
     from ..run import check_steady_options
 
-    settle = args.settle
     names = {
         "settle": "--settle",
         "window_revs": "--window-revs",
@@ -76,7 +75,7 @@ def options(args) -> dict | None:
 
     workers = available_cpus() if args.workers is None else args.workers
     check_steady_options(
-        settle,
+        args.settle,
         args.window_revs,
         args.seeds,
         args.settle_tolerance,
@@ -86,7 +85,7 @@ def options(args) -> dict | None:
         workers=workers,
     )
     return dict(
-        settle=settle if settle in ("auto", "off") else float(settle),
+        settle=args.settle,  # "auto", "off" or a time in ms, as text: simulate_steady reads it
         window_revs=int(args.window_revs),
         seeds=int(args.seeds),
         tolerance=args.settle_tolerance,

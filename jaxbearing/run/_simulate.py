@@ -87,6 +87,8 @@ def _histories(ts, saved, args: SolveArgs) -> dict:
     trajectory does not depend on what is saved. Here XLA compiles the contacts of the outputs
     once, which takes about 12 % less time to compile a solve with samples (README)."""
     n = ts.shape[0]
+    # padded rather than lax.map's own remainder, which would be a second compiled copy of the
+    # contacts (a vmap over the leftover samples)
     chunk = min(HISTORY_CHUNK, n)
     m = -(-n // chunk) * chunk
 
