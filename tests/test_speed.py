@@ -129,3 +129,48 @@ def test_parallel_map_in_an_unguarded_script_is_one_line_not_a_hang(tmp_path):
     assert proc.returncode != 0
     last = proc.stderr.strip().splitlines()[-1]
     assert "workers = 2" in last and "__main__" in last
+
+
+def test_workers_end_when_the_process_that_started_them_is_killed(tmp_path):
+    """A sweep or search killed with SIGKILL (or by the out-of-memory killer) leaves no pool
+    workers behind: each holds a JAX runtime and would otherwise wait for ever on a queue its
+    dead parent can no longer close."""
+    import os
+    import subprocess
+    import sys
+    import time
+
+    script = tmp_path / "killed.py"
+    script.write_text(
+        "import os, signal\nfrom jaxbearing.run import shared_workers, parallel_map\n"
+        "def pid(_):\n    return os.getpid()\n"
+        'if __name__ == "__main__":\n'
+        "    with shared_workers(2):\n"
+        "        print(*sorted(set(parallel_map(pid, range(8), workers=2))), flush=True)\n"
+        "        os.kill(os.getpid(), signal.SIGKILL)\n"
+    )
+    out = tmp_path / "out.txt"  # a file, not a pipe: surviving workers would hold a pipe open
+    with out.open("w") as f:
+        proc = subprocess.run([sys.executable, str(script)], stdout=f, stderr=subprocess.STDOUT, timeout=240)
+    assert proc.returncode == -9, out.read_text()[-2000:]
+    workers = [int(p) for p in out.read_text().split()]
+    assert workers and os.getpid() not in workers
+
+    def alive(pid):  # a zombie (ended, not yet reaped by whoever adopted it) counts as ended
+        try:
+            os.kill(pid, 0)
+        except ProcessLookupError:
+            return False
+        try:
+            with open(f"/proc/{pid}/stat") as f:
+                return f.read().rsplit(")", 1)[1].split()[0] != "Z"
+        except OSError:
+            return True
+
+    deadline = time.monotonic() + 30
+    while any(map(alive, workers)) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    left = [p for p in workers if alive(p)]
+    for p in left:  # do not leave them to the next test either
+        os.kill(p, 9)
+    assert not left, f"workers {left} outlived the killed process"

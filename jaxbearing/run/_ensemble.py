@@ -19,6 +19,8 @@ process (no pool). A worker that dies (killed, out of memory, or a script withou
 ``if __name__ == "__main__":`` whose workers re-run it on import, as `spawn` does) ends the map
 with a one-line `UserInputError` instead of a pool that restarts workers for ever
 (`concurrent.futures.ProcessPoolExecutor` reports a broken pool; `multiprocessing.Pool` hangs).
+The other way round, the workers end when the process that started them is killed
+(`_exit_with_parent`): a killed sweep or search leaves no workers behind.
 
 `as_completed_map(function, items, workers=N)` yields each result as it finishes (the sweep
 writes every batch file at once).
@@ -130,7 +132,31 @@ def _worker_died(workers: int) -> UserInputError:
 
 
 def _pool(workers: int) -> ProcessPoolExecutor:
-    return ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"))
+    return ProcessPoolExecutor(
+        workers, mp_context=multiprocessing.get_context("spawn"), initializer=_exit_with_parent
+    )
+
+
+def _exit_with_parent() -> None:
+    """Worker initializer: end this worker when the process that started the pool dies.
+
+    A pool's workers hold both ends of its call queue, so a parent that is killed (SIGKILL, the
+    out-of-memory killer, a cluster's time limit) never closes it: the workers would wait on it
+    for ever, each holding a JAX runtime (about 0.5 GB). A daemon thread waits on the parent's
+    sentinel (`multiprocessing.parent_process()`, ready when the parent ends) and exits the
+    worker; a worker of a living parent is untouched."""
+    import threading
+    from multiprocessing.connection import wait
+
+    parent = multiprocessing.parent_process()
+    if parent is None:  # pragma: no cover - a pool worker always has one
+        return
+
+    def watch():
+        wait([parent.sentinel])
+        os._exit(1)
+
+    threading.Thread(target=watch, name="exit-with-parent", daemon=True).start()
 
 
 #: pools kept open by `shared_workers`, by XLA flags: (workers, executor)
