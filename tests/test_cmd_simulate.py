@@ -109,6 +109,50 @@ def test_solver_reaches_the_run(monkeypatch):
     assert seen["solver"] == "ros34pw2"
 
 
+def test_progress_of_a_fixed_run_keeps_the_program_cacheable(monkeypatch, capsys):
+    """With progress on, a fixed-duration run is solved without the in-solve meter (a host
+    callback: JAX would compile that program afresh in every process); the host-side meter
+    prints the closing line from the result."""
+    import types
+
+    import jaxbearing as jb
+    import jaxbearing.run as run
+    from jaxbearing.cli._simulate import run_cases
+
+    seen = []
+
+    def fake(bearing, op, **kw):
+        seen.append(kw)
+        ok = len(seen) == 1  # the arc run succeeds, the corner run stops at a quarter
+        return types.SimpleNamespace(ok=ok, reached_time=kw["duration"] * (1.0 if ok else 0.25))
+
+    monkeypatch.setattr(run, "simulate", fake)
+    monkeypatch.setattr(run, "summarise", lambda res: {})
+    cfg = jb.loads_config('[simulation]\nduration_ms = 2.0\nend = "both"\n')
+    run_cases(cfg, progress=True)
+    assert [kw["progress"] for kw in seen] == [False, False]
+    out = capsys.readouterr().out
+    assert "[arc end] simulating 2 ms" in out and "100% of the simulated time" in out
+    assert "stopped at 25.0% of the simulated time" in out
+
+
+def test_host_progress_prints_elapsed_time_and_the_closing_line(capsys):
+    import time
+
+    from jaxbearing.run import HostProgress
+
+    with HostProgress(interval=0.05) as meter:
+        time.sleep(0.3)
+    meter.close(1.0)
+    with HostProgress(interval=10.0) as meter:
+        pass
+    meter.close(0.372)
+    lines = capsys.readouterr().out.splitlines()
+    assert any(line.strip().endswith("s elapsed") and "%" not in line for line in lines[:-2])
+    assert "100% of the simulated time" in lines[-2]
+    assert "stopped at 37.2% of the simulated time" in lines[-1] and "the solve failed" in lines[-1]
+
+
 def test_forced_solver_failure_nonzero_exit(tmp_path, capsys):
     """A failed solve: exit 1, the progress meter says where it stopped (no jump to 100 %), the
     table marks the failed run's values, summary.json is strict JSON (issue 16)."""

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import math
 import pathlib
 
@@ -103,7 +104,7 @@ def run_cases(cfg, progress: bool = True, steady: dict | None = None) -> dict:
     """Run the configured end type(s); returns {end: (result, summary)}. `steady`: keyword
     arguments of a settled run (`_steady.options`)."""
     from ..io import check_runnable
-    from ..run import simulate, summarise
+    from ..run import HostProgress, simulate, summarise
 
     sim = cfg.simulation
     bearing = cfg.bearing()
@@ -116,17 +117,23 @@ def run_cases(cfg, progress: bool = True, steady: dict | None = None) -> dict:
         if progress:
             what = "until settled" if steady else f"{sim.duration_ms:g} ms"
             print(f"[{end} end] simulating {what} ...", flush=True)
-        res = simulate(
-            b,
-            op,
-            duration=sim.duration_ms * 1e-3,
-            rtol=sim.rtol,
-            atol=sim.atol,
-            max_steps=sim.max_steps,
-            progress=progress,
-            solver=sim.solver,
-            **(steady or {}),
-        )
+        # a fixed-duration run shows the host-side meter (`HostProgress`): the solve's own meter
+        # is a host callback, which would make the program uncacheable (compiled in every process)
+        meter = HostProgress() if progress and not steady else contextlib.nullcontext()
+        with meter:
+            res = simulate(
+                b,
+                op,
+                duration=sim.duration_ms * 1e-3,
+                rtol=sim.rtol,
+                atol=sim.atol,
+                max_steps=sim.max_steps,
+                progress=progress and bool(steady),
+                solver=sim.solver,
+                **(steady or {}),
+            )
+        if isinstance(meter, HostProgress):
+            meter.close(1.0 if res.ok else min(res.reached_time / (sim.duration_ms * 1e-3), 0.999))
         out[end] = (res, summarise(res))
     return out
 

@@ -5,7 +5,8 @@
   `flange_functionals` (smooth peak PV and contact heights for gradients), `Perturbation`
   (seeded initial roller scatter), `initial_state`, `skid_start` (the speeds of steady running,
   issue 11; `STARTS`), `smooth_functionals`, `result_code` and
-  `RESULT_NAMES` (the outcome code of a solve), `SolveProgress` (the text progress meter);
+  `RESULT_NAMES` (the outcome code of a solve), `SolveProgress` (the text progress meter
+  inside a solve) and `HostProgress` (the same from the calling process: cacheable programs);
 - statistics: `contact_events`, `summarise`, `film_statistics` (film over contact time,
   `FILM_KEYS`); of settled running with 95 % confidence
   intervals: `steady_statistics`, `revolution_statistics`, `confidence_intervals`,
@@ -45,7 +46,7 @@ from ._design import (
 from ._ensemble import as_completed_map, available_cpus, parallel_map, shared_workers, simulate_ensemble
 from ._initial import STARTS, Perturbation, SkidStart, initial_state, skid_start
 from ._plots import plot_run
-from ._progress import SolveProgress
+from ._progress import HostProgress, SolveProgress
 from ._result import (
     RESULT_NAMES,
     SimulationResult,
@@ -123,6 +124,7 @@ __all__ = [
     "SimulationResult",
     "Solution",
     "SolveProgress",
+    "HostProgress",
     "SteadyResult",
     "SolveArgs",
     "batch_means",

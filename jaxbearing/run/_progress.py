@@ -14,6 +14,16 @@ step (cheap, every step) and the progress last printed; the host is called only 
 progress has grown by `minimum_increase` (and once at the end). The estimate of the time left
 is elapsed * (1 - p) / p: the rate of the run so far, so it is rough while the step size still
 settles. Meant for one unbatched solve (`simulate`); batched solves (sweeps) run without it.
+
+Its price: the meter's host callbacks are part of the compiled program, and JAX neither persists
+such a program (the persistent compilation cache) nor exports it (`jax.export`), so a solve with
+the meter is traced and compiled afresh in every process. `HostProgress` is the meter that
+costs nothing in the program: a thread of the calling process prints the elapsed wall time
+every `interval` seconds while an ordinary (cached) solve runs, and the same closing line as
+`SolveProgress` from its result (100 %, or where a failed solve stopped). It cannot know the
+percentage while the solve runs. The command line uses it (`jaxbearing simulate`: 0.2 ms
+simulated, a second process, 8.2 s with it against 25.5 s with `SolveProgress`, README,
+Performance).
 """
 
 from __future__ import annotations
@@ -56,21 +66,55 @@ def _show(progress, idx) -> np.ndarray:
     return np.asarray(idx, dtype=np.int32)
 
 
+def closing_line(fraction: float, elapsed: float) -> str:
+    """The meter's last line: 100 %, or where a failed solve stopped (`fraction` < 1)."""
+    if fraction < 1.0:
+        return (
+            f"{_INDENT}stopped at {100 * fraction:.1f}% of the simulated time after {elapsed:.1f} s: "
+            "the solve failed (see its status)"
+        )
+    return f"{_INDENT}100% of the simulated time, {elapsed:.1f} s elapsed"
+
+
 def _close(idx, latest) -> None:
     p = float(np.min(latest))
     with _LOCK:
         meter = _METERS.pop(int(np.max(idx)), None)
     if meter is None:
         return
-    elapsed = time.perf_counter() - meter["start"]
-    if p < 1.0:
-        print(
-            f"{_INDENT}stopped at {100 * p:.1f}% of the simulated time after {elapsed:.1f} s: "
-            "the solve failed (see its status)",
-            flush=True,
-        )
-    elif meter["shown"] < 1.0:
-        print(f"{_INDENT}100% of the simulated time, {elapsed:.1f} s elapsed", flush=True)
+    if p < 1.0 or meter["shown"] < 1.0:
+        print(closing_line(p, time.perf_counter() - meter["start"]), flush=True)
+
+
+class HostProgress:
+    """The progress of a solve that runs without `SolveProgress` (module docstring): while the
+    `with` block runs, a daemon thread prints the elapsed wall time every `interval` seconds;
+    `close(fraction)` prints the closing line, `fraction` being the simulated time reached over
+    the duration (1 for a solve that succeeded)."""
+
+    def __init__(self, interval: float = 10.0):
+        self.interval = float(interval)
+        self._stop = threading.Event()
+        self._thread: threading.Thread | None = None
+        self.start = time.perf_counter()
+
+    def _tick(self) -> None:
+        while not self._stop.wait(self.interval):
+            print(f"{_INDENT}{time.perf_counter() - self.start:.0f} s elapsed", flush=True)
+
+    def __enter__(self) -> HostProgress:
+        self.start = time.perf_counter()
+        self._thread = threading.Thread(target=self._tick, name="host-progress", daemon=True)
+        self._thread.start()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join()
+
+    def close(self, fraction: float) -> None:
+        print(closing_line(float(fraction), time.perf_counter() - self.start), flush=True)
 
 
 class _MeterState(eqx.Module):
