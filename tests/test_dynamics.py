@@ -134,7 +134,10 @@ def test_tolerance_halving_convergence(reference_run):
 
 
 def test_forced_failure_reports_status():
-    res, s = _run(max_steps=40)
+    # the program of tests/test_cmd_simulate.py's failure run (default num_saves, max_steps 30):
+    # a step limit is static, so each distinct one is a compilation of its own
+    res = simulate(jb.reference_bearing(), jb.reference_operating_point(), duration=DURATION, max_steps=30)
+    s = summarise(res)
     assert not res.ok
     assert s["status"].startswith("failed: the step limit max_steps was reached")
     assert "simulated time reached" in s["status"]
