@@ -3,7 +3,8 @@ no land film, no gravity: pure rolling), its own equations, the dynamics started
 pre-start that lands it on the settled plateau.
 
 The dynamic checks run the reference bearing with 11 slices per raceway (the `test_settle`
-configuration) over two or three cage revolutions, all through one compiled `solve_from`."""
+configuration) over two or three cage revolutions, all through the settled run's compiled
+`solve_from`."""
 
 import dataclasses
 
@@ -16,7 +17,7 @@ import pytest
 import jaxbearing as jb
 from jaxbearing.dynamics import Params, contact_loads, physical_rates
 from jaxbearing.geometry import kinematic_cage_speed
-from jaxbearing.run import Perturbation, skid_start, solve_from
+from jaxbearing.run import Perturbation, skid_start
 
 
 @pytest.fixture(scope="module")
@@ -80,17 +81,14 @@ def test_no_start_up_step_from_the_skid_start(reference, reference_skid):
     assert abs(means[1] - means[0]) < 2e-3 * w0
 
 
-_RUN = jax.jit(solve_from, static_argnames=("num_saves", "max_steps"))
-
-
 def _integrator(reference):
-    """`solve_from` at the run's tolerances, as `skid_start`'s pre-start takes it."""
+    """The settled run's own integrator (`solve_from` compiled with `simulate_steady`'s saves,
+    step limit and tolerances), as `skid_start`'s pre-start takes it: the program of every
+    11-slice settled run in the suite (tests/test_settle.py, notebook 03), compiled once."""
+    from jaxbearing.run._settle import SAVES_PER_REV, _integrator
+
     params = Params(bearing=reference[0], operating=reference[1])
-
-    def integrate(state, duration):
-        return _RUN(params, state, duration, num_saves=200, rtol=1e-3, atol=1e-6, max_steps=200_000)
-
-    return integrate
+    return _integrator(params, SAVES_PER_REV, 2_000_000, 1e-3, 1e-6, [])
 
 
 def _revolution_means(integrate, state, n):
