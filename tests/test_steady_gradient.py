@@ -15,7 +15,7 @@ import pytest
 
 import jaxbearing as jb
 from jaxbearing.flange import DesignVariables
-from jaxbearing.run import ratio_gradient, skid_start, solve_from, steady_gradient, tangent_growth
+from jaxbearing.run import ratio_gradient, skid_start, steady_gradient, tangent_growth
 from jaxbearing.run._steady_gradient import STEADY_FUNCTIONALS, window_integrals
 
 
@@ -49,14 +49,18 @@ def test_jackknife_of_a_mean_is_the_standard_error():
 @pytest.fixture(scope="module")
 def running():
     """Two states of running (reduced size): the skid start of two seeds after 3 ms (the rollers
-    have skewed onto their flanges)."""
+    have skewed onto their flanges), through the settled design run's own integrator (the
+    program of `steady_design_metrics` at 11 slices: tests/test_steady_design.py, notebook 05)."""
+    from jaxbearing.run._settle import SAVES_PER_REV, _integrator
+
     b = dataclasses.replace(jb.reference_bearing(), num_slices=11)
     op = jb.reference_operating_point()
     params = jb.dynamics.Params(bearing=b, operating=op, functionals=STEADY_FUNCTIONALS)
+    integrate = _integrator(params, SAVES_PER_REV, 2_000_000, 1e-3, 1e-6, [])
     states = []
     for seed in (0, 1):
         s0 = skid_start(b, op, jb.Perturbation(seed=seed, skew=1e-3)).state
-        _, s, code, _ = solve_from(params, s0, 3e-3, num_saves=0, rtol=1e-3, atol=1e-6, max_steps=100_000)
+        _, s, code, _ = integrate(s0, 3e-3)
         assert int(code) == 0
         states.append(s)
     return b, op, states
