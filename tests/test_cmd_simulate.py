@@ -139,6 +139,7 @@ def test_progress_of_a_fixed_run_keeps_the_program_cacheable(monkeypatch, capsys
 def test_host_progress_prints_elapsed_time_and_the_closing_line(capsys):
     import time
 
+    import jaxbearing as jb
     from jaxbearing.run import HostProgress
 
     with HostProgress(interval=0.05) as meter:
@@ -151,6 +152,8 @@ def test_host_progress_prints_elapsed_time_and_the_closing_line(capsys):
     assert any(line.strip().endswith("s elapsed") and "%" not in line for line in lines[:-2])
     assert "100% of the simulated time" in lines[-2]
     assert "stopped at 37.2% of the simulated time" in lines[-1] and "the solve failed" in lines[-1]
+    with pytest.raises(jb.UserInputError, match=r"^interval = -1.0: must be > 0 s$"):
+        HostProgress(interval=-1)
 
 
 def test_forced_solver_failure_nonzero_exit(tmp_path, capsys):

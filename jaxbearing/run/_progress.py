@@ -21,9 +21,8 @@ the meter is traced and compiled afresh in every process. `HostProgress` is the 
 costs nothing in the program: a thread of the calling process prints the elapsed wall time
 every `interval` seconds while an ordinary (cached) solve runs, and the same closing line as
 `SolveProgress` from its result (100 %, or where a failed solve stopped). It cannot know the
-percentage while the solve runs. The command line uses it (`jaxbearing simulate`: 0.2 ms
-simulated, a second process, 8.2 s with it against 25.5 s with `SolveProgress`, README,
-Performance).
+percentage while the solve runs. The command line uses it (`jaxbearing simulate` of 0.2 ms on
+warm caches: 7.9-9.1 s with it, 24.5-30.9 s with `SolveProgress`; README, Command line).
 """
 
 from __future__ import annotations
@@ -39,6 +38,8 @@ import jax.numpy as jnp
 import numpy as np
 from jax.experimental import io_callback
 from jaxtyping import Array
+
+from ..io import require
 
 _METERS: dict[int, dict] = {}
 _IDS = itertools.count(1)
@@ -93,6 +94,7 @@ class HostProgress:
     the duration (1 for a solve that succeeded)."""
 
     def __init__(self, interval: float = 10.0):
+        require("interval", interval, lambda v: np.isfinite(v) & (v > 0), "> 0 s")
         self.interval = float(interval)
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
@@ -104,6 +106,7 @@ class HostProgress:
 
     def __enter__(self) -> HostProgress:
         self.start = time.perf_counter()
+        self._stop = threading.Event()
         self._thread = threading.Thread(target=self._tick, name="host-progress", daemon=True)
         self._thread.start()
         return self
