@@ -50,6 +50,35 @@ def test_raceway_normal_norm_is_the_max_norm_with_radial_tolerances_loosened():
     np.testing.assert_allclose(float(norm(big)), 3.0)
 
 
+def test_default_atol_means_10_nm_10_um_s_and_0_01_rad_s():
+    """docs/model.md 13: the default atol = 1e-6 of the scaled deviation state is 10 nm, 10 um/s,
+    0.01 rad/s and 1e-8 in an axis component: deviations of that size scale to exactly 1e-6."""
+    from jaxbearing.dynamics import Scaling, state_scales
+    from jaxbearing.run._simulate import initial_state
+
+    b, op = jb.reference_bearing(), jb.reference_operating_point()
+    y0 = initial_state(b, op, None)
+    pitch_radius = b.pitch_diameter / 2
+    scaling = Scaling(
+        nominal=y0, scale=state_scales(b.num_rollers, pitch_radius), orbit_speed=jnp.asarray(0.0)
+    )
+    paths = (
+        lambda s: s.rollers.radial,
+        lambda s: s.rollers.axial_velocity,
+        lambda s: s.rollers.angular_velocity,
+        lambda s: s.rollers.axis,
+        lambda s: s.cage.speed,
+    )
+    steps = (10e-9, 10e-6, 0.01, 1e-8, 10e-6 / pitch_radius)  # m, m/s, rad/s, -, 10 um/s at the pitch
+    y = y0
+    for path, step in zip(paths, steps):
+        y = eqx.tree_at(path, y, path(y0) + step)
+    scaled = scaling.scale_state(0.0, y)
+    for path in paths:
+        np.testing.assert_allclose(np.asarray(path(scaled)), 1e-6, rtol=1e-6)
+    np.testing.assert_allclose(np.asarray(scaled.rollers.axial), 0.0, atol=1e-15)
+
+
 def test_solve_program_has_no_host_callback():
     """JAX's persistent cache refuses programs with host callbacks; `solve` must contain none
     (equinox's checks are traced as NaN, `_compile_cache.checks_without_host_callbacks`)."""

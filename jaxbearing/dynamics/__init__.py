@@ -27,6 +27,7 @@ from ._quasistatic import QuasiStatic, quasi_static
 from ._rigid_body import angular_momentum, axisymmetric_body_rates, kinetic_energy
 from ._skid import SkidEquilibrium, cage_time_constant, skid_equilibrium
 from ._state import (
+    SCALED_UNITS,
     Accumulators,
     CageState,
     RingState,
@@ -40,6 +41,7 @@ from ._state import (
 
 __all__ = [
     "FLANGE_NAMES",
+    "SCALED_UNITS",
     "Accumulators",
     "CageState",
     "Functionals",

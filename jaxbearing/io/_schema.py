@@ -764,7 +764,7 @@ KEYS: tuple[Key, ...] = (
         1e-6,
         "",
         "",
-        "absolute tolerance (on the scaled state)",
+        "absolute tolerance on the scaled state (1e-6: 10 nm, 10 um/s, 0.01 rad/s)",
         constant_bound(0, False),
         constant_bound(1, False),
     ),

@@ -5,7 +5,8 @@
   skews in a deterministic model; real rollers start with manufacturing scatter).
 * Explicit adaptive Runge-Kutta (Tsit5) with a PID step-size controller, the paper's tolerances
   (rtol 1e-3, atol 1e-6) applied to a *scaled deviation* of the state (`_state.Scaling`) under the
-  max norm, so that every component's tolerance means something physical, except that the
+  max norm, so that every component's tolerance means something physical (atol: 10 nm,
+  10 um/s, 0.01 rad/s; `dynamics.SCALED_UNITS`, docs/model.md 13), except that the
   raceway-normal coordinates (roller radial position and velocity, inner-ring centre) have
   tolerances `raceway_loosen` = 100 times looser (`_step_control`: their 62 kHz ringing need not
   be resolved to rtol); `max_steps` explicit. `solver="ros34pw2"` selects the linearly implicit
