@@ -23,13 +23,15 @@ Protocol.
    orbit, accumulators at zero), with the step controller built here as `prepare_from` builds it
    (`step_controller(rtol, atol, raceway_normal_norm(y0_scaled, loosen))`), so that rtol, atol
    and the raceway-normal loosening are chosen per integrator; the library is not changed.
-   Integrators (`VARIANTS`): the reference, Tsit5 with rtol 1e-7, atol 1e-10 and the plain max
-   norm (loosen 1); (b) the old default, Tsit5 rtol 1e-3, atol 1e-6, loosen 1; (c) the current
-   default, rtol 1e-3, atol 1e-6, loosen 100; (d) rtol 1e-2, loosen 100; (e) rtol 3e-3,
-   loosen 100; (e') rtol 3e-2, loosen 100; (f) SciPy `solve_ivp(RK45)` at rtol 1e-3, atol 1e-6 (RMS norm) on the same
-   compiled field (`_common.FlatField`, `bench_work_precision.ScipyRunner`'s samples); (g) atol
-   1e-2 instead of 1e-6 (of the scaled state: 10 nm, 10 um/s, 0.01 rad/s instead of 1 pm,
-   1 nm/s, 1 urad/s) at rtol 1e-3 and at rtol 1e-2, loosen 100.
+   Integrators (`VARIANTS`): the reference, Tsit5 with rtol 1e-7, atol 1e-14 (1e-16 m) and
+   the plain max norm (loosen 1); then, at atol `PREVIOUS_ATOL` (1 pm, 1 nm/s, 1 urad/s: what
+   the default atol 1e-6 meant before the state's scales were chosen for the tolerances,
+   `jaxbearing.dynamics.SCALED_UNITS`): (b) the old default, Tsit5 rtol 1e-3, loosen 1; (c) the
+   previous default, rtol 1e-3, loosen 100; (d) rtol 1e-2, (e) 3e-3, (e') 3e-2, loosen 100;
+   (f) SciPy `solve_ivp(RK45)` at rtol 1e-3 (RMS norm) on the same compiled field
+   (`_common.FlatField`, `bench_work_precision.ScipyRunner`'s samples); and at today's default
+   atol 1e-6 (10 nm, 10 um/s, 0.01 rad/s): (g) the default, rtol 1e-3, loosen 100; (h) rtol
+   1e-2, loosen 100; (i) SciPy RK45 at rtol 1e-3.
 3. Statistics per run over the window (`bench_work_precision.window_statistics`): mean and p95
    PV over flange samples with normal force > 1 N, mean sliding speed, cage slip
    1 - mean(cage speed) / kinematic cage speed; per-seed 95 % half-widths from 8 batch means of
@@ -44,7 +46,7 @@ Protocol.
    "agrees within CI" when the paired difference's interval contains 0 AND |mean difference| is
    below the reference ensemble mean's half-width.
 5. Cost: field evaluations per simulated ms (Tsit5: `_common.fsal_rk_evaluations`, 6 per step
-   attempt + 1; SciPy: nfev), their ratio against the old and the current default, and wall time
+   attempt + 1; SciPy: nfev), their ratio against the old and today's default, and wall time
    per simulated ms (compile excluded; single runs on a shared 2-core machine: the evaluation
    counts are the primary figure).
 
@@ -68,6 +70,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import _common  # noqa: E402
 from bench_work_precision import (  # noqa: E402
+    PREVIOUS_ATOL,
     REF_ATOL,
     REF_RTOL,
     SAMPLE_DT,
@@ -90,19 +93,26 @@ MAX_STEPS = 2_000_000
 CACHE_DIR = Path(tempfile.gettempdir()) / "jaxbearing_bench_work_precision_settled"
 #: the saved quantities the statistics need
 SAVED = ("t", "flange_force", "flange_pv", "flange_sliding_speed", "cage_speed")
-OLD_DEFAULT, CURRENT_DEFAULT = "old default", "current default"
+OLD_DEFAULT, PREVIOUS_DEFAULT, CURRENT_DEFAULT = "old default", "previous default", "default"
 
 #: (label, kind, rtol, atol, raceway_loosen); kind "tsit5" (diffrax, max norm with the
 #: raceway-normal tolerances `raceway_loosen` times looser) or "scipy" (solve_ivp RK45, RMS norm)
 VARIANTS = (
-    (f"{OLD_DEFAULT}: Tsit5, max norm, rtol 1e-3", "tsit5", 1e-3, 1e-6, 1.0),
-    (f"{CURRENT_DEFAULT}: Tsit5, raceway-normal x100, rtol 1e-3", "tsit5", 1e-3, 1e-6, 100.0),
-    ("Tsit5, raceway-normal x100, rtol 1e-2", "tsit5", 1e-2, 1e-6, 100.0),
-    ("Tsit5, raceway-normal x100, rtol 3e-3", "tsit5", 3e-3, 1e-6, 100.0),
-    ("Tsit5, raceway-normal x100, rtol 3e-2", "tsit5", 3e-2, 1e-6, 100.0),
-    ("SciPy RK45 (same field, RMS), rtol 1e-3", "scipy", 1e-3, 1e-6, 1.0),
-    ("Tsit5, raceway-normal x100, rtol 1e-3, atol 1e-2", "tsit5", 1e-3, 1e-2, 100.0),
-    ("Tsit5, raceway-normal x100, rtol 1e-2, atol 1e-2", "tsit5", 1e-2, 1e-2, 100.0),
+    (f"{OLD_DEFAULT}: Tsit5, max norm, rtol 1e-3, atol 1 pm", "tsit5", 1e-3, PREVIOUS_ATOL, 1.0),
+    (
+        f"{PREVIOUS_DEFAULT}: Tsit5, raceway-normal x100, rtol 1e-3, atol 1 pm",
+        "tsit5",
+        1e-3,
+        PREVIOUS_ATOL,
+        100.0,
+    ),
+    ("Tsit5, raceway-normal x100, rtol 1e-2, atol 1 pm", "tsit5", 1e-2, PREVIOUS_ATOL, 100.0),
+    ("Tsit5, raceway-normal x100, rtol 3e-3, atol 1 pm", "tsit5", 3e-3, PREVIOUS_ATOL, 100.0),
+    ("Tsit5, raceway-normal x100, rtol 3e-2, atol 1 pm", "tsit5", 3e-2, PREVIOUS_ATOL, 100.0),
+    ("SciPy RK45 (same field, RMS), rtol 1e-3, atol 1 pm", "scipy", 1e-3, PREVIOUS_ATOL, 1.0),
+    (f"{CURRENT_DEFAULT}: Tsit5, raceway-normal x100, rtol 1e-3, atol 10 nm", "tsit5", 1e-3, 1e-6, 100.0),
+    ("Tsit5, raceway-normal x100, rtol 1e-2, atol 10 nm", "tsit5", 1e-2, 1e-6, 100.0),
+    ("SciPy RK45 (same field, RMS), rtol 1e-3, atol 10 nm", "scipy", 1e-3, 1e-6, 1.0),
 )
 
 
@@ -275,10 +285,20 @@ def stored_reference(case: dict) -> dict | None:
     if not path.exists():
         return None
     old = json.loads(path.read_text())
-    keys = ("seeds", "window_s", "num_saves", "reference", "inner_speed_rpm", "radial_load_N")
+    keys = ("seeds", "window_s", "num_saves", "inner_speed_rpm", "radial_load_N")
     if old.get("quick") or any(old["case"].get(k) != case[k] for k in keys):
         return None
+    if reference_tolerances(old["case"]["reference"]) != reference_tolerances(case["reference"]):
+        return None
     return old["reference"]
+
+
+def reference_tolerances(reference: dict) -> tuple:
+    """(rtol, atol in metres of length, method) of a stored case's reference. Results stored
+    before the state's scales were chosen for the tolerances have no "atol_length_m": their
+    atol was of 1-um units."""
+    length = reference.get("atol_length_m", reference["atol"] * 1e-6)
+    return reference["rtol"], float(f"{length:.6g}"), reference["method"]
 
 
 def main(quick: bool = False, window_revs: int = WINDOW_REVS, reuse_reference: bool = False) -> dict:
@@ -287,7 +307,7 @@ def main(quick: bool = False, window_revs: int = WINDOW_REVS, reuse_reference: b
     import numpy as np
 
     import jaxbearing as jb
-    from jaxbearing.dynamics import Functionals, Params
+    from jaxbearing.dynamics import SCALED_UNITS, Functionals, Params
 
     started = time.perf_counter()
     seeds = SEEDS[:1] if quick else SEEDS
@@ -337,7 +357,12 @@ def main(quick: bool = False, window_revs: int = WINDOW_REVS, reuse_reference: b
         "kinematic_cage_speed_rpm": float(jb.rad_s_to_rpm(omega_kin)),
         "sample_dt_s": SAMPLE_DT,
         "num_saves": num_saves,
-        "reference": {"rtol": ref_rtol, "atol": REF_ATOL, "method": "Tsit5, max norm (loosen 1)"},
+        "reference": {
+            "rtol": ref_rtol,
+            "atol": REF_ATOL,
+            "atol_length_m": REF_ATOL * SCALED_UNITS[0],
+            "method": "Tsit5, max norm (loosen 1)",
+        },
         "agreement": "paired difference's 95 % Student-t interval over seeds contains 0 and "
         "|mean difference| < the reference ensemble mean's 95 % Student-t half-width over seeds",
         "note": "every integrator starts from the same settled state per seed (simulate_steady's "
