@@ -130,7 +130,11 @@ def build_parser() -> argparse.ArgumentParser:
         "--duration-ms", type=float, help="startup: simulated time per evaluation [ms] (default 0.3)"
     )
     r.add_argument("--rtol", type=float, help="solver rtol (default 1e-3)")
-    r.add_argument("--atol", type=float, help="solver atol (default 1e-6)")
+    r.add_argument(
+        "--atol",
+        type=float,
+        help="solver atol on the scaled state (default 1e-6: 10 nm, 10 um/s, 0.01 rad/s)",
+    )
     r.add_argument("--out", default="optimise_out", help="output directory (default optimise_out)")
     r.add_argument("--quiet", action="store_true", help="no per-iteration progress")
     r.set_defaults(func=run)
