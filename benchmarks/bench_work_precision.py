@@ -34,7 +34,9 @@ Integrators (all on the same compiled field and initial state):
   roller's 12 x 12 Jacobian block implicit (`jaxbearing.run._rosenbrock`), same error norm.
 
 `--imex` runs only the reference, the default Tsit5 rows and the Rosenbrock-W rows
-(`IMEX_VARIANTS`) and writes `bench_work_precision_imex.json`.
+(`IMEX_VARIANTS`) and writes `bench_work_precision_imex.json`. `--rows 0,3,13` runs the
+reference and those rows of `VARIANTS` (ratios against the first) and writes
+`bench_work_precision_rows.json`.
 
 Reported per integrator and seed: step attempts, rejected steps, field evaluations (Tsit5:
 6 attempts + 1, `_common.fsal_rk_evaluations`; SciPy: nfev; Rosenbrock-W: 4 attempts + 1, plus
@@ -319,7 +321,7 @@ class ScipyRunner:
 
 
 # -- the benchmark -----------------------------------------------------------------------------
-def main(quick: bool = False, imex: bool = False) -> dict:
+def main(quick: bool = False, imex: bool = False, rows: tuple | None = None) -> dict:
 
     import jaxbearing as jb
 
@@ -334,6 +336,8 @@ def main(quick: bool = False, imex: bool = False) -> dict:
     variants = [VARIANTS[i] for i in QUICK_VARIANTS] if quick else list(VARIANTS)
     if imex:
         variants = [VARIANTS[i] for i in IMEX_VARIANTS]
+    if rows is not None:
+        variants = [VARIANTS[i] for i in rows]
 
     _common.log(
         f"{NAME}: compiling solve (max/weighted norm), {num_saves} samples over {duration * 1e3:g} ms"
@@ -419,7 +423,7 @@ def main(quick: bool = False, imex: bool = False) -> dict:
     }
     result["table"] = _table(result)
     print(result["table"])
-    _common.write_json(NAME + ("_imex" if imex else ""), result)
+    _common.write_json(NAME + ("_imex" if imex else "") + ("_rows" if rows is not None else ""), result)
     return result
 
 
@@ -526,4 +530,7 @@ def self_check() -> None:
 
 
 if __name__ == "__main__":
-    main(quick="--quick" in sys.argv, imex="--imex" in sys.argv)
+    selected = None
+    if "--rows" in sys.argv:  # e.g. --rows 0,3,13: those VARIANTS only, to bench_work_precision_rows.json
+        selected = tuple(int(i) for i in sys.argv[sys.argv.index("--rows") + 1].split(","))
+    main(quick="--quick" in sys.argv, imex="--imex" in sys.argv, rows=selected)
