@@ -36,7 +36,8 @@ Integrators (all on the same compiled field and initial state):
 `--imex` runs only the reference, the default Tsit5 rows and the Rosenbrock-W rows
 (`IMEX_VARIANTS`) and writes `bench_work_precision_imex.json`. `--rows 0,3,13` runs the
 reference and those rows of `VARIANTS` (ratios against the first) and writes
-`bench_work_precision_rows.json`.
+`bench_work_precision_rows.json`. `--corner`: flat ends with the corner radius instead of arc
+ends (`with_flat_ends()`; "_corner" added to the results' name).
 
 Reported per integrator and seed: step attempts, rejected steps, field evaluations (Tsit5:
 6 attempts + 1, `_common.fsal_rk_evaluations`; SciPy: nfev; Rosenbrock-W: 4 attempts + 1, plus
@@ -321,7 +322,7 @@ class ScipyRunner:
 
 
 # -- the benchmark -----------------------------------------------------------------------------
-def main(quick: bool = False, imex: bool = False, rows: tuple | None = None) -> dict:
+def main(quick: bool = False, imex: bool = False, rows: tuple | None = None, corner: bool = False) -> dict:
 
     import jaxbearing as jb
 
@@ -331,6 +332,8 @@ def main(quick: bool = False, imex: bool = False, rows: tuple | None = None) -> 
     duration = t0 + window
     num_saves = int(round(duration / SAMPLE_DT)) + 1
     bearing, op = jb.reference_bearing(), jb.reference_operating_point()
+    if corner:
+        bearing = bearing.with_flat_ends()
     jb.validate_bearing(bearing, op)
     omega_kin = float(jb.kinematic_cage_speed(bearing, op))
     variants = [VARIANTS[i] for i in QUICK_VARIANTS] if quick else list(VARIANTS)
@@ -404,7 +407,7 @@ def main(quick: bool = False, imex: bool = False, rows: tuple | None = None) -> 
         "benchmark": NAME,
         "quick": quick,
         "case": {
-            "bearing": "reference_bearing() (26 rollers, 31 slices, arc ends)",
+            "bearing": f"reference_bearing() (26 rollers, 31 slices, {'corner' if corner else 'arc'} ends)",
             "inner_speed_rpm": float(jb.rad_s_to_rpm(op.inner_speed)),
             "radial_load_N": float(op.radial_load),
             "startup_s": t0,
@@ -423,7 +426,8 @@ def main(quick: bool = False, imex: bool = False, rows: tuple | None = None) -> 
     }
     result["table"] = _table(result)
     print(result["table"])
-    _common.write_json(NAME + ("_imex" if imex else "") + ("_rows" if rows is not None else ""), result)
+    suffix = ("_imex" if imex else "") + ("_rows" if rows is not None else "") + ("_corner" if corner else "")
+    _common.write_json(NAME + suffix, result)
     return result
 
 
@@ -533,4 +537,4 @@ if __name__ == "__main__":
     selected = None
     if "--rows" in sys.argv:  # e.g. --rows 0,3,13: those VARIANTS only, to bench_work_precision_rows.json
         selected = tuple(int(i) for i in sys.argv[sys.argv.index("--rows") + 1].split(","))
-    main(quick="--quick" in sys.argv, imex="--imex" in sys.argv, rows=selected)
+    main(quick="--quick" in sys.argv, imex="--imex" in sys.argv, rows=selected, corner="--corner" in sys.argv)
