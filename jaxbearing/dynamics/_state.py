@@ -143,8 +143,8 @@ def state_scales(num_rollers: int, pitch_radius: float) -> State:
     the axis components. That is two orders of magnitude below the micrometre deflections of
     the contacts and far below the sliding speeds (m/s) that a flange statistic reads; smaller
     scales (1 um per unit, an absolute tolerance of 1 pm) made components whose deviation passes
-    through zero hold the step for nothing (README, Performance: 1.51x more field evaluations
-    at the same settled statistics). rtol is relative to the deviation and does not depend on
+    through zero hold the step for nothing (README, Performance: 1.54x more field evaluations
+    at agreeing settled statistics). rtol is relative to the deviation and does not depend on
     the scales. Accumulators are scaled large: they must not steer the step size.
     """
     ones = jnp.ones((num_rollers,))

@@ -70,7 +70,8 @@ from ._simulate import flange_functionals
 #: horizon [s] at which AD and central finite differences of the flange functionals agree to 1%
 #: on the reference bearing from `seated_perturbation` (see the module docstring)
 GRADIENT_HORIZON = 0.3e-3
-#: tolerances of the gradient check (applied to the scaled state, as in `jaxbearing.solve`)
+#: tolerances of the gradient check (applied to the scaled state, as in `jaxbearing.solve`; atol
+#: 1e-9 is 10 pm, 10 nm/s, 1e-5 rad/s, `dynamics.SCALED_UNITS`)
 GRADIENT_RTOL = 1e-6
 GRADIENT_ATOL = 1e-9
 

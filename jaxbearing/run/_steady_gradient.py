@@ -235,8 +235,9 @@ def tangent_growth(
 ):
     """(t (num_saves,), tangent norms (3, num_saves)): the RMS over the scaled state (lengths in
     units of 10 mm, velocities of 10 m/s, angular velocities of 1e4 rad/s;
-    `dynamics.SCALED_UNITS`; accumulators excluded) of the forward-mode tangent of the trajectory from `start` with respect to each
-    design variable, scaled by that variable (d/d ln x). The slope of log(norm) against t is the
+    `dynamics.SCALED_UNITS`; accumulators excluded) of the forward-mode tangent of the
+    trajectory from `start` with respect to each design variable, scaled by that variable
+    (d/d ln x). The slope of log(norm) against t is the
     finite-time Lyapunov exponent of the tangent dynamics along the design direction."""
     x = jnp.asarray(design.as_array(), dtype=float)
     ts = jnp.linspace(0.0, duration, num_saves)
