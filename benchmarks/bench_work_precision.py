@@ -92,7 +92,7 @@ VARIANTS = (
     ("default: Tsit5, raceway-normal tol x100, rtol 1e-3, atol 10 nm", "solve", 1e-3, 1e-6, 100.0),
 )
 QUICK_VARIANTS = (0, 3, 5, 8, 9, 13)
-#: `--imex`: the old and new Tsit5 defaults, Tsit5 at rtol 1e-2, and the Rosenbrock-W rows
+#: `--imex`: the old and previous Tsit5 defaults (atol 1 pm), Tsit5 at rtol 1e-2, and the Rosenbrock-W rows
 IMEX_VARIANTS = (0, 3, 6, 10, 11, 12)
 
 
