@@ -117,9 +117,9 @@ def test_tolerance_halving_convergence(reference_run):
     transient are not asserted: their timing moves with the step sequence (between rtol 1e-3 and
     5e-4 the maximum moved 8 % and the median 0.7 % in one environment, the median 7.0 % with
     jax 0.10.2 on the same code), so they are a property of the chaotic transient, not of the
-    solver's accuracy. Statistics of settled running and their convergence under halving rtol
+    solver's accuracy. Statistics of settled running and their convergence under halving the tolerances
     are asserted against their confidence intervals in
-    `tests/test_settle.py::test_halving_rtol_moves_settled_pv_and_slip_less_than_their_intervals`
+    `tests/test_settle.py::test_halving_the_tolerances_moves_settled_pv_and_slip_less_than_their_intervals`
     (slow). Event counts and means over events are more sensitive (an event is a threshold
     crossing) and are not asserted.
     """
