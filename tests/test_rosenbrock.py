@@ -255,11 +255,14 @@ def test_roller_blocks_equal_the_diagonal_blocks_of_the_dense_jacobian():
 @pytest.mark.slow
 def test_agrees_with_tsit5_on_a_short_reference_bearing_run():
     """0.3 ms of the reference bearing from the quasi-static start: cage speed and roller loads
-    of ROS34PW2 and Tsit5 (both rtol 1e-5) agree to far below their own scale."""
+    of ROS34PW2 and Tsit5 (both rtol 1e-5, atol 1e-10: 1 pm, 1 nm/s, 1 urad/s) agree to far below
+    their own scale. (At the default atol, 10 nm, with the raceway-normal coordinates' 100x
+    looser, the roller loads of the two differ by 1.7 % of the largest: the tolerance, not the
+    solvers.)"""
     b, op = jb.reference_bearing(), jb.reference_operating_point()
     out = {}
     for solver in ("tsit5", "ros34pw2"):
-        sol = jb.solve(b, op, 3e-4, num_saves=31, rtol=1e-5, solver=solver)
+        sol = jb.solve(b, op, 3e-4, num_saves=31, rtol=1e-5, atol=1e-10, solver=solver)
         assert int(sol.result) == 0
         out[solver] = jax.tree_util.tree_map(np.asarray, sol.histories)
     t5, ros = out["tsit5"], out["ros34pw2"]
