@@ -340,6 +340,10 @@ def main(quick: bool = False, imex: bool = False, rows: tuple | None = None, cor
     if imex:
         variants = [VARIANTS[i] for i in IMEX_VARIANTS]
     if rows is not None:
+        if not rows or any(not 0 <= i < len(VARIANTS) for i in rows):
+            raise SystemExit(
+                f"--rows = {list(rows)}: indices of VARIANTS must be in [0, {len(VARIANTS) - 1}]"
+            )
         variants = [VARIANTS[i] for i in rows]
 
     _common.log(
@@ -536,5 +540,8 @@ def self_check() -> None:
 if __name__ == "__main__":
     selected = None
     if "--rows" in sys.argv:  # e.g. --rows 0,3,13: those VARIANTS only, to bench_work_precision_rows.json
-        selected = tuple(int(i) for i in sys.argv[sys.argv.index("--rows") + 1].split(","))
+        text = sys.argv[sys.argv.index("--rows") + 1] if sys.argv.index("--rows") + 1 < len(sys.argv) else ""
+        if not all(i.strip().isdigit() for i in text.split(",")):
+            raise SystemExit(f"--rows = {text!r}: comma-separated indices of VARIANTS, e.g. 0,3,13")
+        selected = tuple(int(i) for i in text.split(","))
     main(quick="--quick" in sys.argv, imex="--imex" in sys.argv, rows=selected, corner="--corner" in sys.argv)
