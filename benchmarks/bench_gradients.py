@@ -20,6 +20,7 @@ Run: .venv/bin/python benchmarks/bench_gradients.py [--quick]
 
 from __future__ import annotations
 
+import functools
 import json
 import pathlib
 import sys
@@ -95,15 +96,9 @@ def main(quick: bool = True) -> dict:
         return val, tang
 
     rev_mode_jit = jax.jit(jax.value_and_grad(pv))
-
-    def forward(x):
-        return forward_jit(x, bearing)
-
-    def fwd_mode(x):
-        return fwd_mode_jit(x, bearing)
-
-    def rev_mode(x):
-        return rev_mode_jit(x, bearing)
+    forward, fwd_mode, rev_mode = (
+        functools.partial(f, base=bearing) for f in (forward_jit, fwd_mode_jit, rev_mode_jit)
+    )
 
     value, first_fwd = _compile_and_first(forward, x0)
     (v_f, g_f), first_jf = _compile_and_first(fwd_mode, x0)
