@@ -54,7 +54,11 @@ Protocol.
 same case (the reference is 12 of the 18 minutes). `--quick`: seed 0, a 0.5 ms window, reference
 at rtol 1e-5 (a smoke test of the code path; the
 settling of seed 0 is shared with the full run through the cache). `--revs N` sets the window in
-cage revolutions (default 2). Results: `results/bench_work_precision_settled.json`.
+cage revolutions (default 2). `--rows 0,6,9` runs only those rows of `VARIANTS` (ratios against
+the defaults among them) and writes `bench_work_precision_settled_rows.json`. `--seeds 4,5,6,7` starts from other
+seeds' settled states (settled and cached on first use; a fresh reference unless one stored
+for those seeds fits) and adds `_seeds4-5-6-7` to the results name: a choice made on the
+default seeds is checked on seeds it was not made on. Results: `results/bench_work_precision_settled.json`.
 """
 
 from __future__ import annotations
@@ -78,6 +82,7 @@ from bench_work_precision import (  # noqa: E402
     ScipyRunner,
     confidence_halfwidths,
     errors,
+    rows_argument,
     variant_row,
     window_statistics,
 )
@@ -94,9 +99,13 @@ CACHE_DIR = Path(tempfile.gettempdir()) / "jaxbearing_bench_work_precision_settl
 #: the saved quantities the statistics need
 SAVED = ("t", "flange_force", "flange_pv", "flange_sliding_speed", "cage_speed")
 OLD_DEFAULT, PREVIOUS_DEFAULT, CURRENT_DEFAULT = "old default", "previous default", "default"
+#: the default from 2026-11-24 to 2026-11-25 (max norm, atol 10 nm)
+MAX_NORM_DEFAULT = "max-norm default"
 
 #: (label, kind, rtol, atol, raceway_loosen); kind "tsit5" (diffrax, max norm with the
-#: raceway-normal tolerances `raceway_loosen` times looser) or "scipy" (solve_ivp RK45, RMS norm)
+#: raceway-normal tolerances `raceway_loosen` times looser), "tsit5_rms" (the same weights in the
+#: RMS norm), "tsit5_body_rms" (the largest of the rollers', cage's and inner ring's RMS) or
+#: "scipy" (solve_ivp RK45, RMS norm)
 VARIANTS = (
     (f"{OLD_DEFAULT}: Tsit5, max norm, rtol 1e-3, atol 1 pm", "tsit5", 1e-3, PREVIOUS_ATOL, 1.0),
     (
@@ -110,10 +119,31 @@ VARIANTS = (
     ("Tsit5, raceway-normal x100, rtol 3e-3, atol 1 pm", "tsit5", 3e-3, PREVIOUS_ATOL, 100.0),
     ("Tsit5, raceway-normal x100, rtol 3e-2, atol 1 pm", "tsit5", 3e-2, PREVIOUS_ATOL, 100.0),
     ("SciPy RK45 (same field, RMS), rtol 1e-3, atol 1 pm", "scipy", 1e-3, PREVIOUS_ATOL, 1.0),
-    (f"{CURRENT_DEFAULT}: Tsit5, raceway-normal x100, rtol 1e-3, atol 10 nm", "tsit5", 1e-3, 1e-6, 100.0),
+    (f"{MAX_NORM_DEFAULT}: Tsit5, raceway-normal x100, rtol 1e-3, atol 10 nm", "tsit5", 1e-3, 1e-6, 100.0),
     ("Tsit5, raceway-normal x100, rtol 1e-2, atol 10 nm", "tsit5", 1e-2, 1e-6, 100.0),
     ("SciPy RK45 (same field, RMS), rtol 1e-3, atol 10 nm", "scipy", 1e-3, 1e-6, 1.0),
+    ("Tsit5, RMS norm, raceway-normal x100, rtol 1e-3, atol 10 nm", "tsit5_rms", 1e-3, 1e-6, 100.0),
+    ("Tsit5, RMS norm, raceway-normal x100, rtol 1e-2, atol 10 nm", "tsit5_rms", 1e-2, 1e-6, 100.0),
+    ("Tsit5, RMS norm, raceway-normal x100, rtol 3e-3, atol 10 nm", "tsit5_rms", 3e-3, 1e-6, 100.0),
+    ("Tsit5, RMS norm, raceway-normal x10, rtol 1e-3, atol 10 nm", "tsit5_rms", 1e-3, 1e-6, 10.0),
+    ("Tsit5, RMS norm (plain), rtol 1e-3, atol 10 nm", "tsit5_rms", 1e-3, 1e-6, 1.0),
+    (
+        f"{CURRENT_DEFAULT}: Tsit5, per-roller RMS norm, raceway-normal x10, rtol 1e-3, atol 10 nm",
+        "tsit5_body_rms",
+        1e-3,
+        1e-6,
+        10.0,
+    ),
+    (
+        "Tsit5, per-roller RMS norm, raceway-normal x100, rtol 1e-3, atol 10 nm",
+        "tsit5_body_rms",
+        1e-3,
+        1e-6,
+        100.0,
+    ),
 )
+#: the error norm's kind (`RacewayNormalNorm.kind`) of each Tsit5 kind of `VARIANTS`
+NORM_OF_KIND = {"tsit5": "max", "tsit5_rms": "rms", "tsit5_body_rms": "body_rms"}
 
 
 # -- settled start states ----------------------------------------------------------------------
@@ -155,11 +185,12 @@ def settled_start(bearing, op, seed: int) -> dict:
 
 
 # -- integrators -----------------------------------------------------------------------------
-def window_solve(params, start, duration, rtol, atol, loosen, *, num_saves: int):
+def window_solve(params, start, duration, rtol, atol, loosen, *, num_saves: int, norm: str = "max"):
     """Tsit5 from the physical state `start` over [0, duration] as `solve_from` integrates, with
     the error norm's raceway-normal loosening `loosen` chosen here: (samples of `SAVED` at
     `num_saves` equally spaced instants including both ends, result code, step attempts,
-    rejected steps). jit-able."""
+    rejected steps). `norm` (static): the norm's kind over the weighted components
+    (`RacewayNormalNorm.kind`). jit-able."""
     import diffrax
     import jax.numpy as jnp
 
@@ -169,7 +200,7 @@ def window_solve(params, start, duration, rtol, atol, loosen, *, num_saves: int)
     from jaxbearing.run._step_control import raceway_normal_norm, step_controller
 
     _, args, y0_scaled, _ = prepare_from(params, start, rtol, atol)
-    controller = step_controller(rtol, atol, raceway_normal_norm(y0_scaled, loosen))
+    controller = step_controller(rtol, atol, raceway_normal_norm(y0_scaled, loosen, norm))
     saveat = diffrax.SaveAt(
         ts=jnp.linspace(0.0, duration, num_saves), fn=lambda t, y, a: {k: _save(t, y, a)[k] for k in SAVED}
     )
@@ -178,13 +209,13 @@ def window_solve(params, start, duration, rtol, atol, loosen, *, num_saves: int)
     return sol.ys, result_code(sol.result), sol.stats["num_steps"], sol.stats["num_rejected_steps"]
 
 
-def compile_window_solve(params, start, num_saves: int):
+def compile_window_solve(params, start, num_saves: int, norm: str = "max"):
     """`window_solve` compiled for (params, start, duration, rtol, atol, loosen): one program
-    serves every seed, tolerance and loosening."""
+    per norm kind serves every seed, tolerance and loosening."""
     import jax.numpy as jnp
 
     def run(p, s, d, r, a, loosen):
-        return window_solve(p, s, d, r, a, loosen, num_saves=num_saves)
+        return window_solve(p, s, d, r, a, loosen, num_saves=num_saves, norm=norm)
 
     f = jnp.asarray
     return _common.compile_jit(run, params, start, f(1e-3), f(1e-3), f(1e-6), f(1.0))
@@ -275,16 +306,21 @@ def _finite(x: float):
 
 
 # -- the benchmark -----------------------------------------------------------------------------
-def stored_reference(case: dict) -> dict | None:
-    """The reference runs of the stored results when they were made for `case` (seeds, window,
-    samples, reference tolerances): `--reuse-reference` runs only the integrators (the reference
-    is 12 of the study's 18 minutes)."""
+def stored_reference(case: dict, names: tuple = (NAME,)) -> dict | None:
+    """The reference runs of the stored results (`names` in results/, the first that fits) when
+    they were made for `case` (seeds, window, samples, reference tolerances): `--reuse-reference`
+    runs only the integrators (the reference is 12 of the study's 18 minutes)."""
     import json
 
-    path = _common.RESULTS_DIR / f"{NAME}.json"
-    if not path.exists():
-        return None
-    old = json.loads(path.read_text())
+    for name in names:
+        path = _common.RESULTS_DIR / f"{name}.json"
+        found = _stored_reference(json.loads(path.read_text()), case) if path.exists() else None
+        if found is not None:
+            return found
+    return None
+
+
+def _stored_reference(old: dict, case: dict) -> dict | None:
     keys = ("seeds", "window_s", "num_saves", "inner_speed_rpm", "radial_load_N")
     if old.get("quick") or any(old["case"].get(k) != case[k] for k in keys):
         return None
@@ -301,7 +337,22 @@ def reference_tolerances(reference: dict) -> tuple:
     return reference["rtol"], float(f"{length:.6g}"), reference["method"]
 
 
-def main(quick: bool = False, window_revs: int = WINDOW_REVS, reuse_reference: bool = False) -> dict:
+def output_name(only: tuple | None, seeds: tuple) -> str:
+    """Results name: `NAME`, `_rows` with --rows, `_seeds4-7` (say) with other seeds than `SEEDS`."""
+    return (
+        NAME
+        + ("" if only is None else "_rows")
+        + ("" if tuple(seeds) == SEEDS else "_seeds" + "-".join(str(s) for s in seeds))
+    )
+
+
+def main(
+    quick: bool = False,
+    window_revs: int = WINDOW_REVS,
+    reuse_reference: bool = False,
+    only: tuple | None = None,
+    seeds: tuple = SEEDS,
+) -> dict:
     import jax
     import jax.numpy as jnp
     import numpy as np
@@ -310,7 +361,8 @@ def main(quick: bool = False, window_revs: int = WINDOW_REVS, reuse_reference: b
     from jaxbearing.dynamics import SCALED_UNITS, Functionals, Params
 
     started = time.perf_counter()
-    seeds = SEEDS[:1] if quick else SEEDS
+    name = output_name(only, seeds)
+    seeds = seeds[:1] if quick else tuple(seeds)
     ref_rtol = QUICK_REF_RTOL if quick else REF_RTOL
     bearing, op = jb.reference_bearing(), jb.reference_operating_point()
     jb.validate_bearing(bearing, op)
@@ -328,10 +380,15 @@ def main(quick: bool = False, window_revs: int = WINDOW_REVS, reuse_reference: b
     ms = window * 1e3
 
     _common.log(f"{NAME}: compiling the window solve, {num_saves} samples over {ms:g} ms")
-    compiled, compile_s = compile_window_solve(params, starts[seeds[0]], num_saves)
-    compile_s = {"window_solve": compile_s}
+    variants = list(VARIANTS) if only is None else [VARIANTS[i] for i in only]
+    compiled, compile_s = {}, {}
+    norms = {NORM_OF_KIND[v[1]] for v in variants if v[1] != "scipy"} | {"max"}  # max: the reference
+    for norm in sorted(norms):
+        compiled[norm], compile_s[f"window_solve_{norm}"] = compile_window_solve(
+            params, starts[seeds[0]], num_saves, norm
+        )
     scipy_runner = None
-    if any(v[1] == "scipy" for v in VARIANTS):
+    if any(v[1] == "scipy" for v in variants):
         scipy_runner = ScipyRunner(bearing, op)
         compile_s["scipy_field"] = scipy_runner.compile_s
 
@@ -339,7 +396,7 @@ def main(quick: bool = False, window_revs: int = WINDOW_REVS, reuse_reference: b
         if kind == "scipy":
             r = run_scipy(scipy_runner, params, starts[seed], window, num_saves, rtol, atol)
         else:
-            r = run_tsit5(compiled, params, starts[seed], window, rtol, atol, loosen)
+            r = run_tsit5(compiled[NORM_OF_KIND[kind]], params, starts[seed], window, rtol, atol, loosen)
         hist = r.pop("hist")
         r["statistics"] = window_statistics(hist, 0.0, omega_kin)
         r["evaluations_per_ms"] = r["evaluations"] / ms
@@ -369,7 +426,8 @@ def main(quick: bool = False, window_revs: int = WINDOW_REVS, reuse_reference: b
         "final_state); per-seed CI from 8 batch means of the reference over the window; cage slip "
         "errors are absolute",
     }
-    reference = (stored_reference(case) if reuse_reference else None) or {}
+    names = (NAME, name, output_name(None, seeds))
+    reference = (stored_reference(case, names) if reuse_reference else None) or {}
     if reference:
         _common.log(f"{NAME}: reference runs from the stored results (--reuse-reference)")
     for seed in seeds:
@@ -385,7 +443,7 @@ def main(quick: bool = False, window_revs: int = WINDOW_REVS, reuse_reference: b
     ref_values = {s: [reference[str(seed)]["statistics"][s] for seed in seeds] for s in STATS}
 
     rows = []
-    for label, kind, rtol, atol, loosen in VARIANTS:
+    for label, kind, rtol, atol, loosen in variants:
         per_seed = {}
         for seed in seeds:
             _common.log(f"{NAME}: {label}, seed {seed}")
@@ -403,11 +461,15 @@ def main(quick: bool = False, window_revs: int = WINDOW_REVS, reuse_reference: b
             }
         )
         rows[-1]["agrees_all"] = all(rows[-1]["over_seeds"][s]["agrees"] for s in STATS)
-    old = next(r for r in rows if r["label"].startswith(OLD_DEFAULT))
-    current = next(r for r in rows if r["label"].startswith(CURRENT_DEFAULT))
-    for row in rows:
-        row["evaluation_ratio_vs_old_default"] = old["evaluations_per_ms"] / row["evaluations_per_ms"]
-        row["evaluation_ratio_vs_current_default"] = current["evaluations_per_ms"] / row["evaluations_per_ms"]
+    for key, label in (
+        ("old_default", OLD_DEFAULT),
+        ("max_norm_default", MAX_NORM_DEFAULT),
+        ("current_default", CURRENT_DEFAULT),
+    ):
+        base = next((r for r in rows if r["label"].startswith(label + ":")), None)
+        for row in rows:  # with --rows, only against the defaults that were run
+            if base is not None:
+                row[f"evaluation_ratio_vs_{key}"] = base["evaluations_per_ms"] / row["evaluations_per_ms"]
     result = {
         "benchmark": NAME,
         "quick": quick,
@@ -424,7 +486,7 @@ def main(quick: bool = False, window_revs: int = WINDOW_REVS, reuse_reference: b
     }
     result["table"] = _table(result)
     print(result["table"])
-    _common.write_json(NAME, result)
+    _common.write_json(name, result)
     return result
 
 
@@ -457,6 +519,7 @@ def _table(r: dict) -> str:
             float(np.mean([x["evaluations_per_ms"] for x in refs])),
             None,
             None,
+            None,
             float(np.mean([x["wall_s_per_ms"] for x in refs])),
             None,
             None,
@@ -467,8 +530,9 @@ def _table(r: dict) -> str:
             [
                 v["label"],
                 v["evaluations_per_ms"],
-                v["evaluation_ratio_vs_old_default"],
-                v["evaluation_ratio_vs_current_default"],
+                v.get("evaluation_ratio_vs_old_default", math.nan),
+                v.get("evaluation_ratio_vs_max_norm_default", math.nan),
+                v.get("evaluation_ratio_vs_current_default", math.nan),
                 v["wall_s_per_ms"],
                 v["max_error_in_ci"],
                 v["agrees_all"] if len(c["seeds"]) > 1 else None,
@@ -484,7 +548,8 @@ def _table(r: dict) -> str:
             "integrator",
             "evals/ms",
             "x fewer vs old",
-            "x fewer vs current",
+            "x fewer vs max-norm",
+            "x fewer vs default",
             "wall s/ms",
             "max err/CI",
             "agree",
@@ -518,6 +583,25 @@ def self_check() -> None:
     assert paired_over_seeds([1.0], [1.0])["agrees"] is None  # one seed: no interval
 
 
+def seeds_argument(argv: list) -> tuple:
+    """The seeds of `--seeds 4,5,6,7` (`SEEDS` without it); anything but two or more distinct
+    non-negative integers ends the program with one line naming the option and its value."""
+    if "--seeds" not in argv:
+        return SEEDS
+    at = argv.index("--seeds") + 1
+    text = argv[at] if at < len(argv) else ""
+    parts = text.split(",")
+    if not all(p.strip().isdigit() for p in parts) or len(set(parts)) < 2:
+        raise SystemExit(f"--seeds = {text!r}: two or more distinct non-negative integers, e.g. 4,5,6,7")
+    return tuple(int(p) for p in parts)
+
+
 if __name__ == "__main__":
     revs = int(sys.argv[sys.argv.index("--revs") + 1]) if "--revs" in sys.argv else WINDOW_REVS
-    main(quick="--quick" in sys.argv, window_revs=revs, reuse_reference="--reuse-reference" in sys.argv)
+    main(
+        quick="--quick" in sys.argv,
+        window_revs=revs,
+        reuse_reference="--reuse-reference" in sys.argv,
+        only=rows_argument(sys.argv, len(VARIANTS)),
+        seeds=seeds_argument(sys.argv),
+    )

@@ -60,7 +60,7 @@ def step_counts(params, start, rtol, loosened: dict):
     from jaxbearing.run._step_control import RacewayNormalNorm, step_controller
 
     _, args, y0, _ = prepare_from(params, start, rtol, 1e-6)
-    controller = step_controller(rtol, 1e-6, RacewayNormalNorm(weights=weights(y0, loosened)))
+    controller = step_controller(rtol, 1e-6, RacewayNormalNorm(weights=weights(y0, loosened), kind="max"))
     saveat = diffrax.SaveAt(t1=True, fn=lambda t, y, a: a.scaling.unscale(t, y).cage.speed)
     with checks_without_host_callbacks():
         sol = _diffeqsolve(y0, args, DURATION, saveat, controller, 2_000_000, None, False, "tsit5")

@@ -32,3 +32,20 @@ def test_agreement_needs_the_difference_below_the_reference_half_width():
     out = paired_over_seeds([1.5, 0.701, 1.399, 0.8], ref)  # differences 0.5, -0.3, 0.4, -0.2
     assert out["difference"]["ci95_low"] < 0.0 < out["difference"]["ci95_high"]
     assert out["agrees"] is False
+
+
+def test_rows_and_seeds_options_are_checked_in_one_line():
+    from bench_work_precision_settled import SEEDS, VARIANTS, output_name, rows_argument, seeds_argument
+
+    assert rows_argument(["x"], len(VARIANTS)) is None
+    assert rows_argument(["x", "--rows", "0,12"], len(VARIANTS)) == (0, 12)
+    for bad in ("0,99", "a", ""):
+        with pytest.raises(SystemExit, match=r"--rows = .*in \[0, \d+\]"):
+            rows_argument(["x", "--rows", bad], len(VARIANTS))
+    assert seeds_argument(["x"]) == SEEDS
+    assert seeds_argument(["x", "--seeds", "4,5,6,7"]) == (4, 5, 6, 7)
+    for bad in ("4", "4,4", "-1,2", "a,b"):
+        with pytest.raises(SystemExit, match="--seeds = "):
+            seeds_argument(["x", "--seeds", bad])
+    assert output_name(None, SEEDS) == "bench_work_precision_settled"
+    assert output_name((0, 12), (4, 5, 6, 7)) == "bench_work_precision_settled_rows_seeds4-5-6-7"

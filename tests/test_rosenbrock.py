@@ -256,9 +256,9 @@ def test_roller_blocks_equal_the_diagonal_blocks_of_the_dense_jacobian():
 def test_agrees_with_tsit5_on_a_short_reference_bearing_run():
     """0.3 ms of the reference bearing from the quasi-static start: cage speed and roller loads
     of ROS34PW2 and Tsit5 (both rtol 1e-5, atol 1e-10: 1 pm, 1 nm/s, 1 urad/s) agree to far below
-    their own scale. (At the default atol, 10 nm, with the raceway-normal coordinates' 100x
-    looser, the roller loads of the two differ by 1.7 % of the largest: the tolerance, not the
-    solvers.)"""
+    their own scale. (At atol 10 nm under the max norm with the raceway-normal coordinates 100x
+    looser, the default of 2026-11-24, the roller loads of the two differed by 1.7 % of the
+    largest: the tolerance, not the solvers.)"""
     b, op = jb.reference_bearing(), jb.reference_operating_point()
     out = {}
     for solver in ("tsit5", "ros34pw2"):

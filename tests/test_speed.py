@@ -36,10 +36,10 @@ def _random_state(z=5):
     )
 
 
-def test_raceway_normal_norm_is_the_max_norm_with_radial_tolerances_loosened():
+def test_raceway_normal_norm_max_kind_is_the_max_norm_with_radial_tolerances_loosened():
     x = _random_state()
-    assert float(raceway_normal_norm(x, 1.0)(x)) == float(optx.max_norm(x))
-    norm = raceway_normal_norm(x, 100.0)
+    assert float(raceway_normal_norm(x, 1.0, "max")(x)) == float(optx.max_norm(x))
+    norm = raceway_normal_norm(x, 100.0, "max")
     assert isinstance(norm, RacewayNormalNorm)
     # a huge radial-velocity error of one roller counts 1/100
     big = jax.tree_util.tree_map(jnp.zeros_like, x)
@@ -48,6 +48,65 @@ def test_raceway_normal_norm_is_the_max_norm_with_radial_tolerances_loosened():
     # an axial (flange-side) error counts in full
     big = eqx.tree_at(lambda s: s.rollers.axial, big, jnp.zeros(5).at[0].set(3.0))
     np.testing.assert_allclose(float(norm(big)), 3.0)
+
+
+def test_rms_kind_is_the_rms_norm_over_the_bodies_coordinates():
+    """sqrt(sum (w_i x_i)^2 / N) over the N coordinates of the rollers, cage and inner ring (not
+    the accumulators); zero derivative at zero error."""
+    x = _random_state()
+    bodies = (x.rollers, x.cage, x.inner_ring)
+    n = sum(v.size for v in jax.tree_util.tree_leaves(bodies))
+    assert n == 12 * 5 + 16
+    rms = raceway_normal_norm(x, 1.0, "rms")
+    np.testing.assert_allclose(float(rms(x)), float(optx.rms_norm(bodies)), rtol=1e-14)
+    acc = eqx.tree_at(lambda s: s.accumulators, x, jax.tree_util.tree_map(lambda a: 1e3 * a, x.accumulators))
+    assert float(rms(acc)) == float(rms(x))
+    norm = raceway_normal_norm(x, 100.0, "rms")
+    zero = jax.tree_util.tree_map(jnp.zeros_like, x)
+    one = eqx.tree_at(lambda s: s.rollers.radial_velocity, zero, jnp.zeros(5).at[2].set(50.0))
+    one = eqx.tree_at(lambda s: s.rollers.axial, one, jnp.zeros(5).at[0].set(3.0))
+    np.testing.assert_allclose(float(norm(one)), np.sqrt((0.5**2 + 3.0**2) / n), rtol=1e-14)
+    grad = jax.grad(norm)(zero)
+    assert all(bool(jnp.all(g == 0.0)) for g in jax.tree_util.tree_leaves(grad))
+    with pytest.raises(ValueError, match="error norm kind 'l1'"):
+        raceway_normal_norm(x, 1.0, "l1")
+
+
+def test_default_norm_is_the_largest_rms_of_a_body():
+    """max over bodies of each body's RMS: a roller's 12 coordinates, the cage's 6, the inner
+    ring's 10 (accumulators left out); the raceway-normal coordinates 10x looser."""
+    from jaxbearing.run._step_control import DEFAULT_ERROR_NORM, RACEWAY_NORMAL_LOOSEN
+
+    assert DEFAULT_ERROR_NORM == "body_rms" and RACEWAY_NORMAL_LOOSEN == 10.0
+    x = _random_state()
+    norm = raceway_normal_norm(x)
+    assert norm.kind == "body_rms"
+    zero = jax.tree_util.tree_map(jnp.zeros_like, x)
+    # roller 2: radial velocity 50 (counts 5) and axial 3; roller 0: axis component 2
+    y = eqx.tree_at(lambda s: s.rollers.radial_velocity, zero, jnp.zeros(5).at[2].set(50.0))
+    y = eqx.tree_at(lambda s: s.rollers.axial, y, jnp.zeros(5).at[2].set(3.0))
+    y = eqx.tree_at(lambda s: s.rollers.axis, y, jnp.zeros((5, 3)).at[0, 1].set(2.0))
+    np.testing.assert_allclose(float(norm(y)), np.sqrt((5.0**2 + 3.0**2) / 12), rtol=1e-14)
+    # the cage alone: RMS over its 6 coordinates
+    c = eqx.tree_at(lambda s: s.cage.speed, zero, jnp.asarray(6.0))
+    np.testing.assert_allclose(float(norm(c)), 6.0 / np.sqrt(6), rtol=1e-14)
+    # the accumulators do not count
+    acc = eqx.tree_at(lambda s: s.accumulators, y, jax.tree_util.tree_map(lambda a: a + 1e3, y.accumulators))
+    assert float(norm(acc)) == float(norm(y))
+    # a huge error of one roller is not diluted by the others: the norm of 26 rollers equals 5's
+    x26 = _random_state(26)
+    y26 = eqx.tree_at(
+        lambda s: s.rollers.axial, jax.tree_util.tree_map(jnp.zeros_like, x26), jnp.zeros(26).at[7].set(3.0)
+    )
+    np.testing.assert_allclose(float(raceway_normal_norm(x26)(y26)), 3.0 / np.sqrt(12), rtol=1e-14)
+
+
+def test_solve_refuses_an_unknown_error_norm_in_one_line():
+    b, op = jb.reference_bearing(), jb.reference_operating_point()
+    with pytest.raises(
+        UserInputError, match=r"error_norm = 'rmss': must be one of \('max', 'rms', 'body_rms'\)"
+    ):
+        jb.solve(b, op, 1e-6, error_norm="rmss")
 
 
 def test_default_atol_means_10_nm_10_um_s_and_0_01_rad_s():

@@ -85,7 +85,13 @@ from ._steady_gradient import (
     steady_gradient,
     tangent_growth,
 )
-from ._step_control import RACEWAY_NORMAL_LOOSEN, RacewayNormalNorm, raceway_normal_norm
+from ._step_control import (
+    DEFAULT_ERROR_NORM,
+    ERROR_NORMS,
+    RACEWAY_NORMAL_LOOSEN,
+    RacewayNormalNorm,
+    raceway_normal_norm,
+)
 from ._summary import FILM_KEYS, contact_events, film_statistics
 
 __all__ = [
@@ -104,6 +110,8 @@ __all__ = [
     "FILM_KEYS",
     "RESULT_NAMES",
     "CACHE_ENV",
+    "DEFAULT_ERROR_NORM",
+    "ERROR_NORMS",
     "RACEWAY_NORMAL_LOOSEN",
     "RacewayNormalNorm",
     "enable_compilation_cache",

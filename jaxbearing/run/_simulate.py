@@ -4,12 +4,13 @@
   perturbation of the rollers' axial positions and skew (a perfectly symmetric bearing never
   skews in a deterministic model; real rollers start with manufacturing scatter).
 * Explicit adaptive Runge-Kutta (Tsit5) with a PID step-size controller, the paper's tolerances
-  (rtol 1e-3, atol 1e-6) applied to a *scaled deviation* of the state (`_state.Scaling`) under the
-  max norm, so that every component's tolerance means something physical (atol: 10 nm,
-  10 um/s, 0.01 rad/s; `dynamics.SCALED_UNITS`, docs/model.md 13), except that the
-  raceway-normal coordinates (roller radial position and velocity, inner-ring centre) have
-  tolerances `raceway_loosen` = 100 times looser (`_step_control`: their 62 kHz ringing need not
-  be resolved to rtol); `max_steps` explicit. `solver="ros34pw2"` selects the linearly implicit
+  (rtol 1e-3, atol 1e-6) applied to a *scaled deviation* of the state (`_state.Scaling`), so
+  that every component's tolerance means something physical (atol: 10 nm, 10 um/s, 0.01 rad/s;
+  `dynamics.SCALED_UNITS`, docs/model.md 13), except that the raceway-normal coordinates
+  (roller radial position and velocity, inner-ring centre) have tolerances `raceway_loosen` =
+  10 times looser (their 62 kHz ringing need not be resolved to rtol), under the largest RMS
+  of a body's coordinates (each roller's, the cage's, the inner ring's; `_step_control`);
+  `max_steps` explicit. `solver="ros34pw2"` selects the linearly implicit
   Rosenbrock-W method with per-roller Jacobian blocks instead (`_rosenbrock`; slower, README).
 * Outputs: the solve keeps only the scaled state at the sample times (`SaveAt(ts=...,
   fn=_saved_state)`, without the accumulators), and the flange-contact quantities, cage speed
@@ -51,7 +52,14 @@ from ._initial import Perturbation, initial_state, perturbation_of, traced_scatt
 from ._progress import SolveProgress
 from ._result import SimulationResult, Solution, result_code, simulation_result, smooth_functionals
 from ._rosenbrock import DEFAULT_SOLVER, check_solver, diffrax_solver
-from ._step_control import DT0, RACEWAY_NORMAL_LOOSEN, raceway_normal_norm, step_controller
+from ._step_control import (
+    DEFAULT_ERROR_NORM,
+    DT0,
+    ERROR_NORMS,
+    RACEWAY_NORMAL_LOOSEN,
+    raceway_normal_norm,
+    step_controller,
+)
 
 
 class SolveArgs(eqx.Module):
@@ -143,10 +151,18 @@ def _save(t, y_scaled, args: SolveArgs):
     )
 
 
-def _check_solve(bearing, op, duration, *, adjoint=None, solver=DEFAULT_SOLVER, **kwargs) -> None:
+def _check_solve(
+    bearing, op, duration, *, adjoint=None, solver=DEFAULT_SOLVER, error_norm=None, **kwargs
+) -> None:
     """`check_solve_inputs` of the solver arguments, perturbation, functionals and pytrees;
-    `adjoint` must be a diffrax adjoint or None; `solver` one of `_rosenbrock.SOLVERS`."""
+    `adjoint` must be a diffrax adjoint or None; `solver` one of `_rosenbrock.SOLVERS`;
+    `error_norm` None, one of `ERROR_NORMS` or a callable."""
     check_solver(solver)
+    if not (error_norm is None or error_norm in ERROR_NORMS or callable(error_norm)):
+        raise UserInputError(
+            f"error_norm = {error_norm!r}: must be one of {ERROR_NORMS}, a function of the scaled "
+            f"state pytree returning a scalar, or None (the default, {DEFAULT_ERROR_NORM!r})"
+        )
     if adjoint is not None and not isinstance(adjoint, diffrax.AbstractAdjoint):
         raise UserInputError(
             f"adjoint = {adjoint!r}: must be a diffrax adjoint (e.g. diffrax.ForwardMode()) or None"
@@ -203,9 +219,11 @@ def solve(
     (`num_saves = 0`: only the smooth functionals at t1, the cheapest form for gradients).
     `adjoint` selects how gradients flow through the solve (default: diffrax's checkpointed
     reverse mode; `diffrax.ForwardMode()` for `jax.jacfwd`).
-    Error control (`_step_control`): the max norm over the scaled state with the raceway-normal
-    coordinates' tolerances `raceway_loosen` times looser (a float, may be traced; 1 = plain max
-    norm); `error_norm` (a function pytree -> scalar, e.g. `optimistix.rms_norm`) replaces it.
+    Error control (`_step_control`): `error_norm` "body_rms" (None: the default; the largest
+    of the rollers', cage's and inner ring's RMS), "rms" or "max" over the scaled state, with
+    the raceway-normal coordinates' tolerances `raceway_loosen` times looser (a float, may be
+    traced; 1 = the plain norm); a function pytree -> scalar (e.g. `optimistix.rms_norm`)
+    replaces it.
     `solver` (static): "tsit5" (default, explicit) or "ros34pw2" (linearly implicit
     Rosenbrock-W with every roller's Jacobian block implicit, `_rosenbrock`; slower at the
     tolerances measured so far: README, Performance).
@@ -227,6 +245,7 @@ def solve(
         functionals=functionals,
         adjoint=adjoint,
         solver=solver,
+        error_norm=error_norm,
     )
     y0 = initial_state(bearing, op, perturbation)
     scaling = Scaling(
@@ -241,7 +260,10 @@ def solve(
         saveat = diffrax.SaveAt(subs=[samples, diffrax.SubSaveAt(t1=True, fn=_save_functionals)])
     else:
         saveat = diffrax.SaveAt(t1=True, fn=_save_functionals)
-    norm = error_norm if error_norm is not None else raceway_normal_norm(y0_scaled, raceway_loosen)
+    if error_norm is None or isinstance(error_norm, str):
+        norm = raceway_normal_norm(y0_scaled, raceway_loosen, error_norm or DEFAULT_ERROR_NORM)
+    else:
+        norm = error_norm
     controller = step_controller(rtol, atol, norm)
     with checks_without_host_callbacks():  # cacheable program (`_compile_cache`)
         sol = _diffeqsolve(
