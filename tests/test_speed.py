@@ -93,6 +93,9 @@ def test_default_norm_is_the_largest_rms_of_a_body():
     # the accumulators do not count
     acc = eqx.tree_at(lambda s: s.accumulators, y, jax.tree_util.tree_map(lambda a: a + 1e3, y.accumulators))
     assert float(norm(acc)) == float(norm(y))
+    # finite (zero) derivative at zero error, as for "rms"
+    grad = jax.grad(norm)(zero)
+    assert all(bool(jnp.all(g == 0.0)) for g in jax.tree_util.tree_leaves(grad))
     # a huge error of one roller is not diluted by the others: the norm of 26 rollers equals 5's
     x26 = _random_state(26)
     y26 = eqx.tree_at(

@@ -125,7 +125,9 @@ class RacewayNormalNorm(eqx.Module):
             return optx.max_norm(weighted)
         if self.kind == "rms":
             return optx.rms_norm((weighted.rollers, weighted.cage, weighted.inner_ring))
-        return jnp.sqrt(jnp.max(_mean_squares_per_body(weighted)))
+        largest = jnp.max(_mean_squares_per_body(weighted))
+        positive = largest > 0.0  # double where: a zero, not a NaN, derivative at zero error
+        return jnp.where(positive, jnp.sqrt(jnp.where(positive, largest, 1.0)), 0.0)
 
 
 def _mean_squares_per_body(x: State) -> Float[Array, " Z+2"]:
