@@ -88,6 +88,15 @@ def _cpu_model() -> str | None:
 _T0 = time.perf_counter()
 
 
+def option_value(argv: Sequence[str], option: str) -> str | None:
+    """The word after `option` in `argv` ("" when `option` is last), None without `option`: the
+    command-line options of the benchmarks, each then checked by its script."""
+    if option not in argv:
+        return None
+    at = list(argv).index(option) + 1
+    return argv[at] if at < len(argv) else ""
+
+
 def log(message: str) -> None:
     """A progress line on stderr, stamped with seconds since import (the tables go to stdout)."""
     print(f"[{time.perf_counter() - _T0:7.1f} s] {message}", file=sys.stderr, flush=True)

@@ -33,7 +33,7 @@ import numpy as np
 RESULTS = pathlib.Path(__file__).resolve().parent / "results"
 sys.path.insert(0, str(RESULTS.parent))
 
-from _common import machine_info  # noqa: E402
+from _common import machine_info, option_value  # noqa: E402
 
 
 def _compile_and_first(f, *args):
@@ -197,8 +197,8 @@ def main(quick: bool = True, atol: float | None = None) -> dict:
 
 if __name__ == "__main__":
     given = None
-    if "--atol" in sys.argv:
-        text = sys.argv[sys.argv.index("--atol") + 1] if sys.argv.index("--atol") + 1 < len(sys.argv) else ""
+    text = option_value(sys.argv, "--atol")
+    if text is not None:
         try:
             given = float(text)
         except ValueError:

@@ -397,8 +397,8 @@ def pool_clearance() -> dict:
 if __name__ == "__main__":
     if "--replicate-clearance" in sys.argv:
         first = REPLICATE_FIRST_SEED
-        if "--first-seed" in sys.argv:
-            value = (sys.argv[sys.argv.index("--first-seed") + 1 :] or [""])[0]
+        value = _common.option_value(sys.argv, "--first-seed")
+        if value is not None:
             if not value.isdigit():
                 raise SystemExit(f"--first-seed {value!r}: must be an integer >= 0")
             first = int(value)

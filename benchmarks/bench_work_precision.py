@@ -445,10 +445,9 @@ def rows_argument(argv: list, count: int) -> tuple | None:
     """The indices given by `--rows i,j,...` in `argv` (None without `--rows`), each in [0,
     `count`); anything else ends the program with one line naming the option, its value and
     the valid range."""
-    if "--rows" not in argv:
+    text = _common.option_value(argv, "--rows")
+    if text is None:
         return None
-    at = argv.index("--rows") + 1
-    text = argv[at] if at < len(argv) else ""
     parts = text.split(",")
     if not all(i.strip().isdigit() for i in parts) or any(not 0 <= int(i) < count for i in parts):
         raise SystemExit(

@@ -586,10 +586,9 @@ def self_check() -> None:
 def seeds_argument(argv: list) -> tuple:
     """The seeds of `--seeds 4,5,6,7` (`SEEDS` without it); anything but two or more distinct
     non-negative integers ends the program with one line naming the option and its value."""
-    if "--seeds" not in argv:
+    text = _common.option_value(argv, "--seeds")
+    if text is None:
         return SEEDS
-    at = argv.index("--seeds") + 1
-    text = argv[at] if at < len(argv) else ""
     parts = text.split(",")
     if not all(p.strip().isdigit() for p in parts) or len(set(parts)) < 2:
         raise SystemExit(f"--seeds = {text!r}: two or more distinct non-negative integers, e.g. 4,5,6,7")
