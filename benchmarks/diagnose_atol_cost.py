@@ -14,7 +14,8 @@ measuring the gradient ratio (issue 12).
    and a forward-mode solve, at atol 1e-9 (`GRADIENT_ATOL`) and 1e-13.
 3. A plain solve of 1 us and of 0.3 ms (rtol 1e-6, atol 1e-9, `seated_perturbation`) compiled
    with the bearing as an argument and with the bearing closed over (its arrays constants of the
-   program): wall time per call, minimum of 5.
+   program): wall time per call, minimum of 5; and the same for the quasi-static start alone
+   (`initial_state`), where the difference lies.
 
     python benchmarks/diagnose_atol_cost.py      (about 4 min; results/diagnose_atol_cost.json)
 """
@@ -126,6 +127,15 @@ def main() -> dict:
             "bearing_closed_over_s": _min_time(closed, jnp.zeros(())),
             "steps": int(argument(b)),
         }
+    # where the closed-over solve's extra time goes: the quasi-static start alone
+    from jaxbearing.run._simulate import initial_state
+
+    argument = jax.jit(lambda bb: initial_state(bb, op, pert))
+    closed = jax.jit(lambda x: initial_state(b, op, pert))
+    per_call["quasi-static start alone"] = {
+        "bearing_argument_s": _min_time(argument, b),
+        "bearing_closed_over_s": _min_time(closed, jnp.zeros(())),
+    }
     result["plain_solve_per_call"] = per_call
 
     _common.log(f"{NAME}: steps of the plain and the forward-mode solve (bench_gradients' case)")
