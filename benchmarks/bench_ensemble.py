@@ -14,7 +14,7 @@ Throughput = cases / wall time. Two ratios (2) / (1):
   seconds per pool, amortised over long ensembles);
 * run phase: 2 x (mean run wall of a case alone) / (mean run wall of a case while two run at
   once), from `SimulationResult.wall_time_s` (compile or cache load excluded): the throughput of
-  two concurrent one-thread processes over one process at a time, the figure for ensembles
+  two concurrent processes (each pinned to one CPU) over one process at a time, the figure for ensembles
   long enough that the fixed cost does not matter. The target (>= 1.5x) is read on this one.
 The two are interleaved as (1), (2), (1), (2) in full mode, and the better of each is kept. The
 machine's load average is recorded: on a shared machine other jobs take cores from both.

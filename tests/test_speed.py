@@ -6,6 +6,7 @@ benchmarks/ (bench_work_precision, bench_compile_cache, bench_ensemble), not her
 from __future__ import annotations
 
 import operator
+import os
 
 import equinox as eqx
 import jax
@@ -182,6 +183,29 @@ def test_cache_directory_from_environment(monkeypatch, tmp_path):
 def test_parallel_map_keeps_order_in_two_processes():
     assert parallel_map(operator.neg, [3, 1, 2], workers=2) == [-3, -1, -2]
     assert parallel_map(operator.neg, [4], workers=2) == [-4]  # one item: no pool
+
+
+@pytest.mark.skipif(not hasattr(os, "sched_getaffinity"), reason="CPU affinity is Linux-only")
+def test_parallel_map_pins_each_worker_to_one_cpu():
+    """Every worker of a pool runs on one CPU of this process's set (its XLA threads with it),
+    the workers in turn on the set's CPUs."""
+    from jaxbearing.run._ensemble import _pin_to_one_cpu
+
+    mine = os.sched_getaffinity(0)
+    seen = parallel_map(os.sched_getaffinity, [0] * 6, workers=2)
+    assert all(len(cpus) == 1 and cpus <= mine for cpus in seen)
+    cpus = sorted(mine)
+    expected = [{cpus[i % len(cpus)]} for i in range(3)]
+    assert parallel_map(_affinity_after_pin, [(i, cpus) for i in range(3)], workers=2) == expected
+    _pin_to_one_cpu(0, [])  # no CPUs given: nothing to do
+    assert os.sched_getaffinity(0) == mine
+
+
+def _affinity_after_pin(args):
+    from jaxbearing.run._ensemble import _pin_to_one_cpu
+
+    _pin_to_one_cpu(*args)
+    return os.sched_getaffinity(0)
 
 
 def test_shared_workers_keep_one_pool_for_the_block():
