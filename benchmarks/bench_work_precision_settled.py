@@ -102,7 +102,13 @@ OLD_DEFAULT, PREVIOUS_DEFAULT, CURRENT_DEFAULT = "old default", "previous defaul
 #: the default from 2026-11-24 to 2026-11-25 (max norm, atol 10 nm)
 MAX_NORM_DEFAULT = "max-norm default"
 
-#: (label, kind, rtol, atol, raceway_loosen); kind "tsit5" (diffrax, max norm with the
+
+def _controller_label(c: tuple) -> str:
+    return "P {:g} I {:g} safety {:g} growth <= {:g}".format(*c)
+
+
+#: (label, kind, rtol, atol, raceway_loosen[, controller]); controller (pcoeff, icoeff, safety,
+#: factormax) of the PID step controller, default the library's; kind "tsit5" (diffrax, max norm with the
 #: raceway-normal tolerances `raceway_loosen` times looser), "tsit5_rms" (the same weights in the
 #: RMS norm), "tsit5_body_rms" (the largest of the rollers', cage's and inner ring's RMS) or
 #: "scipy" (solve_ivp RK45, RMS norm)
@@ -140,6 +146,29 @@ VARIANTS = (
         1e-3,
         1e-6,
         100.0,
+    ),
+    # the step controller (rows 16-24): the default's norm and tolerances, other (pcoeff,
+    # icoeff, safety, factormax); the library's is (0.3, 0.4, 0.9, 10)
+    *(
+        (
+            f"Tsit5, per-roller RMS x10, rtol 1e-3, atol 10 nm, controller {_controller_label(c)}",
+            "tsit5_body_rms",
+            1e-3,
+            1e-6,
+            10.0,
+            c,
+        )
+        for c in (
+            (0.0, 1.0, 0.9, 10.0),
+            (0.4, 0.3, 0.9, 10.0),
+            (0.1, 0.3, 0.9, 10.0),
+            (0.0, 0.7, 0.9, 10.0),
+            (0.3, 0.4, 0.8, 10.0),
+            (0.3, 0.4, 0.95, 10.0),
+            (0.3, 0.4, 1.0, 10.0),
+            (0.3, 0.4, 0.9, 2.0),
+            (0.3, 0.4, 0.9, 1.5),
+        )
     ),
 )
 #: the error norm's kind (`RacewayNormalNorm.kind`) of each Tsit5 kind of `VARIANTS`
@@ -185,12 +214,15 @@ def settled_start(bearing, op, seed: int) -> dict:
 
 
 # -- integrators -----------------------------------------------------------------------------
-def window_solve(params, start, duration, rtol, atol, loosen, *, num_saves: int, norm: str = "max"):
+def window_solve(
+    params, start, duration, rtol, atol, loosen, controller=None, *, num_saves: int, norm: str = "max"
+):
     """Tsit5 from the physical state `start` over [0, duration] as `solve_from` integrates, with
     the error norm's raceway-normal loosening `loosen` chosen here: (samples of `SAVED` at
     `num_saves` equally spaced instants including both ends, result code, step attempts,
     rejected steps). `norm` (static): the norm's kind over the weighted components
-    (`RacewayNormalNorm.kind`). jit-able."""
+    (`RacewayNormalNorm.kind`). `controller`: the step controller's (pcoeff, icoeff, safety,
+    factormax), default the library's (`library_controller`). jit-able."""
     import diffrax
     import jax.numpy as jnp
 
@@ -200,7 +232,16 @@ def window_solve(params, start, duration, rtol, atol, loosen, *, num_saves: int,
     from jaxbearing.run._step_control import raceway_normal_norm, step_controller
 
     _, args, y0_scaled, _ = prepare_from(params, start, rtol, atol)
-    controller = step_controller(rtol, atol, raceway_normal_norm(y0_scaled, loosen, norm))
+    pcoeff, icoeff, safety, factormax = library_controller() if controller is None else controller
+    controller = step_controller(
+        rtol,
+        atol,
+        raceway_normal_norm(y0_scaled, loosen, norm),
+        pcoeff=pcoeff,
+        icoeff=icoeff,
+        safety=safety,
+        factormax=factormax,
+    )
     saveat = diffrax.SaveAt(
         ts=jnp.linspace(0.0, duration, num_saves), fn=lambda t, y, a: {k: _save(t, y, a)[k] for k in SAVED}
     )
@@ -209,26 +250,35 @@ def window_solve(params, start, duration, rtol, atol, loosen, *, num_saves: int,
     return sol.ys, result_code(sol.result), sol.stats["num_steps"], sol.stats["num_rejected_steps"]
 
 
+def library_controller() -> tuple:
+    """The library's step controller: (pcoeff, icoeff, safety, factormax)."""
+    from jaxbearing.run import _step_control as c
+
+    return (c.PID_PCOEFF, c.PID_ICOEFF, c.PID_SAFETY, c.PID_FACTORMAX)
+
+
 def compile_window_solve(params, start, num_saves: int, norm: str = "max"):
-    """`window_solve` compiled for (params, start, duration, rtol, atol, loosen): one program
-    per norm kind serves every seed, tolerance and loosening."""
+    """`window_solve` compiled for (params, start, duration, rtol, atol, loosen, controller):
+    one program per norm kind serves every seed, tolerance, loosening and controller."""
     import jax.numpy as jnp
 
-    def run(p, s, d, r, a, loosen):
-        return window_solve(p, s, d, r, a, loosen, num_saves=num_saves, norm=norm)
+    def run(p, s, d, r, a, loosen, c):
+        return window_solve(p, s, d, r, a, loosen, tuple(c), num_saves=num_saves, norm=norm)
 
     f = jnp.asarray
-    return _common.compile_jit(run, params, start, f(1e-3), f(1e-3), f(1e-6), f(1.0))
+    return _common.compile_jit(run, params, start, f(1e-3), f(1e-3), f(1e-6), f(1.0), f(library_controller()))
 
 
-def run_tsit5(compiled, params, start, duration, rtol, atol, loosen) -> dict:
+def run_tsit5(compiled, params, start, duration, rtol, atol, loosen, controller=None) -> dict:
     import jax
     import jax.numpy as jnp
     import numpy as np
 
     f = jnp.asarray
     wall, (hist, code, steps, rejected) = _common.time_once(
-        lambda: compiled(params, start, f(duration), f(rtol), f(atol), f(loosen))
+        lambda: compiled(
+            params, start, f(duration), f(rtol), f(atol), f(loosen), f(controller or library_controller())
+        )
     )
     steps = int(steps)
     return {
@@ -392,11 +442,13 @@ def main(
         scipy_runner = ScipyRunner(bearing, op)
         compile_s["scipy_field"] = scipy_runner.compile_s
 
-    def run(kind, seed, rtol, atol, loosen):
+    def run(kind, seed, rtol, atol, loosen, controller=None):
         if kind == "scipy":
             r = run_scipy(scipy_runner, params, starts[seed], window, num_saves, rtol, atol)
         else:
-            r = run_tsit5(compiled[NORM_OF_KIND[kind]], params, starts[seed], window, rtol, atol, loosen)
+            r = run_tsit5(
+                compiled[NORM_OF_KIND[kind]], params, starts[seed], window, rtol, atol, loosen, controller
+            )
         hist = r.pop("hist")
         r["statistics"] = window_statistics(hist, 0.0, omega_kin)
         r["evaluations_per_ms"] = r["evaluations"] / ms
@@ -443,11 +495,12 @@ def main(
     ref_values = {s: [reference[str(seed)]["statistics"][s] for seed in seeds] for s in STATS}
 
     rows = []
-    for label, kind, rtol, atol, loosen in variants:
+    for label, kind, rtol, atol, loosen, *rest in variants:
+        controller = rest[0] if rest else None
         per_seed = {}
         for seed in seeds:
             _common.log(f"{NAME}: {label}, seed {seed}")
-            r, _ = run(kind, seed, rtol, atol, loosen)
+            r, _ = run(kind, seed, rtol, atol, loosen, controller)
             ref = reference[str(seed)]
             r["errors"] = errors(r["statistics"], ref["statistics"], ref["ci_halfwidth"])
             per_seed[str(seed)] = r
@@ -455,6 +508,9 @@ def main(
         rows.append(
             {
                 **variant_row(label, kind, rtol, atol, loosen, per_seed),
+                "controller": dict(
+                    zip(("pcoeff", "icoeff", "safety", "factormax"), controller or library_controller())
+                ),
                 "over_seeds": {
                     s: paired_over_seeds([x["statistics"][s] for x in runs], ref_values[s]) for s in STATS
                 },

@@ -62,17 +62,38 @@ RACEWAY_NORMAL_LOOSEN = 10.0
 #: PID step-size controller coefficients (diffrax `PIDController`: proportional 0.3, integral
 #: 0.4, the values diffrax's documentation suggests for non-stiff problems).
 PID_PCOEFF, PID_ICOEFF = 0.3, 0.4
+#: the controller's safety factor on the proposed step and its largest growth per step
+#: (diffrax's defaults, stated here so that a benchmark can vary them)
+PID_SAFETY, PID_FACTORMAX = 0.9, 10.0
 #: smallest step [s]: below it the solve stops with `dt_min_reached` (non-finite dynamics).
 DT_MIN = 1e-13
 #: first step tried [s] (diffrax's automatic first step stalls at the quasi-static start).
 DT0 = 1e-7
 
 
-def step_controller(rtol, atol, norm) -> diffrax.PIDController:
-    """The step-size controller of every solve: PID with `PID_PCOEFF`, `PID_ICOEFF`, `DT_MIN`
-    and the error `norm` (e.g. `raceway_normal_norm(y0)`)."""
+def step_controller(
+    rtol,
+    atol,
+    norm,
+    *,
+    pcoeff=PID_PCOEFF,
+    icoeff=PID_ICOEFF,
+    safety=PID_SAFETY,
+    factormax=PID_FACTORMAX,
+) -> diffrax.PIDController:
+    """The step-size controller of every solve: PID with `PID_PCOEFF`, `PID_ICOEFF`,
+    `PID_SAFETY`, `PID_FACTORMAX`, `DT_MIN` and the error `norm` (e.g.
+    `raceway_normal_norm(y0)`). The keywords are for studies of the controller
+    (benchmarks/bench_work_precision_settled.py); they may be traced."""
     return diffrax.PIDController(
-        rtol=rtol, atol=atol, pcoeff=PID_PCOEFF, icoeff=PID_ICOEFF, norm=norm, dtmin=DT_MIN
+        rtol=rtol,
+        atol=atol,
+        pcoeff=pcoeff,
+        icoeff=icoeff,
+        safety=safety,
+        factormax=factormax,
+        norm=norm,
+        dtmin=DT_MIN,
     )
 
 
