@@ -76,7 +76,8 @@ STATS = ("mean_pv", "p95_pv", "mean_sliding_speed", "cage_slip")
 #: (label, kind, rtol, atol, raceway_loosen); kind: "solve" (max norm weighted by
 #: raceway_loosen), "rms" (solve with optimistix.rms_norm), "scipy" (solve_ivp RK45), "ros"
 #: (ROS34PW2, max norm weighted by raceway_loosen), "default" (solve's default norm, the largest
-#: RMS of one body's coordinates, weighted by raceway_loosen)
+#: RMS of one body's coordinates, weighted by raceway_loosen); an optional sixth element, the
+#: rotations' loosening (`solve(rotation_loosen=...)`), is 1 where absent
 VARIANTS = (
     ("old default: Tsit5, max norm, rtol 1e-3", "solve", 1e-3, PREVIOUS_ATOL, 1.0),
     ("Tsit5, max norm, rtol 1e-2", "solve", 1e-2, PREVIOUS_ATOL, 1.0),
@@ -93,14 +94,22 @@ VARIANTS = (
     ("Rosenbrock-W ROS34PW2, raceway-normal tol x100, rtol 3e-2", "ros", 3e-2, PREVIOUS_ATOL, 100.0),
     ("max-norm default: Tsit5, raceway-normal tol x100, rtol 1e-3, atol 10 nm", "solve", 1e-3, 1e-6, 100.0),
     (
-        "default: Tsit5, per-roller RMS norm, raceway-normal tol x10, rtol 1e-3, atol 10 nm",
+        "per-roller RMS default: Tsit5, per-roller RMS norm, raceway-normal tol x10, rtol 1e-3, atol 10 nm",
         "default",
         1e-3,
         1e-6,
         10.0,
     ),
+    (
+        "default: Tsit5, per-roller RMS norm, raceway-normal tol x10, rotations x10, rtol 1e-3, atol 10 nm",
+        "default",
+        1e-3,
+        1e-6,
+        10.0,
+        10.0,
+    ),
 )
-QUICK_VARIANTS = (0, 3, 5, 8, 9, 14)
+QUICK_VARIANTS = (0, 3, 5, 8, 9, 15)
 #: `--imex`: the old and previous Tsit5 defaults (atol 1 pm), Tsit5 at rtol 1e-2, and the Rosenbrock-W rows
 IMEX_VARIANTS = (0, 3, 6, 10, 11, 12)
 
@@ -184,14 +193,15 @@ def errors(stats: dict, ref: dict, ci: dict) -> dict:
 
 # -- integrators -----------------------------------------------------------------------------
 def compile_solve(bearing, op, num_saves: int, kind: str):
-    """Compiled (bearing, op, duration, rtol, atol, loosen, seed) -> Solution; seed is traced, so
-    one program serves every seed, tolerance and loosening."""
+    """Compiled (bearing, op, duration, rtol, atol, loosen, rotation, seed) -> Solution; seed is
+    traced, so one program serves every seed, tolerance and loosening (raceway-normal
+    `loosen`, `rotation` for the rotations)."""
     import jax.numpy as jnp
     import optimistix as optx
 
     import jaxbearing as jb
 
-    def run(b, o, d, r, a, loosen, seed):
+    def run(b, o, d, r, a, loosen, rotation, seed):
         norm = {"rms": optx.rms_norm, "default": None}.get(kind, "max")
         return jb.solve(
             b,
@@ -202,12 +212,14 @@ def compile_solve(bearing, op, num_saves: int, kind: str):
             rtol=r,
             atol=a,
             raceway_loosen=loosen,
+            rotation_loosen=rotation,
             error_norm=norm,
             perturbation=jb.Perturbation(seed=seed),
         )
 
     f = jnp.asarray
-    return _common.compile_jit(run, bearing, op, f(1e-3), f(1e-3), f(1e-6), f(1.0), jnp.asarray(0, jnp.int32))
+    seed = jnp.asarray(0, jnp.int32)
+    return _common.compile_jit(run, bearing, op, f(1e-3), f(1e-3), f(1e-6), f(1.0), f(1.0), seed)
 
 
 def jacobian_cost(bearing, op, repeats: int = 20) -> dict:
@@ -234,14 +246,18 @@ def jacobian_cost(bearing, op, repeats: int = 20) -> dict:
     return out
 
 
-def run_solve(compiled, bearing, op, duration, rtol, atol, loosen, seed, kind="solve", jac_cost=0.0) -> dict:
+def run_solve(
+    compiled, bearing, op, duration, rtol, atol, loosen, seed, kind="solve", jac_cost=0.0, rotation=1.0
+) -> dict:
     import jax
     import jax.numpy as jnp
     import numpy as np
 
     f = jnp.asarray
     wall, sol = _common.time_once(
-        lambda: compiled(bearing, op, f(duration), f(rtol), f(atol), f(loosen), jnp.asarray(seed, jnp.int32))
+        lambda: compiled(
+            bearing, op, f(duration), f(rtol), f(atol), f(loosen), f(rotation), jnp.asarray(seed, jnp.int32)
+        )
     )
     hist = jax.tree_util.tree_map(np.asarray, sol.histories)
     steps = int(sol.num_steps)
@@ -369,11 +385,13 @@ def main(quick: bool = False, imex: bool = False, rows: tuple | None = None, cor
     if scipy_runner is not None:
         compile_s["scipy_field"] = scipy_runner.compile_s
 
-    def run(kind, rtol, atol, loosen, seed):
+    def run(kind, rtol, atol, loosen, seed, rotation=1.0):
         if kind == "scipy":
             return scipy_runner.run(duration, num_saves, rtol, atol, seed)
         cost = jac["jacobian_cost_in_evaluations"] if kind == "ros" else 0.0
-        return run_solve(programs[kind][0], bearing, op, duration, rtol, atol, loosen, seed, kind, cost)
+        return run_solve(
+            programs[kind][0], bearing, op, duration, rtol, atol, loosen, seed, kind, cost, rotation
+        )
 
     reference = {}
     for seed in seeds:
@@ -388,11 +406,12 @@ def main(quick: bool = False, imex: bool = False, rows: tuple | None = None, cor
         reference[str(seed)] = r
 
     rows = []
-    for label, kind, rtol, atol, loosen in variants:
+    for label, kind, rtol, atol, loosen, *rest in variants:
+        rotation = rest[0] if rest else 1.0
         per_seed = {}
         for seed in seeds:
             _common.log(f"{NAME}: {label}, seed {seed}")
-            r = run(kind, rtol, atol, loosen, seed)
+            r = run(kind, rtol, atol, loosen, seed, rotation)
             hist = r.pop("hist")
             ref = reference[str(seed)]
             r["statistics"] = window_statistics(hist, t0, omega_kin)
@@ -403,6 +422,7 @@ def main(quick: bool = False, imex: bool = False, rows: tuple | None = None, cor
         rows.append(
             {
                 **variant_row(label, kind, rtol, atol, loosen, per_seed),
+                "rotation_loosen": rotation,
                 "max_relative_error_pv_speed": max(
                     s["errors"]["max_relative_pv_speed"] for s in per_seed.values()
                 ),

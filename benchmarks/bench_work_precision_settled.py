@@ -31,7 +31,9 @@ Protocol.
    (f) SciPy `solve_ivp(RK45)` at rtol 1e-3 (RMS norm) on the same compiled field
    (`_common.FlatField`, `bench_work_precision.ScipyRunner`'s samples); and at today's default
    atol 1e-6 (10 nm, 10 um/s, 0.01 rad/s): (g) the default, rtol 1e-3, loosen 100; (h) rtol
-   1e-2, loosen 100; (i) SciPy RK45 at rtol 1e-3.
+   1e-2, loosen 100; (i) SciPy RK45 at rtol 1e-3. Later rows (see the comments in `VARIANTS`):
+   the error norms (9-15), the step controller (16-24) and the rotations' loosening (25-27;
+   row 26 is the library's default since 2026-11-25, row 14 the per-roller RMS default before).
 3. Statistics per run over the window (`bench_work_precision.window_statistics`): mean and p95
    PV over flange samples with normal force > 1 N, mean sliding speed, cage slip
    1 - mean(cage speed) / kinematic cage speed; per-seed 95 % half-widths from 8 batch means of
@@ -55,7 +57,8 @@ same case (the reference is 12 of the 18 minutes). `--quick`: seed 0, a 0.5 ms w
 at rtol 1e-5 (a smoke test of the code path; the
 settling of seed 0 is shared with the full run through the cache). `--revs N` sets the window in
 cage revolutions (default 2). `--rows 0,6,9` runs only those rows of `VARIANTS` (ratios against
-the defaults among them) and writes `bench_work_precision_settled_rows.json`. `--seeds 4,5,6,7` starts from other
+the defaults among them) and writes `bench_work_precision_settled_rows.json` (`--tag rotation`:
+`bench_work_precision_settled_rows_rotation.json`). `--seeds 4,5,6,7` starts from other
 seeds' settled states (settled and cached on first use; a fresh reference unless one stored
 for those seeds fits) and adds `_seeds4-5-6-7` to the results name: a choice made on the
 default seeds is checked on seeds it was not made on. Results: `results/bench_work_precision_settled.json`.
@@ -101,14 +104,17 @@ SAVED = ("t", "flange_force", "flange_pv", "flange_sliding_speed", "cage_speed")
 OLD_DEFAULT, PREVIOUS_DEFAULT, CURRENT_DEFAULT = "old default", "previous default", "default"
 #: the default from 2026-11-24 to 2026-11-25 (max norm, atol 10 nm)
 MAX_NORM_DEFAULT = "max-norm default"
+#: the default on 2026-11-25 before the rotations' tolerances were loosened (row 14)
+PER_ROLLER_DEFAULT = "per-roller RMS default"
 
 
 def _controller_label(c: tuple) -> str:
     return "P {:g} I {:g} safety {:g} growth <= {:g}".format(*c)
 
 
-#: (label, kind, rtol, atol, raceway_loosen[, controller]); controller (pcoeff, icoeff, safety,
-#: factormax) of the PID step controller, default the library's; kind "tsit5" (diffrax, max norm with the
+#: (label, kind, rtol, atol, raceway_loosen[, options]); options: "controller", (pcoeff, icoeff,
+#: safety, factormax) of the PID step controller, default the library's; "rotation_loosen"
+#: (`window_solve`), default 1; kind "tsit5" (diffrax, max norm with the
 #: raceway-normal tolerances `raceway_loosen` times looser), "tsit5_rms" (the same weights in the
 #: RMS norm), "tsit5_body_rms" (the largest of the rollers', cage's and inner ring's RMS) or
 #: "scipy" (solve_ivp RK45, RMS norm)
@@ -134,7 +140,7 @@ VARIANTS = (
     ("Tsit5, RMS norm, raceway-normal x10, rtol 1e-3, atol 10 nm", "tsit5_rms", 1e-3, 1e-6, 10.0),
     ("Tsit5, RMS norm (plain), rtol 1e-3, atol 10 nm", "tsit5_rms", 1e-3, 1e-6, 1.0),
     (
-        f"{CURRENT_DEFAULT}: Tsit5, per-roller RMS norm, raceway-normal x10, rtol 1e-3, atol 10 nm",
+        f"{PER_ROLLER_DEFAULT}: Tsit5, per-roller RMS norm, raceway-normal x10, rtol 1e-3, atol 10 nm",
         "tsit5_body_rms",
         1e-3,
         1e-6,
@@ -156,7 +162,7 @@ VARIANTS = (
             1e-3,
             1e-6,
             10.0,
-            c,
+            {"controller": c},
         )
         for c in (
             (0.0, 1.0, 0.9, 10.0),
@@ -169,6 +175,21 @@ VARIANTS = (
             (0.3, 0.4, 0.9, 2.0),
             (0.3, 0.4, 0.9, 1.5),
         )
+    ),
+    # rows 25-27: the rollers' orbital rate and angular velocity and the cage, which held the
+    # step under the per-roller RMS (diagnose_step_control.py --norm body_rms), looser; x10 is
+    # the library's default (`jaxbearing.run.ROTATION_LOOSEN`)
+    *(
+        (
+            f"{CURRENT_DEFAULT + ': ' if r == 10 else ''}Tsit5, per-roller RMS x10, rotations x{r:g}, "
+            "rtol 1e-3, atol 10 nm",
+            "tsit5_body_rms",
+            1e-3,
+            1e-6,
+            10.0,
+            {"rotation_loosen": r},
+        )
+        for r in (3.0, 10.0, 100.0)
     ),
 )
 #: the error norm's kind (`RacewayNormalNorm.kind`) of each Tsit5 kind of `VARIANTS`
@@ -215,14 +236,26 @@ def settled_start(bearing, op, seed: int) -> dict:
 
 # -- integrators -----------------------------------------------------------------------------
 def window_solve(
-    params, start, duration, rtol, atol, loosen, controller=None, *, num_saves: int, norm: str = "max"
+    params,
+    start,
+    duration,
+    rtol,
+    atol,
+    loosen,
+    controller=None,
+    rotation_loosen=1.0,
+    *,
+    num_saves: int,
+    norm: str = "max",
 ):
     """Tsit5 from the physical state `start` over [0, duration] as `solve_from` integrates, with
     the error norm's raceway-normal loosening `loosen` chosen here: (samples of `SAVED` at
     `num_saves` equally spaced instants including both ends, result code, step attempts,
     rejected steps). `norm` (static): the norm's kind over the weighted components
     (`RacewayNormalNorm.kind`). `controller`: the step controller's (pcoeff, icoeff, safety,
-    factormax), default the library's (`library_controller`). jit-able."""
+    factormax), default the library's (`library_controller`). `rotation_loosen`: the rollers'
+    orbital rate and angular velocity and the cage's coordinates that much looser
+    (`raceway_normal_weights`). jit-able."""
     import diffrax
     import jax.numpy as jnp
 
@@ -236,7 +269,7 @@ def window_solve(
     controller = step_controller(
         rtol,
         atol,
-        raceway_normal_norm(y0_scaled, loosen, norm),
+        raceway_normal_norm(y0_scaled, loosen, norm, rotation_loosen),
         pcoeff=pcoeff,
         icoeff=icoeff,
         safety=safety,
@@ -262,14 +295,17 @@ def compile_window_solve(params, start, num_saves: int, norm: str = "max"):
     one program per norm kind serves every seed, tolerance, loosening and controller."""
     import jax.numpy as jnp
 
-    def run(p, s, d, r, a, loosen, c):
-        return window_solve(p, s, d, r, a, loosen, tuple(c), num_saves=num_saves, norm=norm)
+    def run(p, s, d, r, a, loosen, c, rotation):
+        return window_solve(p, s, d, r, a, loosen, tuple(c), rotation, num_saves=num_saves, norm=norm)
 
     f = jnp.asarray
-    return _common.compile_jit(run, params, start, f(1e-3), f(1e-3), f(1e-6), f(1.0), f(library_controller()))
+    example = (f(1e-3), f(1e-3), f(1e-6), f(1.0), f(library_controller()), f(1.0))
+    return _common.compile_jit(run, params, start, *example)
 
 
-def run_tsit5(compiled, params, start, duration, rtol, atol, loosen, controller=None) -> dict:
+def run_tsit5(
+    compiled, params, start, duration, rtol, atol, loosen, controller=None, rotation_loosen=1.0
+) -> dict:
     import jax
     import jax.numpy as jnp
     import numpy as np
@@ -277,7 +313,14 @@ def run_tsit5(compiled, params, start, duration, rtol, atol, loosen, controller=
     f = jnp.asarray
     wall, (hist, code, steps, rejected) = _common.time_once(
         lambda: compiled(
-            params, start, f(duration), f(rtol), f(atol), f(loosen), f(controller or library_controller())
+            params,
+            start,
+            f(duration),
+            f(rtol),
+            f(atol),
+            f(loosen),
+            f(controller or library_controller()),
+            f(rotation_loosen),
         )
     )
     steps = int(steps)
@@ -387,13 +430,24 @@ def reference_tolerances(reference: dict) -> tuple:
     return reference["rtol"], float(f"{length:.6g}"), reference["method"]
 
 
-def output_name(only: tuple | None, seeds: tuple) -> str:
-    """Results name: `NAME`, `_rows` with --rows, `_seeds4-7` (say) with other seeds than `SEEDS`."""
+def output_name(only: tuple | None, seeds: tuple, tag: str | None = None) -> str:
+    """Results name: `NAME`, `_rows` with --rows, `_{tag}` with --tag, `_seeds4-7` (say) with
+    other seeds than `SEEDS`."""
     return (
         NAME
         + ("" if only is None else "_rows")
+        + ("" if not tag else f"_{tag}")
         + ("" if tuple(seeds) == SEEDS else "_seeds" + "-".join(str(s) for s in seeds))
     )
+
+
+def tag_argument(argv: list) -> str | None:
+    """`--tag NAME` (letters, digits, '-' and '_'): a results name of its own, so that a study
+    does not overwrite the rows quoted from another."""
+    tag = _common.option_value(argv, "--tag")
+    if tag is not None and not (tag and all(c.isalnum() or c in "-_" for c in tag)):
+        raise SystemExit(f"--tag = {tag!r}: letters, digits, '-' or '_', e.g. rotation")
+    return tag
 
 
 def main(
@@ -402,6 +456,7 @@ def main(
     reuse_reference: bool = False,
     only: tuple | None = None,
     seeds: tuple = SEEDS,
+    tag: str | None = None,
 ) -> dict:
     import jax
     import jax.numpy as jnp
@@ -411,7 +466,7 @@ def main(
     from jaxbearing.dynamics import SCALED_UNITS, Functionals, Params
 
     started = time.perf_counter()
-    name = output_name(only, seeds)
+    name = output_name(only, seeds, tag)
     seeds = seeds[:1] if quick else tuple(seeds)
     ref_rtol = QUICK_REF_RTOL if quick else REF_RTOL
     bearing, op = jb.reference_bearing(), jb.reference_operating_point()
@@ -442,12 +497,21 @@ def main(
         scipy_runner = ScipyRunner(bearing, op)
         compile_s["scipy_field"] = scipy_runner.compile_s
 
-    def run(kind, seed, rtol, atol, loosen, controller=None):
+    def run(kind, seed, rtol, atol, loosen, options=None):
+        options = options or {}
         if kind == "scipy":
             r = run_scipy(scipy_runner, params, starts[seed], window, num_saves, rtol, atol)
         else:
             r = run_tsit5(
-                compiled[NORM_OF_KIND[kind]], params, starts[seed], window, rtol, atol, loosen, controller
+                compiled[NORM_OF_KIND[kind]],
+                params,
+                starts[seed],
+                window,
+                rtol,
+                atol,
+                loosen,
+                options.get("controller"),
+                options.get("rotation_loosen", 1.0),
             )
         hist = r.pop("hist")
         r["statistics"] = window_statistics(hist, 0.0, omega_kin)
@@ -496,11 +560,11 @@ def main(
 
     rows = []
     for label, kind, rtol, atol, loosen, *rest in variants:
-        controller = rest[0] if rest else None
+        options = rest[0] if rest else {}
         per_seed = {}
         for seed in seeds:
             _common.log(f"{NAME}: {label}, seed {seed}")
-            r, _ = run(kind, seed, rtol, atol, loosen, controller)
+            r, _ = run(kind, seed, rtol, atol, loosen, options)
             ref = reference[str(seed)]
             r["errors"] = errors(r["statistics"], ref["statistics"], ref["ci_halfwidth"])
             per_seed[str(seed)] = r
@@ -509,8 +573,12 @@ def main(
             {
                 **variant_row(label, kind, rtol, atol, loosen, per_seed),
                 "controller": dict(
-                    zip(("pcoeff", "icoeff", "safety", "factormax"), controller or library_controller())
+                    zip(
+                        ("pcoeff", "icoeff", "safety", "factormax"),
+                        options.get("controller") or library_controller(),
+                    )
                 ),
+                "rotation_loosen": options.get("rotation_loosen", 1.0),
                 "over_seeds": {
                     s: paired_over_seeds([x["statistics"][s] for x in runs], ref_values[s]) for s in STATS
                 },
@@ -659,4 +727,5 @@ if __name__ == "__main__":
         reuse_reference="--reuse-reference" in sys.argv,
         only=rows_argument(sys.argv, len(VARIANTS)),
         seeds=seeds_argument(sys.argv),
+        tag=tag_argument(sys.argv),
     )

@@ -32,17 +32,24 @@ import _common  # noqa: E402
 NAME = "diagnose_error_norms"
 DURATION, NUM_SAVES = 4e-3, 800  # as tests/test_dynamics.py
 RTOLS = (1.5e-3, 1.2e-3, 1e-3, 8e-4, 7e-4, 6e-4, 5e-4, 4e-4, 3e-4, 2.5e-4)
-#: (label, kind of `RacewayNormalNorm`, raceway-normal loosening)
+#: (label, kind of `RacewayNormalNorm`, raceway-normal loosening, rotations' loosening)
 NORMS = (
-    ("max norm, raceway-normal x100 (default until 2026-11-25)", "max", 100.0),
-    ("RMS over all bodies' coordinates, raceway-normal x10", "rms", 10.0),
-    ("per-roller RMS, raceway-normal x10 (default)", "body_rms", 10.0),
+    ("max norm, raceway-normal x100 (default until 2026-11-25)", "max", 100.0, 1.0),
+    ("RMS over all bodies' coordinates, raceway-normal x10", "rms", 10.0, 1.0),
+    (
+        "per-roller RMS, raceway-normal x10 (default on 2026-11-25 before rotations x10)",
+        "body_rms",
+        10.0,
+        1.0,
+    ),
+    ("per-roller RMS, raceway-normal x10, rotations x10 (default)", "body_rms", 10.0, 10.0),
 )
 VIOLENT = 3.0
 
 
-def run_norm(kind: str, loosen: float) -> list[dict]:
-    """One row per rtol of `RTOLS` for the error norm `kind` with `loosen`."""
+def run_norm(kind: str, loosen: float, rotation: float = 1.0) -> list[dict]:
+    """One row per rtol of `RTOLS` for the error norm `kind` with `loosen` (raceway-normal) and
+    `rotation` (`solve(rotation_loosen=...)`)."""
     import jax
     import jax.numpy as jnp
     import numpy as np
@@ -53,9 +60,17 @@ def run_norm(kind: str, loosen: float) -> list[dict]:
 
     b, op = jb.reference_bearing(), jb.reference_operating_point()
 
-    def run(rtol, atol, w):
+    def run(rtol, atol, w, w_rotation):
         sol = jb.solve(
-            b, op, DURATION, num_saves=NUM_SAVES, rtol=rtol, atol=atol, raceway_loosen=w, error_norm=kind
+            b,
+            op,
+            DURATION,
+            num_saves=NUM_SAVES,
+            rtol=rtol,
+            atol=atol,
+            raceway_loosen=w,
+            rotation_loosen=w_rotation,
+            error_norm=kind,
         )
         h = sol.histories
         peak_pv = smooth_functionals(sol.accumulators, Functionals())[0]
@@ -67,7 +82,7 @@ def run_norm(kind: str, loosen: float) -> list[dict]:
     rows = []
     for rtol in RTOLS:
         code, steps, peak, largest, cage = program(
-            jnp.asarray(rtol), jnp.asarray(1e-3 * rtol), jnp.asarray(loosen)
+            jnp.asarray(rtol), jnp.asarray(1e-3 * rtol), jnp.asarray(loosen), jnp.asarray(rotation)
         )
         rows.append(
             {
@@ -82,7 +97,7 @@ def run_norm(kind: str, loosen: float) -> list[dict]:
                 "cage_speed_rpm_at_end": float(np.asarray(jb.rad_s_to_rpm(cage))),
             }
         )
-        _common.log(f"{NAME}: {kind} x{loosen:g}, rtol {rtol:g}: {rows[-1]}")
+        _common.log(f"{NAME}: {kind} x{loosen:g} rotations x{rotation:g}, rtol {rtol:g}: {rows[-1]}")
     return rows
 
 
@@ -111,11 +126,12 @@ def main() -> dict:
         "case": "reference bearing, 20,000 rpm, 1000 N, 4 ms from the quasi-static start",
     }
     result["norms"] = {}
-    for label, kind, loosen in NORMS:
-        rows = run_norm(kind, loosen)
+    for label, kind, loosen, rotation in NORMS:
+        rows = run_norm(kind, loosen, rotation)
         result["norms"][label] = {
             "kind": kind,
             "raceway_loosen": loosen,
+            "rotation_loosen": rotation,
             "rows": rows,
             "summary": summary(rows),
         }

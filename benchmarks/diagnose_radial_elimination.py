@@ -167,7 +167,7 @@ def window_solve(params, start, duration, rtol, atol, loosen, *, num_saves: int)
         y0=y0,
         args=args,
         saveat=diffrax.SaveAt(ts=jnp.linspace(0.0, duration, num_saves), fn=_samples),
-        stepsize_controller=step_controller(rtol, atol, raceway_normal_norm(y0, loosen, "max")),
+        stepsize_controller=step_controller(rtol, atol, raceway_normal_norm(y0, loosen, "max", 1.0)),
         max_steps=2_000_000,
         throw=False,
     )

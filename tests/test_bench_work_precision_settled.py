@@ -35,7 +35,14 @@ def test_agreement_needs_the_difference_below_the_reference_half_width():
 
 
 def test_rows_and_seeds_options_are_checked_in_one_line():
-    from bench_work_precision_settled import SEEDS, VARIANTS, output_name, rows_argument, seeds_argument
+    from bench_work_precision_settled import (
+        SEEDS,
+        VARIANTS,
+        output_name,
+        rows_argument,
+        seeds_argument,
+        tag_argument,
+    )
 
     assert rows_argument(["x"], len(VARIANTS)) is None
     assert rows_argument(["x", "--rows", "0,12"], len(VARIANTS)) == (0, 12)
@@ -49,3 +56,8 @@ def test_rows_and_seeds_options_are_checked_in_one_line():
             seeds_argument(["x", "--seeds", bad])
     assert output_name(None, SEEDS) == "bench_work_precision_settled"
     assert output_name((0, 12), (4, 5, 6, 7)) == "bench_work_precision_settled_rows_seeds4-5-6-7"
+    assert output_name((0,), (4, 5), "rotation") == "bench_work_precision_settled_rows_rotation_seeds4-5"
+    assert tag_argument(["x"]) is None and tag_argument(["x", "--tag", "a-b_1"]) == "a-b_1"
+    for bad in ("", "a/b", "x y"):
+        with pytest.raises(SystemExit, match="--tag = "):
+            tag_argument(["x", "--tag", bad])

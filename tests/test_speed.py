@@ -39,8 +39,8 @@ def _random_state(z=5):
 
 def test_raceway_normal_norm_max_kind_is_the_max_norm_with_radial_tolerances_loosened():
     x = _random_state()
-    assert float(raceway_normal_norm(x, 1.0, "max")(x)) == float(optx.max_norm(x))
-    norm = raceway_normal_norm(x, 100.0, "max")
+    assert float(raceway_normal_norm(x, 1.0, "max", 1.0)(x)) == float(optx.max_norm(x))
+    norm = raceway_normal_norm(x, 100.0, "max", 1.0)
     assert isinstance(norm, RacewayNormalNorm)
     # a huge radial-velocity error of one roller counts 1/100
     big = jax.tree_util.tree_map(jnp.zeros_like, x)
@@ -58,11 +58,11 @@ def test_rms_kind_is_the_rms_norm_over_the_bodies_coordinates():
     bodies = (x.rollers, x.cage, x.inner_ring)
     n = sum(v.size for v in jax.tree_util.tree_leaves(bodies))
     assert n == 12 * 5 + 16
-    rms = raceway_normal_norm(x, 1.0, "rms")
+    rms = raceway_normal_norm(x, 1.0, "rms", 1.0)
     np.testing.assert_allclose(float(rms(x)), float(optx.rms_norm(bodies)), rtol=1e-14)
     acc = eqx.tree_at(lambda s: s.accumulators, x, jax.tree_util.tree_map(lambda a: 1e3 * a, x.accumulators))
     assert float(rms(acc)) == float(rms(x))
-    norm = raceway_normal_norm(x, 100.0, "rms")
+    norm = raceway_normal_norm(x, 100.0, "rms", 1.0)
     zero = jax.tree_util.tree_map(jnp.zeros_like, x)
     one = eqx.tree_at(lambda s: s.rollers.radial_velocity, zero, jnp.zeros(5).at[2].set(50.0))
     one = eqx.tree_at(lambda s: s.rollers.axial, one, jnp.zeros(5).at[0].set(3.0))
@@ -75,10 +75,11 @@ def test_rms_kind_is_the_rms_norm_over_the_bodies_coordinates():
 
 def test_default_norm_is_the_largest_rms_of_a_body():
     """max over bodies of each body's RMS: a roller's 12 coordinates, the cage's 6, the inner
-    ring's 10 (accumulators left out); the raceway-normal coordinates 10x looser."""
-    from jaxbearing.run._step_control import DEFAULT_ERROR_NORM, RACEWAY_NORMAL_LOOSEN
+    ring's 10 (accumulators left out); the raceway-normal coordinates and the rotations (each
+    roller's orbital rate and angular velocity, the cage) 10x looser."""
+    from jaxbearing.run._step_control import DEFAULT_ERROR_NORM, RACEWAY_NORMAL_LOOSEN, ROTATION_LOOSEN
 
-    assert DEFAULT_ERROR_NORM == "body_rms" and RACEWAY_NORMAL_LOOSEN == 10.0
+    assert DEFAULT_ERROR_NORM == "body_rms" and RACEWAY_NORMAL_LOOSEN == ROTATION_LOOSEN == 10.0
     x = _random_state()
     norm = raceway_normal_norm(x)
     assert norm.kind == "body_rms"
@@ -88,9 +89,15 @@ def test_default_norm_is_the_largest_rms_of_a_body():
     y = eqx.tree_at(lambda s: s.rollers.axial, y, jnp.zeros(5).at[2].set(3.0))
     y = eqx.tree_at(lambda s: s.rollers.axis, y, jnp.zeros((5, 3)).at[0, 1].set(2.0))
     np.testing.assert_allclose(float(norm(y)), np.sqrt((5.0**2 + 3.0**2) / 12), rtol=1e-14)
-    # the cage alone: RMS over its 6 coordinates
+    # the cage alone: RMS over its 6 coordinates, 10x looser
     c = eqx.tree_at(lambda s: s.cage.speed, zero, jnp.asarray(6.0))
-    np.testing.assert_allclose(float(norm(c)), 6.0 / np.sqrt(6), rtol=1e-14)
+    np.testing.assert_allclose(float(norm(c)), 0.6 / np.sqrt(6), rtol=1e-14)
+    # a roller's orbital rate and angular velocity count 1/10, its skew (axis) in full
+    r = eqx.tree_at(lambda s: s.rollers.azimuth_rate, zero, jnp.zeros(5).at[1].set(30.0))
+    r = eqx.tree_at(lambda s: s.rollers.angular_velocity, r, jnp.zeros((5, 3)).at[1, 0].set(40.0))
+    np.testing.assert_allclose(float(norm(r)), np.sqrt((3.0**2 + 4.0**2) / 12), rtol=1e-14)
+    r = eqx.tree_at(lambda s: s.rollers.axis, r, jnp.zeros((5, 3)).at[1, 2].set(5.0))
+    np.testing.assert_allclose(float(norm(r)), np.sqrt((3.0**2 + 4.0**2 + 5.0**2) / 12), rtol=1e-14)
     # the accumulators do not count
     acc = eqx.tree_at(lambda s: s.accumulators, y, jax.tree_util.tree_map(lambda a: a + 1e3, y.accumulators))
     assert float(norm(acc)) == float(norm(y))
@@ -111,6 +118,14 @@ def test_solve_refuses_an_unknown_error_norm_in_one_line():
         UserInputError, match=r"error_norm = 'rmss': must be one of \('max', 'rms', 'body_rms'\)"
     ):
         jb.solve(b, op, 1e-6, error_norm="rmss")
+
+
+@pytest.mark.parametrize("name", ["raceway_loosen", "rotation_loosen"])
+@pytest.mark.parametrize("value", [0.0, -10.0, float("nan"), float("inf")])
+def test_solve_refuses_a_loosening_that_is_not_positive_in_one_line(name, value):
+    b, op = jb.reference_bearing(), jb.reference_operating_point()
+    with pytest.raises(UserInputError, match=rf"{name} = .*must be"):
+        jb.solve(b, op, 1e-6, **{name: value})
 
 
 def test_default_atol_means_10_nm_10_um_s_and_0_01_rad_s():

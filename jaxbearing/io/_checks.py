@@ -178,6 +178,8 @@ SOLVER_ARGUMENTS: dict[str, Rule] = {
     "progress": Rule("bool"),
     "window_revs": real(0, unit="cage revolutions"),
     "seeds": count(1, note="number of seeded repeats"),
+    "raceway_loosen": real(0, note="factor on the raceway-normal coordinates' tolerances"),
+    "rotation_loosen": real(0, note="factor on the rollers' orbit and spin and the cage's tolerances"),
 }
 
 #: `simulate` keeps histories: at least one sample

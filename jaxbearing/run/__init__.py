@@ -89,6 +89,7 @@ from ._step_control import (
     DEFAULT_ERROR_NORM,
     ERROR_NORMS,
     RACEWAY_NORMAL_LOOSEN,
+    ROTATION_LOOSEN,
     RacewayNormalNorm,
     raceway_normal_norm,
 )
@@ -113,6 +114,7 @@ __all__ = [
     "DEFAULT_ERROR_NORM",
     "ERROR_NORMS",
     "RACEWAY_NORMAL_LOOSEN",
+    "ROTATION_LOOSEN",
     "RacewayNormalNorm",
     "enable_compilation_cache",
     "compiled_program",

@@ -8,8 +8,10 @@
   that every component's tolerance means something physical (atol: 10 nm, 10 um/s, 0.01 rad/s;
   `dynamics.SCALED_UNITS`, docs/model.md 13), except that the raceway-normal coordinates
   (roller radial position and velocity, inner-ring centre) have tolerances `raceway_loosen` =
-  10 times looser (their 62 kHz ringing need not be resolved to rtol), under the largest RMS
-  of a body's coordinates (each roller's, the cage's, the inner ring's; `_step_control`);
+  10 times looser (their 62 kHz ringing need not be resolved to rtol), and so have the
+  rotations (each roller's orbital rate and angular velocity, the cage's coordinates;
+  `rotation_loosen` = 10), under the largest RMS of a body's coordinates (each roller's, the
+  cage's, the inner ring's; `_step_control`);
   `max_steps` explicit. `solver="ros34pw2"` selects the linearly implicit
   Rosenbrock-W method with per-roller Jacobian blocks instead (`_rosenbrock`; slower, README).
 * Outputs: the solve keeps only the scaled state at the sample times (`SaveAt(ts=...,
@@ -57,6 +59,7 @@ from ._step_control import (
     DT0,
     ERROR_NORMS,
     RACEWAY_NORMAL_LOOSEN,
+    ROTATION_LOOSEN,
     raceway_normal_norm,
     step_controller,
 )
@@ -212,6 +215,7 @@ def solve(
     raceway_loosen=RACEWAY_NORMAL_LOOSEN,
     error_norm=None,
     solver: str = DEFAULT_SOLVER,
+    rotation_loosen=ROTATION_LOOSEN,
 ) -> Solution:
     """Pure, jit-able and vmappable solve of the whole bearing over [0, duration].
 
@@ -221,9 +225,11 @@ def solve(
     reverse mode; `diffrax.ForwardMode()` for `jax.jacfwd`).
     Error control (`_step_control`): `error_norm` "body_rms" (None: the default; the largest
     of the rollers', cage's and inner ring's RMS), "rms" or "max" over the scaled state, with
-    the raceway-normal coordinates' tolerances `raceway_loosen` times looser (a float, may be
-    traced; 1 = the plain norm); a function pytree -> scalar (e.g. `optimistix.rms_norm`)
-    replaces it.
+    the raceway-normal coordinates' tolerances `raceway_loosen` times looser and the rotations'
+    (each roller's orbital rate and angular velocity, the cage's coordinates) `rotation_loosen`
+    times looser (floats, may be traced; 1 and 1 = the plain norm); a function pytree -> scalar
+    (e.g. `optimistix.rms_norm`) replaces it. `error_norm="max", raceway_loosen=100,
+    rotation_loosen=1` is the default until 2026-11-25.
     `solver` (static): "tsit5" (default, explicit) or "ros34pw2" (linearly implicit
     Rosenbrock-W with every roller's Jacobian block implicit, `_rosenbrock`; slower at the
     tolerances measured so far: README, Performance).
@@ -246,6 +252,8 @@ def solve(
         adjoint=adjoint,
         solver=solver,
         error_norm=error_norm,
+        raceway_loosen=raceway_loosen,
+        rotation_loosen=rotation_loosen,
     )
     y0 = initial_state(bearing, op, perturbation)
     scaling = Scaling(
@@ -261,7 +269,9 @@ def solve(
     else:
         saveat = diffrax.SaveAt(t1=True, fn=_save_functionals)
     if error_norm is None or isinstance(error_norm, str):
-        norm = raceway_normal_norm(y0_scaled, raceway_loosen, error_norm or DEFAULT_ERROR_NORM)
+        norm = raceway_normal_norm(
+            y0_scaled, raceway_loosen, error_norm or DEFAULT_ERROR_NORM, rotation_loosen
+        )
     else:
         norm = error_norm
     controller = step_controller(rtol, atol, norm)

@@ -35,7 +35,19 @@ work-precision benchmark and by the peak-PV check of `benchmarks/diagnose_error_
   among 26 rollers' coordinates;
 - "body_rms", the default: 1.33x fewer evaluations than "max", agreeing on every statistic
   on both sets of seeds, with the peak PV spread of "max".
-`solve(error_norm="max", raceway_loosen=100)` gives the previous default back.
+
+Under the per-roller RMS the rotations held the step: each roller's orbital rate (its
+collisions with the cage pockets), its angular velocity (spin traction) and the cage's
+coordinates (benchmarks/diagnose_step_control.py --norm body_rms). Their tolerances are
+`rotation_loosen` = 10 times looser by default (`ROTATION_LOOSEN`): 1.25x fewer evaluations in
+settled running, every flange statistic and the cage slip agreeing with the tight reference
+on the seeds used to choose it and on others. The smooth peak PV of a start-up transient
+shows no bias against the max norm, but scatters about three times as much between
+trajectories (standard deviation 3.4 % against 1.1 %; README, Performance): a study of one
+trajectory's peak passes `rotation_loosen=1`. The flange contact's own coordinates (a
+roller's axial position and velocity, its axis: skew and tilt) keep their tolerances.
+`solve(error_norm="max", raceway_loosen=100, rotation_loosen=1)` gives the max-norm default
+of 2026-11-24 back, `solve(rotation_loosen=1)` the per-roller RMS default before.
 """
 
 from __future__ import annotations
@@ -58,6 +70,15 @@ from ..dynamics import State
 #: half-width): the radial coordinates then hardly count and the step nears the radial mode's
 #: stability limit. 10 keeps them in the error control.
 RACEWAY_NORMAL_LOOSEN = 10.0
+#: default loosening of the rotations' tolerances: each roller's orbital rate and angular
+#: velocity and the cage's coordinates. Under the per-roller RMS with the raceway-normal
+#: coordinates 10x looser, these held the step (benchmarks/diagnose_step_control.py --norm
+#: body_rms: with everything else 100x looser, the roller's orbital rate alone kept 93 % of the
+#: evaluations). 10x looser: 1.25x fewer evaluations in settled running, every statistic
+#: agreeing with the tight reference on seeds 0-3 and on seeds 4-7 not used to choose it; 100x
+#: gains 1.5 % more (benchmarks/bench_work_precision_settled.py, rows 25-27). The cost: a single
+#: start-up trajectory's smooth peak PV scatters 3x more (benchmarks/diagnose_error_norms.py).
+ROTATION_LOOSEN = 10.0
 
 #: PID step-size controller coefficients (diffrax `PIDController`: proportional 0.3, integral
 #: 0.4, the values diffrax's documentation suggests for non-stiff problems).
@@ -97,13 +118,16 @@ def step_controller(
     )
 
 
-def raceway_normal_weights(state: State, loosen) -> State:
+def raceway_normal_weights(state: State, loosen, rotation_loosen=1.0) -> State:
     """Weights of the error norm: 1/`loosen` on roller radial position and velocity and on the
-    inner ring's centre, tilt and their rates, 1 elsewhere (same pytree as `state`)."""
+    inner ring's centre, tilt and their rates; 1/`rotation_loosen` on the rollers' orbital rate
+    and angular velocity and on the cage's coordinates; 1 elsewhere (same pytree as
+    `state`)."""
     w = jnp.asarray(1.0) / jnp.asarray(loosen, dtype=float)
+    w_rotation = jnp.asarray(1.0) / jnp.asarray(rotation_loosen, dtype=float)
     ones = jax.tree_util.tree_map(jnp.ones_like, state)
     loose = lambda x: w * jnp.ones_like(x)  # noqa: E731
-    return eqx.tree_at(
+    weights = eqx.tree_at(
         lambda s: (
             s.rollers.radial,
             s.rollers.radial_velocity,
@@ -114,6 +138,11 @@ def raceway_normal_weights(state: State, loosen) -> State:
         ),
         ones,
         replace_fn=loose,
+    )
+    return eqx.tree_at(
+        lambda s: (s.rollers.azimuth_rate, s.rollers.angular_velocity, s.cage),
+        weights,
+        replace_fn=lambda x: jax.tree_util.tree_map(lambda v: w_rotation * v, x),
     )
 
 
@@ -161,7 +190,10 @@ def _mean_squares_per_body(x: State) -> Float[Array, " Z+2"]:
 
 
 def raceway_normal_norm(
-    state: State, loosen=RACEWAY_NORMAL_LOOSEN, kind: str = DEFAULT_ERROR_NORM
+    state: State,
+    loosen=RACEWAY_NORMAL_LOOSEN,
+    kind: str = DEFAULT_ERROR_NORM,
+    rotation_loosen=ROTATION_LOOSEN,
 ) -> RacewayNormalNorm:
     """The error norm of `solve` for a state shaped like `state` (module docstring)."""
-    return RacewayNormalNorm(weights=raceway_normal_weights(state, loosen), kind=kind)
+    return RacewayNormalNorm(weights=raceway_normal_weights(state, loosen, rotation_loosen), kind=kind)
