@@ -291,8 +291,9 @@ def library_controller() -> tuple:
 
 
 def compile_window_solve(params, start, num_saves: int, norm: str = "max"):
-    """`window_solve` compiled for (params, start, duration, rtol, atol, loosen, controller):
-    one program per norm kind serves every seed, tolerance, loosening and controller."""
+    """`window_solve` compiled for (params, start, duration, rtol, atol, loosen, controller,
+    rotation_loosen): one program per norm kind serves every seed, tolerance, loosening and
+    controller."""
     import jax.numpy as jnp
 
     def run(p, s, d, r, a, loosen, c, rotation):
