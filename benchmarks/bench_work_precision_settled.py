@@ -17,8 +17,10 @@ Protocol.
 2. From each seed's settled state, a window of W = `WINDOW_REVS` cage revolutions (W =
    revolutions x 2 pi / the settled cage speed, the mean over seeds of the last settled
    revolution's mean, rounded to whole samples; the same W for every seed) is integrated with
-   every integrator below from the same state, saving the flange quantities every `SAMPLE_DT`
-   = 2 us (the same instants for every integrator). The continuation is that of
+   every integrator below from the same state, sampling the flange quantities every `SAMPLE_DT`
+   = 2 us (the same instants for every integrator; as the library does, the states are kept in
+   the loop and the flange quantities evaluated after it, vmapped: `_histories`; SciPy's from
+   its dense output, likewise). The continuation is that of
    `jaxbearing.run.solve_from` (`prepare_from`: scaled deviation state about the start's own
    orbit, accumulators at zero), with the step controller built here as `prepare_from` builds it
    (`step_controller(rtol, atol, raceway_normal_norm(y0_scaled, loosen))`), so that rtol, atol
@@ -49,8 +51,12 @@ Protocol.
    below the reference ensemble mean's half-width.
 5. Cost: field evaluations per simulated ms (Tsit5: `_common.fsal_rk_evaluations`, 6 per step
    attempt + 1; SciPy: nfev), their ratio against the old and today's default, and wall time
-   per simulated ms (compile excluded; single runs on a shared 2-core machine: the evaluation
-   counts are the primary figure).
+   per simulated ms (compile excluded, the samples included for every integrator; single runs
+   on a shared 2-core machine: the evaluation counts are the primary figure). Until
+   2026-11-25 the Tsit5 rows evaluated the flange quantities inside diffrax's saving (7128
+   contact evaluations per window, in the timed loop) and SciPy's samples were not timed,
+   which put 0.02-0.035 s per simulated ms on the Tsit5 rows' wall times alone (the
+   `--tag wall` rerun against `--tag scipy`).
 
 `--reuse-reference` takes the reference runs from the stored results when they were made for the
 same case (the reference is 12 of the 18 minutes). `--quick`: seed 0, a 0.5 ms window, reference
@@ -261,7 +267,7 @@ def window_solve(
 
     from jaxbearing.run import prepare_from, result_code
     from jaxbearing.run._compile_cache import checks_without_host_callbacks
-    from jaxbearing.run._simulate import _diffeqsolve, _save
+    from jaxbearing.run._simulate import _diffeqsolve, _histories, _saved_state
     from jaxbearing.run._step_control import raceway_normal_norm, step_controller
 
     _, args, y0_scaled, _ = prepare_from(params, start, rtol, atol)
@@ -275,12 +281,12 @@ def window_solve(
         safety=safety,
         factormax=factormax,
     )
-    saveat = diffrax.SaveAt(
-        ts=jnp.linspace(0.0, duration, num_saves), fn=lambda t, y, a: {k: _save(t, y, a)[k] for k in SAVED}
-    )
+    # as the library saves (`solve_from`): the states in the loop, the samples after it
+    saveat = diffrax.SaveAt(ts=jnp.linspace(0.0, duration, num_saves), fn=_saved_state)
     with checks_without_host_callbacks():
         sol = _diffeqsolve(y0_scaled, args, duration, saveat, controller, MAX_STEPS, None, False, "tsit5")
-    return sol.ys, result_code(sol.result), sol.stats["num_steps"], sol.stats["num_rejected_steps"]
+    hist = {k: v for k, v in _histories(sol.ts, sol.ys, args).items() if k in SAVED}
+    return hist, result_code(sol.result), sol.stats["num_steps"], sol.stats["num_rejected_steps"]
 
 
 def library_controller() -> tuple:
@@ -351,6 +357,7 @@ def run_scipy(runner: ScipyRunner, params, start, duration, num_saves, rtol, ato
         raise RuntimeError("the continuation's state or arguments do not ravel like the flat field's")
     field = runner.compiled_field
     ts = np.linspace(0.0, duration, num_saves)
+    runner.warm_samples(num_saves, args_flat)
     start_t = time.perf_counter()
     sol = solve_ivp(
         lambda t, y: np.asarray(field(t, y, args_flat)),
@@ -361,8 +368,9 @@ def run_scipy(runner: ScipyRunner, params, start, duration, num_saves, rtol, ato
         atol=atol,
         t_eval=ts,
     )
-    wall = time.perf_counter() - start_t
+    # the samples are part of the run, as in the Tsit5 rows (`window_solve`) and the library
     hist = jax.tree_util.tree_map(np.asarray, runner.samples(sol.t, sol.y.T, args_flat))
+    wall = time.perf_counter() - start_t
     return {
         "ok": sol.status == 0,
         "wall_s": wall,
