@@ -15,7 +15,9 @@ measuring the gradient ratio (issue 12).
 3. A plain solve of 1 us and of 0.3 ms (rtol 1e-6, atol 1e-9, `seated_perturbation`) compiled
    with the bearing as an argument and with the bearing closed over (its arrays constants of the
    program): wall time per call, minimum of 5; and the same for the quasi-static start alone
-   (`initial_state`), where the difference lies.
+   (`initial_state`), where the difference lay (0.202 against 0.037 s per call) until
+   `quasi_static` put an optimization barrier on the bearing (2026-11-25: XLA specialised its
+   Newton loops on the closed-over constants).
 
     python benchmarks/diagnose_atol_cost.py      (about 4 min; results/diagnose_atol_cost.json)
 """

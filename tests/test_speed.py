@@ -306,3 +306,34 @@ def test_workers_end_when_the_process_that_started_them_is_killed(tmp_path):
     for p in left:  # do not leave them to the next test either
         os.kill(p, 9)
     assert not left, f"workers {left} outlived the killed process"
+
+
+def test_a_closed_over_bearing_costs_no_more_than_an_argument():
+    """A caller's jit that closes over the bearing makes its arrays constants; XLA specialised
+    the quasi-static Newton loops on them (0.21 s per start against 0.036 s) until
+    `quasi_static` made them opaque (`jax.lax.optimization_barrier`). The same values to 1e-12
+    (before, the specialised program's rounding differed beyond that too), and a closed-over
+    start within 2x of the argument one (min of 5 calls each; it was 6x)."""
+    import time
+
+    from jaxbearing.run import initial_state
+
+    b, op = jb.reference_bearing(), jb.reference_operating_point()
+    pert = jb.Perturbation(seed=0)
+    as_argument = jax.jit(lambda bb: initial_state(bb, op, pert))
+    closed_over = jax.jit(lambda _: initial_state(b, op, pert))
+
+    def best(f, x):
+        out = jax.block_until_ready(f(x))
+        times = []
+        for _ in range(5):
+            t = time.perf_counter()
+            jax.block_until_ready(f(x))
+            times.append(time.perf_counter() - t)
+        return min(times), out
+
+    t_arg, y_arg = best(as_argument, b)
+    t_closed, y_closed = best(closed_over, jnp.zeros(()))
+    for u, v in zip(jax.tree_util.tree_leaves(y_arg), jax.tree_util.tree_leaves(y_closed)):
+        np.testing.assert_allclose(np.asarray(u), np.asarray(v), rtol=1e-12, atol=1e-300)
+    assert t_closed < 2.0 * t_arg + 0.01, (t_closed, t_arg)
