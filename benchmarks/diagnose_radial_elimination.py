@@ -145,19 +145,25 @@ def newton_residual(params, start):
     return jnp.max(jnp.abs(radial_force(y_star))), jnp.max(jnp.abs(radial_force(start))), jnp.max(jnp.abs(dr))
 
 
-def window_solve(params, start, duration, rtol, atol, loosen, *, num_saves: int):
+def window_solve(
+    params, start, duration, rtol, atol, loosen, controller=None, rotation_loosen=1.0, *, num_saves: int
+):
     """Tsit5 of the quasi-static-radial field from the physical state `start` (radial velocity
     set to zero), with the arguments and returns of `bench_work_precision_settled.window_solve`
-    (the error norm's raceway-normal loosening `loosen`). jit-able."""
+    (the max norm's raceway-normal loosening `loosen`, the step `controller`, the rotations'
+    loosening `rotation_loosen`), so that `run_tsit5` runs both. jit-able."""
     import diffrax
     import equinox as eqx
+    import jax
     import jax.numpy as jnp
+    from bench_work_precision_settled import library_controller
 
     from jaxbearing.run import prepare_from, result_code
     from jaxbearing.run._step_control import DT0, raceway_normal_norm, step_controller
 
     start = eqx.tree_at(lambda s: s.rollers.radial_velocity, start, jnp.zeros_like(start.rollers.radial))
     _, args, y0, _ = prepare_from(params, start, rtol, atol)
+    pcoeff, icoeff, safety, factormax = library_controller() if controller is None else controller
     sol = diffrax.diffeqsolve(
         diffrax.ODETerm(_field),
         diffrax.Tsit5(),
@@ -166,12 +172,23 @@ def window_solve(params, start, duration, rtol, atol, loosen, *, num_saves: int)
         dt0=DT0,
         y0=y0,
         args=args,
-        saveat=diffrax.SaveAt(ts=jnp.linspace(0.0, duration, num_saves), fn=_samples),
-        stepsize_controller=step_controller(rtol, atol, raceway_normal_norm(y0, loosen, "max", 1.0)),
+        # sampled as the settled benchmark and the library sample: states in the loop, the
+        # flange quantities after it
+        saveat=diffrax.SaveAt(ts=jnp.linspace(0.0, duration, num_saves)),
+        stepsize_controller=step_controller(
+            rtol,
+            atol,
+            raceway_normal_norm(y0, loosen, "max", rotation_loosen),
+            pcoeff=pcoeff,
+            icoeff=icoeff,
+            safety=safety,
+            factormax=factormax,
+        ),
         max_steps=2_000_000,
         throw=False,
     )
-    return sol.ys, result_code(sol.result), sol.stats["num_steps"], sol.stats["num_rejected_steps"]
+    hist = jax.vmap(_samples, in_axes=(0, 0, None))(sol.ts, sol.ys, args)
+    return hist, result_code(sol.result), sol.stats["num_steps"], sol.stats["num_rejected_steps"]
 
 
 def main(quick: bool = False) -> dict:
@@ -182,6 +199,7 @@ def main(quick: bool = False) -> dict:
     from bench_work_precision_settled import (
         SEEDS,
         compile_window_solve,
+        library_controller,
         paired_over_seeds,
         run_tsit5,
         settled_start,
@@ -203,13 +221,21 @@ def main(quick: bool = False) -> dict:
     window = (num_saves - 1) * SAMPLE_DT
     ms = window * 1e3
 
-    def qs(p, s, d, r, a, loosen):
-        return window_solve(p, s, d, r, a, loosen, num_saves=num_saves)
+    def qs(p, s, d, r, a, loosen, c, rotation):
+        return window_solve(p, s, d, r, a, loosen, tuple(c), rotation, num_saves=num_saves)
 
     f = jnp.asarray
     compiled = {
         "quasi-static radial": _common.compile_jit(
-            qs, params, starts[seeds[0]], f(window), f(RTOL), f(ATOL), f(LOOSEN)
+            qs,
+            params,
+            starts[seeds[0]],
+            f(window),
+            f(RTOL),
+            f(ATOL),
+            f(LOOSEN),
+            f(library_controller()),
+            f(1.0),
         ),
         "default": compile_window_solve(params, starts[seeds[0]], num_saves),
     }
