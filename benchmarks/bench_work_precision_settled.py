@@ -296,6 +296,12 @@ def library_controller() -> tuple:
     return (c.PID_PCOEFF, c.PID_ICOEFF, c.PID_SAFETY, c.PID_FACTORMAX)
 
 
+def variant_options(options: dict | None = None) -> dict:
+    """A row's options (`VARIANTS`) with the defaults filled in: the library's controller, the
+    rotations not loosened."""
+    return {"controller": library_controller(), "rotation_loosen": 1.0, **(options or {})}
+
+
 def compile_window_solve(params, start, num_saves: int, norm: str = "max"):
     """`window_solve` compiled for (params, start, duration, rtol, atol, loosen, controller,
     rotation_loosen): one program per norm kind serves every seed, tolerance, loosening and
@@ -507,7 +513,7 @@ def main(
         compile_s["scipy_field"] = scipy_runner.compile_s
 
     def run(kind, seed, rtol, atol, loosen, options=None):
-        options = options or {}
+        options = variant_options(options)
         if kind == "scipy":
             r = run_scipy(scipy_runner, params, starts[seed], window, num_saves, rtol, atol)
         else:
@@ -519,8 +525,8 @@ def main(
                 rtol,
                 atol,
                 loosen,
-                options.get("controller"),
-                options.get("rotation_loosen", 1.0),
+                options["controller"],
+                options["rotation_loosen"],
             )
         hist = r.pop("hist")
         r["statistics"] = window_statistics(hist, 0.0, omega_kin)
@@ -569,7 +575,7 @@ def main(
 
     rows = []
     for label, kind, rtol, atol, loosen, *rest in variants:
-        options = rest[0] if rest else {}
+        options = variant_options(rest[0] if rest else None)
         per_seed = {}
         for seed in seeds:
             _common.log(f"{NAME}: {label}, seed {seed}")
@@ -581,13 +587,8 @@ def main(
         rows.append(
             {
                 **variant_row(label, kind, rtol, atol, loosen, per_seed),
-                "controller": dict(
-                    zip(
-                        ("pcoeff", "icoeff", "safety", "factormax"),
-                        options.get("controller") or library_controller(),
-                    )
-                ),
-                "rotation_loosen": options.get("rotation_loosen", 1.0),
+                "controller": dict(zip(("pcoeff", "icoeff", "safety", "factormax"), options["controller"])),
+                "rotation_loosen": options["rotation_loosen"],
                 "over_seeds": {
                     s: paired_over_seeds([x["statistics"][s] for x in runs], ref_values[s]) for s in STATS
                 },
