@@ -13,8 +13,9 @@ the flange statistics do not depend on resolving its phase.
 `RacewayNormalNorm` weights the raceway-normal coordinates of every roller (radial position
 and velocity) and the inner ring's radial position, tilt and their rates (the tilt moves the
 raceway normally, against the same slice stiffness) by 1/`loosen`: their tolerances are `loosen`
-times looser, every other component (axial motion, skew and tilt of the axis, spin, orbit,
-cage) keeps its tolerance. An explicit method still keeps the radial mode stable (its step
+times looser; the rotations (spin, orbit, cage) are weighted by 1/`rotation_loosen` (below);
+the flange contact's coordinates (axial motion, skew and tilt of the axis) keep their
+tolerance. An explicit method still keeps the radial mode stable (its step
 cannot exceed the stability limit, about 7.5 us for Tsit5); what is no longer paid for is
 resolving its phase to rtol.
 
