@@ -120,7 +120,7 @@ def _controller_label(c: tuple) -> str:
 
 #: (label, kind, rtol, atol, raceway_loosen[, options]); options: "controller", (pcoeff, icoeff,
 #: safety, factormax) of the PID step controller, default the library's; "rotation_loosen"
-#: (`window_solve`), default 1; kind "tsit5" (diffrax, max norm with the
+#: (`window_solve`), default 1; "flat" (`window_solve`), default None (the library's choice); kind "tsit5" (diffrax, max norm with the
 #: raceway-normal tolerances `raceway_loosen` times looser), "tsit5_rms" (the same weights in the
 #: RMS norm), "tsit5_body_rms" (the largest of the rollers', cage's and inner ring's RMS) or
 #: "scipy" (solve_ivp RK45, RMS norm)
@@ -197,6 +197,16 @@ VARIANTS = (
         )
         for r in (3.0, 10.0, 100.0)
     ),
+    # row 28: the default with diffrax on the `State` pytree, as before 2026-11-25 (the library
+    # hands it the state as one vector, `jaxbearing.run._flat`)
+    (
+        "Tsit5, per-roller RMS x10, rotations x10, rtol 1e-3, atol 10 nm, State pytree",
+        "tsit5_body_rms",
+        1e-3,
+        1e-6,
+        10.0,
+        {"rotation_loosen": 10.0, "flat": False},
+    ),
 )
 #: the error norm's kind (`RacewayNormalNorm.kind`) of each Tsit5 kind of `VARIANTS`
 NORM_OF_KIND = {"tsit5": "max", "tsit5_rms": "rms", "tsit5_body_rms": "body_rms"}
@@ -253,6 +263,7 @@ def window_solve(
     *,
     num_saves: int,
     norm: str = "max",
+    flat: bool | None = None,
 ):
     """Tsit5 from the physical state `start` over [0, duration] as `solve_from` integrates, with
     the error norm's raceway-normal loosening `loosen` chosen here: (samples of `SAVED` at
@@ -261,7 +272,8 @@ def window_solve(
     (`RacewayNormalNorm.kind`). `controller`: the step controller's (pcoeff, icoeff, safety,
     factormax), default the library's (`library_controller`). `rotation_loosen`: the rollers'
     orbital rate and angular velocity and the cage's coordinates that much looser
-    (`raceway_normal_weights`). jit-able."""
+    (`raceway_normal_weights`). `flat` (static): the state as one vector (None: the library's
+    choice, `_flat`), False: diffrax on the `State` pytree as before 2026-11-25. jit-able."""
     import diffrax
     import jax.numpy as jnp
 
@@ -284,7 +296,9 @@ def window_solve(
     # as the library saves (`solve_from`): the states in the loop, the samples after it
     saveat = diffrax.SaveAt(ts=jnp.linspace(0.0, duration, num_saves), fn=_saved_state)
     with checks_without_host_callbacks():
-        sol = _diffeqsolve(y0_scaled, args, duration, saveat, controller, MAX_STEPS, None, False, "tsit5")
+        sol = _diffeqsolve(
+            y0_scaled, args, duration, saveat, controller, MAX_STEPS, None, False, "tsit5", flat=flat
+        )
     hist = {k: v for k, v in _histories(sol.ts, sol.ys, args).items() if k in SAVED}
     return hist, result_code(sol.result), sol.stats["num_steps"], sol.stats["num_rejected_steps"]
 
@@ -298,18 +312,20 @@ def library_controller() -> tuple:
 
 def variant_options(options: dict | None = None) -> dict:
     """A row's options (`VARIANTS`) with the defaults filled in: the library's controller, the
-    rotations not loosened."""
-    return {"controller": library_controller(), "rotation_loosen": 1.0, **(options or {})}
+    rotations not loosened, the state as the library hands it to diffrax ("flat": None)."""
+    return {"controller": library_controller(), "rotation_loosen": 1.0, "flat": None, **(options or {})}
 
 
-def compile_window_solve(params, start, num_saves: int, norm: str = "max"):
+def compile_window_solve(params, start, num_saves: int, norm: str = "max", flat: bool | None = None):
     """`window_solve` compiled for (params, start, duration, rtol, atol, loosen, controller,
-    rotation_loosen): one program per norm kind serves every seed, tolerance, loosening and
-    controller."""
+    rotation_loosen): one program per norm kind (and `flat`) serves every seed, tolerance,
+    loosening and controller."""
     import jax.numpy as jnp
 
     def run(p, s, d, r, a, loosen, c, rotation):
-        return window_solve(p, s, d, r, a, loosen, tuple(c), rotation, num_saves=num_saves, norm=norm)
+        return window_solve(
+            p, s, d, r, a, loosen, tuple(c), rotation, num_saves=num_saves, norm=norm, flat=flat
+        )
 
     f = jnp.asarray
     example = (f(1e-3), f(1e-3), f(1e-6), f(1.0), f(library_controller()), f(1.0))
@@ -502,10 +518,16 @@ def main(
     _common.log(f"{NAME}: compiling the window solve, {num_saves} samples over {ms:g} ms")
     variants = list(VARIANTS) if only is None else [VARIANTS[i] for i in only]
     compiled, compile_s = {}, {}
-    norms = {NORM_OF_KIND[v[1]] for v in variants if v[1] != "scipy"} | {"max"}  # max: the reference
-    for norm in sorted(norms):
-        compiled[norm], compile_s[f"window_solve_{norm}"] = compile_window_solve(
-            params, starts[seeds[0]], num_saves, norm
+    # one program per (norm, flat); ("max", None): the reference
+    programs = {
+        (NORM_OF_KIND[v[1]], variant_options(v[5] if len(v) > 5 else None)["flat"])
+        for v in variants
+        if v[1] != "scipy"
+    } | {("max", None)}
+    for norm, flat in sorted(programs, key=str):
+        key = f"window_solve_{norm}" + ("" if flat is None else f"_flat_{flat}")
+        compiled[norm, flat], compile_s[key] = compile_window_solve(
+            params, starts[seeds[0]], num_saves, norm, flat
         )
     scipy_runner = None
     if any(v[1] == "scipy" for v in variants):
@@ -518,7 +540,7 @@ def main(
             r = run_scipy(scipy_runner, params, starts[seed], window, num_saves, rtol, atol)
         else:
             r = run_tsit5(
-                compiled[NORM_OF_KIND[kind]],
+                compiled[NORM_OF_KIND[kind], options["flat"]],
                 params,
                 starts[seed],
                 window,
@@ -589,6 +611,7 @@ def main(
                 **variant_row(label, kind, rtol, atol, loosen, per_seed),
                 "controller": dict(zip(("pcoeff", "icoeff", "safety", "factormax"), options["controller"])),
                 "rotation_loosen": options["rotation_loosen"],
+                "flat": options["flat"],
                 "over_seeds": {
                     s: paired_over_seeds([x["statistics"][s] for x in runs], ref_values[s]) for s in STATS
                 },

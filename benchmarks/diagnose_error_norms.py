@@ -18,6 +18,11 @@ the other runs against the median: an error norm that does not resolve the impac
 spread (or a bias) there, beyond the max norm's.
 
     python benchmarks/diagnose_error_norms.py    (about 5 min; results/diagnose_error_norms.json)
+
+The rows' "default" labels are those of the day they were measured. `diagnose_peak_spread.py`
+(2026-11-25, third session) holds the accuracy and changes only the step sequence, and finds the
+violent impacts numerical: none under the max norm, 5 of 8 under the fourth row's control; since
+then that control serves settled windows only and start-up transients take the first row's.
 """
 
 from __future__ import annotations

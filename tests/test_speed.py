@@ -5,6 +5,7 @@ benchmarks/ (bench_work_precision, bench_compile_cache, bench_ensemble), not her
 
 from __future__ import annotations
 
+import inspect
 import operator
 import os
 
@@ -337,3 +338,147 @@ def test_a_closed_over_bearing_costs_no_more_than_an_argument():
     for u, v in zip(jax.tree_util.tree_leaves(y_arg), jax.tree_util.tree_leaves(y_closed)):
         np.testing.assert_allclose(np.asarray(u), np.asarray(v), rtol=1e-12, atol=1e-300)
     assert t_closed < 2.0 * t_arg + 0.01, (t_closed, t_arg)
+
+
+def _toy_problem():
+    """A damped oscillator and a decaying pair held as a dict pytree of mixed shapes, with a
+    norm that reads the pytree (as `raceway_normal_norm` does)."""
+    import diffrax
+
+    y0 = {"x": jnp.array([1.0, 0.5]), "v": jnp.array([0.0, -0.2]), "pair": jnp.ones((2, 2))}
+
+    def field(t, y, args):
+        k, c = args
+        return {"x": y["v"], "v": -k * y["x"] - c * y["v"], "pair": -c * y["pair"] * (1 + t)}
+
+    def norm(y):
+        assert isinstance(y, dict)  # the norm sees the pytree, not the flat vector
+        return jnp.sqrt(jnp.mean(y["x"] ** 2) + 0.5 * jnp.mean(y["v"] ** 2) + jnp.max(y["pair"] ** 2))
+
+    saveat = diffrax.SaveAt(
+        subs=[
+            diffrax.SubSaveAt(ts=jnp.linspace(0.0, 2.0, 7), fn=lambda t, y, a: {"x": y["x"], "t": t}),
+            diffrax.SubSaveAt(t1=True),
+        ]
+    )
+    controller = diffrax.PIDController(rtol=1e-6, atol=1e-8, pcoeff=0.3, icoeff=0.4, norm=norm)
+    return field, y0, saveat, controller
+
+
+def _toy_solve(args, flat: bool):
+    import diffrax
+
+    from jaxbearing.run._flat import flatten_problem
+
+    field, y0, saveat, controller = _toy_problem()
+    if flat:
+        field, y0, saveat, controller = flatten_problem(field, y0, saveat, controller)
+    sol = diffrax.diffeqsolve(
+        diffrax.ODETerm(field),
+        diffrax.Tsit5(),
+        0.0,
+        2.0,
+        0.01,
+        y0,
+        args=args,
+        saveat=saveat,
+        stepsize_controller=controller,
+        adjoint=diffrax.ForwardMode(),
+    )
+    return sol.ys, sol.stats["num_steps"]
+
+
+def test_the_flat_state_solves_the_same_problem_as_the_pytree():
+    """`_flat.flatten_problem`: the same steps, samples of the same structure and values, the
+    same final state, and the same forward-mode derivative with respect to the arguments."""
+    args = (jnp.array(4.0), jnp.array(0.3))
+    (tree_ys, tree_steps), (flat_ys, flat_steps) = (_toy_solve(args, flat) for flat in (False, True))
+    assert int(tree_steps) == int(flat_steps)
+    assert jax.tree_util.tree_structure(tree_ys) == jax.tree_util.tree_structure(flat_ys)
+    for a, b in zip(jax.tree_util.tree_leaves(tree_ys), jax.tree_util.tree_leaves(flat_ys)):
+        np.testing.assert_allclose(b, a, rtol=1e-13, atol=1e-15)
+
+    def final_x(args, flat):
+        return _toy_solve(args, flat)[0][1]["x"][-1]
+
+    tangent = (jnp.array(1.0), jnp.array(0.0))
+    d_tree, d_flat = (jax.jvp(lambda a: final_x(a, flat), (args,), (tangent,))[1] for flat in (False, True))
+    np.testing.assert_allclose(d_flat, d_tree, rtol=1e-12)
+
+
+def test_the_library_solve_hands_diffrax_one_vector():
+    """`_diffeqsolve` flattens the state for the explicit solver only (the Rosenbrock-W
+    solver's blocks are built from the `State`)."""
+    import diffrax
+
+    from jaxbearing.run import _simulate
+
+    seen = []
+
+    class Seen(Exception):
+        pass
+
+    def spy(term, solver, *args, y0, **kwargs):
+        seen.append(
+            (type(solver).__name__, jax.tree_util.tree_structure(y0).num_leaves, getattr(y0, "shape", None))
+        )
+        raise Seen
+
+    bearing, op = jb.reference_bearing(), jb.reference_operating_point()
+    original = diffrax.diffeqsolve
+    try:
+        diffrax.diffeqsolve = spy
+        for solver in ("tsit5", "ros34pw2"):
+            with pytest.raises(Seen):
+                jax.eval_shape(
+                    lambda b, s=solver: _simulate.solve(b, op, 1e-5, num_saves=2, solver=s), bearing
+                )
+    finally:
+        diffrax.diffeqsolve = original
+    (tsit5, n_tsit5, shape), (ros, n_ros, _) = seen
+    assert tsit5 == "Tsit5" and n_tsit5 == 1 and len(shape) == 1
+    assert ros != "Tsit5" and n_ros > 1
+
+
+def test_start_up_transients_take_the_max_norm_and_settled_windows_the_per_roller_rms():
+    """`solve` (fixed-duration runs, sweeps, trajectory gradients) builds its error norm from
+    `TRANSIENT_ERROR_NORM`: the max norm, raceway-normal x100, rotations not loosened (the
+    per-roller RMS with the rotations 10x looser gives spurious corner impacts there,
+    benchmarks/diagnose_peak_spread.py); `prepare_from` (settled windows) from the per-roller
+    RMS defaults."""
+    from jaxbearing.run import (
+        TRANSIENT_ERROR_NORM,
+        TRANSIENT_RACEWAY_LOOSEN,
+        TRANSIENT_ROTATION_LOOSEN,
+        _settle,
+        _simulate,
+    )
+
+    assert (TRANSIENT_ERROR_NORM, TRANSIENT_RACEWAY_LOOSEN, TRANSIENT_ROTATION_LOOSEN) == ("max", 100.0, 1.0)
+    bearing, op = jb.reference_bearing(), jb.reference_operating_point()
+    built = []
+
+    class Built(Exception):
+        pass
+
+    def spy(*args, **kwargs):
+        bound = inspect.signature(raceway_normal_norm).bind(*args, **kwargs)
+        bound.apply_defaults()
+        built.append({k: v for k, v in bound.arguments.items() if k != "state"})
+        raise Built
+
+    for module in (_simulate, _settle):
+        original = module.raceway_normal_norm
+        module.raceway_normal_norm = spy
+        try:
+            with pytest.raises(Built):
+                if module is _simulate:
+                    jax.eval_shape(lambda b: jb.run.solve(b, op, 1e-5, num_saves=2), bearing)
+                else:
+                    start = jb.run.initial_state(bearing, op, jb.Perturbation())
+                    _settle.prepare_from(jb.dynamics.Params(bearing=bearing, operating=op), start, 1e-3, 1e-6)
+        finally:
+            module.raceway_normal_norm = original
+    transient, settled = ({k: v if k == "kind" else float(v) for k, v in b.items()} for b in built)
+    assert transient == {"loosen": 100.0, "kind": "max", "rotation_loosen": 1.0}
+    assert settled == {"loosen": 10.0, "kind": "body_rms", "rotation_loosen": 10.0}

@@ -20,7 +20,8 @@
 - design metrics through the dynamics: `design_metrics`, `design_jacobian`, `DesignMetrics`,
   `seated_perturbation`, `forward_jacobian`;
 - `plot_run`: the figures of one run;
-- speed: `raceway_normal_norm` (the error norm of `solve`), `enable_compilation_cache` (JAX's
+- speed: `raceway_normal_norm` (the error norm of settled windows, `prepare_from`; `solve`'s
+  is `TRANSIENT_ERROR_NORM`), `enable_compilation_cache` (JAX's
   persistent cache in a user directory, `$JAXBEARING_CACHE_DIR`; on at import),
   `compiled_program` (a program compiled once per process and traced once per machine:
   `jax.export` artefacts in `program_cache_dir`),
@@ -90,6 +91,9 @@ from ._step_control import (
     ERROR_NORMS,
     RACEWAY_NORMAL_LOOSEN,
     ROTATION_LOOSEN,
+    TRANSIENT_ERROR_NORM,
+    TRANSIENT_RACEWAY_LOOSEN,
+    TRANSIENT_ROTATION_LOOSEN,
     RacewayNormalNorm,
     raceway_normal_norm,
 )
@@ -115,6 +119,9 @@ __all__ = [
     "ERROR_NORMS",
     "RACEWAY_NORMAL_LOOSEN",
     "ROTATION_LOOSEN",
+    "TRANSIENT_ERROR_NORM",
+    "TRANSIENT_RACEWAY_LOOSEN",
+    "TRANSIENT_ROTATION_LOOSEN",
     "RacewayNormalNorm",
     "enable_compilation_cache",
     "compiled_program",

@@ -78,8 +78,11 @@ PROJECTIVE_THRESHOLD = 0.25
 
 def prepare_from(params: Params, start: State, rtol, atol):
     """What a solve from the physical state `start` needs: (scaling, solve arguments, scaled
-    start with the accumulators at zero, step controller), with `solve`'s error norm; the
-    scaling's nominal orbit runs at the start's own cage speed."""
+    start with the accumulators at zero, step controller), with the settled windows' error
+    norm (`raceway_normal_norm`'s defaults: the per-roller RMS with the raceway-normal
+    coordinates and the rotations 10x looser; validated on settled statistics, not on start-up
+    transients, whose `solve` has `TRANSIENT_ERROR_NORM`); the scaling's nominal orbit runs at
+    the start's own cage speed."""
     b = params.bearing
     zero_acc = jax.tree_util.tree_map(jnp.zeros_like, start.accumulators)
     start = State(rollers=start.rollers, cage=start.cage, inner_ring=start.inner_ring, accumulators=zero_acc)
@@ -115,7 +118,7 @@ def solve_from(
         saveat = diffrax.SaveAt(subs=[saves, last])
     else:
         saveat = diffrax.SaveAt(subs=[last])
-    with checks_without_host_callbacks():  # the same integrator and error norm as `solve`
+    with checks_without_host_callbacks():  # the integrator of `solve`, the error norm of `prepare_from`
         sol = _diffeqsolve(y0_scaled, args, duration, saveat, controller, max_steps, adjoint, False, solver)
     if num_saves:
         hist, final = _histories(sol.ts[0], sol.ys[0], args), sol.ys[1]
