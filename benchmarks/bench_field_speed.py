@@ -36,6 +36,16 @@ XLA_FLAGS=--xla_cpu_enable_xprof_traceme=true) showed where: XLA fuses the per-s
 into each consumer of the stacked components, so a slice's contact law is evaluated once per
 summed component; written with the pocket by components as well, one such fusion took 98 us of
 a 240 us field.
+
+Measured 2026-11-25, fourth session (`--baseline c695504 --current 0797e02 --repeats 3
+--output bench_field_speed_one_raceway_vmap`, results/bench_field_speed_one_raceway_vmap.json;
+0797e02 is an unlanded probe commit): both raceways in one vmap over the rings, v_rel with one
+cross product a slice ((v_b - v_r - w_r x (p - c_r)) + (w_b - w_r) x (x_j - p)) and the ring's
+moment from the roller's (-(M_b + (p - c_r) x F)). XLA counts 1.62x fewer flops in the field
+and 1.20x fewer with three tangents; the field took 311.7 against 336.3 us (1.08x), three
+tangents 1.07x, the sampled solve 1.08x, but the plain solve 0.49-0.62 against 0.37-0.42 s per
+simulated ms in all three pairs (0.76x). Not landed. (The machine ran the field at about 340 us
+that day against 165-170 us in earlier sessions: shared and loaded.)
 """
 
 from __future__ import annotations

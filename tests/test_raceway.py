@@ -373,3 +373,81 @@ def test_bad_ring_sign_is_a_user_error():
     b = _bearing()
     with pytest.raises(UserInputError, match="ring_sign"):
         raceway_contact(b, 0.0, b.inner_raceway_radius, ZERO, jnp.asarray(X), ZERO, ZERO, ZERO, ZERO, ZERO)
+
+
+def test_sliding_velocity_and_ring_moment_are_the_slice_formulas():
+    """The sliding velocity and the ring's moment of `raceway_contact` are the formulas of the
+    module docstring written per slice (a regression check for any rewrite of them for speed):
+    u_j = tangential part of (v_b + w_b x (x_j - p)) - (v_r + w_r x (x_j - c_r)) and
+    M_ring = -sum_j (x_j - c_r) x f_j."""
+    b = _bearing()
+    rng = np.random.default_rng(11)
+    e = X + rng.uniform(-3e-3, 3e-3, 3)
+    e = jnp.asarray(e / np.linalg.norm(e))
+    p = _inner_position(b, 3e-6) + jnp.asarray([1e-4, 2e-6, -1e-6])
+    v, w = jnp.asarray(rng.normal(size=3) * 0.5), jnp.asarray(rng.normal(size=3) * 1e3)
+    c_r = jnp.asarray([2e-5, 1e-6, -2e-6])
+    v_r, w_r = jnp.asarray([0.001, 0.01, 0.02]), jnp.asarray([2000.0, 3.0, -2.0])
+    a = jnp.asarray([math.cos(2e-3), 0.0, -math.sin(2e-3)])
+    c = jax.jit(raceway_contact)(b, 1.0, b.inner_raceway_radius, p, e, v, w, c_r, v_r, w_r, ring_axis=a)
+    x, n = np.asarray(c.contact_points), np.asarray(c.normals)
+    v_rel = (np.asarray(v) + np.cross(np.asarray(w), x - np.asarray(p))) - (
+        np.asarray(v_r) + np.cross(np.asarray(w_r), x - np.asarray(c_r))
+    )
+    u = v_rel - np.sum(v_rel * n, axis=-1, keepdims=True) * n
+    np.testing.assert_allclose(np.asarray(c.sliding_velocity), u, rtol=1e-9, atol=1e-9 * np.abs(u).max())
+    f = np.asarray(c.slice_loads)[:, None] * n + np.asarray(c.slice_traction)
+    ring_moment = -np.sum(np.cross(x - np.asarray(c_r), f), axis=0)
+    scale = np.linalg.norm(np.asarray(c.force_on_roller)) * float(b.roller.diameter)
+    assert scale > 1e-2
+    np.testing.assert_allclose(np.asarray(c.moment_on_ring), ring_moment, rtol=0, atol=1e-12 * scale)
+
+
+def test_the_field_takes_both_raceways_as_single_calls_do():
+    """`dynamics.contact_loads`' raceways equal `raceway_contact` for each ring alone (inner:
+    tilted, displaced, moving ring; outer: fixed, axis X by default): a regression check for
+    any regrouping of the raceway evaluations for speed."""
+    from jaxbearing.dynamics import Params, contact_loads, inner_ring_pose
+
+    b = jb.reference_bearing()
+    op = eqx.tree_at(lambda o: o.misalignment, jb.reference_operating_point(), jnp.asarray(2e-3))
+    y = jb.run.initial_state(b, op, jb.Perturbation(seed=4))
+    y = eqx.tree_at(lambda s: s.inner_ring.centre, y, y.inner_ring.centre + jnp.array([2e-6, -1e-6]))
+    y = eqx.tree_at(lambda s: s.inner_ring.velocity, y, jnp.array([0.01, -0.02]))
+    loads = contact_loads(y, Params(bearing=b, operating=op))
+    ring = inner_ring_pose(y.inner_ring, op)
+    r = y.rollers
+    e = r.axis / jnp.linalg.norm(r.axis, axis=-1, keepdims=True)
+    per_roller = jax.jit(jax.vmap(raceway_contact, in_axes=(None, None, None, 0, 0, 0, 0, None, None, None)))
+
+    def inner_one(p, e, v, w):
+        return raceway_contact(
+            b,
+            1.0,
+            b.inner_raceway_radius,
+            p,
+            e,
+            v,
+            w,
+            ring.centre,
+            ring.velocity,
+            ring.angular_velocity,
+            ring_axis=ring.axis,
+        )
+
+    inner = jax.jit(jax.vmap(inner_one))(r.centre, e, r.velocity, r.angular_velocity)
+    outer = per_roller(
+        b, -1.0, b.outer_raceway_radius, r.centre, e, r.velocity, r.angular_velocity, ZERO, ZERO, ZERO
+    )
+    assert float(jnp.max(inner.normal_load)) > 10.0 and float(jnp.max(outer.normal_load)) > 10.0
+    for got, want in ((loads.inner, inner), (loads.outer, outer)):
+        for name in (
+            "interference",
+            "slice_loads",
+            "sliding_velocity",
+            "force_on_roller",
+            "moment_on_roller",
+            "moment_on_ring",
+        ):
+            g, w = np.asarray(getattr(got, name)), np.asarray(getattr(want, name))
+            np.testing.assert_allclose(g, w, rtol=1e-10, atol=1e-10 * np.abs(w).max(), err_msg=name)
