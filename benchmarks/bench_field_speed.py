@@ -39,7 +39,7 @@ a 240 us field.
 
 Measured 2026-11-25, fourth session (`--baseline c695504 --current 0797e02 --repeats 3
 --output bench_field_speed_one_raceway_vmap`, results/bench_field_speed_one_raceway_vmap.json;
-0797e02 is an unlanded probe commit): both raceways in one vmap over the rings, v_rel with one
+0797e02 is an unlanded probe commit, its diff in results/bench_field_speed_one_raceway_vmap.diff): both raceways in one vmap over the rings, v_rel with one
 cross product a slice ((v_b - v_r - w_r x (p - c_r)) + (w_b - w_r) x (x_j - p)) and the ring's
 moment from the roller's (-(M_b + (p - c_r) x F)). XLA counts 1.62x fewer flops in the field
 and 1.20x fewer with three tangents; the field took 311.7 against 336.3 us (1.08x), three
