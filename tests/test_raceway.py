@@ -389,7 +389,7 @@ def test_sliding_velocity_and_ring_moment_are_the_slice_formulas():
     c_r = jnp.asarray([2e-5, 1e-6, -2e-6])
     v_r, w_r = jnp.asarray([0.001, 0.01, 0.02]), jnp.asarray([2000.0, 3.0, -2.0])
     a = jnp.asarray([math.cos(2e-3), 0.0, -math.sin(2e-3)])
-    c = jax.jit(raceway_contact)(b, 1.0, b.inner_raceway_radius, p, e, v, w, c_r, v_r, w_r, ring_axis=a)
+    c = _contact(b, 1.0, b.inner_raceway_radius, p, e, v, w, c_r, v_r, w_r, ring_axis=a)
     x, n = np.asarray(c.contact_points), np.asarray(c.normals)
     v_rel = (np.asarray(v) + np.cross(np.asarray(w), x - np.asarray(p))) - (
         np.asarray(v_r) + np.cross(np.asarray(w_r), x - np.asarray(c_r))
