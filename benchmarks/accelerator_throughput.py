@@ -45,7 +45,7 @@ Two parts (`--part sweep`, `--part ensemble`, or both):
 writes `results/accelerator_throughput.json` (or PATH) and prints a table. The committed results
 came from `--part sweep --output benchmarks/results/accelerator_sweep.json` and `--part ensemble
 --members 128 --output benchmarks/results/accelerator_ensemble.json` and `--part gradient
---members 128 --output benchmarks/results/accelerator_gradient.json` on an H100 (README, On a
+--members 128 --output benchmarks/results/accelerator_gradient.json` on an H100 (docs/performance.md, On a
 GPU). Without an accelerator it stops with one line. It is not a `bench_*.py`, so `make bench`
 (which runs where CI runs, on CPUs) does not run it.
 """

@@ -83,7 +83,7 @@ def main(quick: bool = True, atol: float | None = None) -> dict:
     kw = dict(rtol=GRADIENT_RTOL, atol=atol, max_steps=100_000)
 
     # the bearing is an argument of every compiled program, not a closed-over constant: closing
-    # over its arrays cost about 0.17 s per call of the plain solve (README, Performance)
+    # over its arrays cost about 0.17 s per call of the plain solve (docs/performance.md)
     def pv(x, base, adjoint=None):
         b = DesignVariables.from_array(x).apply(base)
         return flange_functionals(

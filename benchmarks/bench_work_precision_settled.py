@@ -67,7 +67,11 @@ the defaults among them) and writes `bench_work_precision_settled_rows.json` (`-
 `bench_work_precision_settled_rows_rotation.json`). `--seeds 4,5,6,7` starts from other
 seeds' settled states (settled and cached on first use; a fresh reference unless one stored
 for those seeds fits) and adds `_seeds4-5-6-7` to the results name: a choice made on the
-default seeds is checked on seeds it was not made on. Results: `results/bench_work_precision_settled.json`.
+default seeds is checked on seeds it was not made on. `--design R_end,theta_f,Delta_bf` (mm, deg,
+mm) runs the study on the reference bearing with that roller-end and flange design instead (its
+own settled states, cache files and reference; `_design...` added to the results name): for
+designs near their corner limit, which the design search visits. Results:
+`results/bench_work_precision_settled.json`.
 """
 
 from __future__ import annotations
@@ -213,14 +217,17 @@ NORM_OF_KIND = {"tsit5": "max", "tsit5_rms": "rms", "tsit5_body_rms": "body_rms"
 
 
 # -- settled start states ----------------------------------------------------------------------
-def settled_start(bearing, op, seed: int) -> dict:
+def settled_start(bearing, op, seed: int, design: tuple | None = None) -> dict:
     """Seed `seed`'s settled state (`SeedRun.final_state`) and how it was obtained, from the
-    cache or from `simulate_steady` (2 window revolutions, one process)."""
+    cache or from `simulate_steady` (2 window revolutions, one process). `design`: the
+    `--design` triple the bearing was built with (part of the cache key), None for the
+    reference bearing."""
     import jaxbearing as jb
     from jaxbearing.run import simulate_steady
 
     rpm, load = float(jb.rad_s_to_rpm(op.inner_speed)), float(op.radial_load)
-    path = CACHE_DIR / f"reference_{rpm:.0f}rpm_{load:.0f}N_seed{seed}.pkl"
+    stem = "reference" if design is None else "design" + design_label(design)
+    path = CACHE_DIR / f"{stem}_{rpm:.0f}rpm_{load:.0f}N_seed{seed}.pkl"
     if path.exists():
         with path.open("rb") as fh:
             out = pickle.load(fh)
@@ -445,7 +452,7 @@ def stored_reference(case: dict, names: tuple = (NAME,)) -> dict | None:
 
 
 def _stored_reference(old: dict, case: dict) -> dict | None:
-    keys = ("seeds", "window_s", "num_saves", "inner_speed_rpm", "radial_load_N")
+    keys = ("seeds", "window_s", "num_saves", "inner_speed_rpm", "radial_load_N", "design")
     if old.get("quick") or any(old["case"].get(k) != case[k] for k in keys):
         return None
     if reference_tolerances(old["case"]["reference"]) != reference_tolerances(case["reference"]):
@@ -461,15 +468,60 @@ def reference_tolerances(reference: dict) -> tuple:
     return reference["rtol"], float(f"{length:.6g}"), reference["method"]
 
 
-def output_name(only: tuple | None, seeds: tuple, tag: str | None = None) -> str:
+def output_name(only: tuple | None, seeds: tuple, tag: str | None = None, design: tuple | None = None) -> str:
     """Results name: `NAME`, `_rows` with --rows, `_{tag}` with --tag, `_seeds4-7` (say) with
-    other seeds than `SEEDS`."""
+    other seeds than `SEEDS`, `_design94.31-1.839-0.15` (say) with --design."""
     return (
         NAME
         + ("" if only is None else "_rows")
         + ("" if not tag else f"_{tag}")
         + ("" if tuple(seeds) == SEEDS else "_seeds" + "-".join(str(s) for s in seeds))
+        + ("" if design is None else "_design" + design_label(design))
     )
+
+
+def design_label(design: tuple) -> str:
+    """`94.31-1.839-0.15` for (R_end mm, theta_f deg, Delta_bf mm) = (94.31, 1.839, 0.15)."""
+    return "-".join(f"{v:.4g}" for v in design)
+
+
+#: valid ranges of `--design`'s three numbers: (name, unit, low, high)
+DESIGN_RANGES = (("R_end", "mm", 10.0, 1000.0), ("theta_f", "deg", 0.0, 10.0), ("Delta_bf", "mm", 0.0, 1.0))
+
+
+def design_argument(argv: list) -> tuple | None:
+    """(R_end mm, theta_f deg, Delta_bf mm) of `--design 94.31,1.839,0.15`, None without it;
+    anything else ends the program with one line naming the option, its value and the ranges."""
+    text = _common.option_value(argv, "--design")
+    if text is None:
+        return None
+    ranges = ", ".join(f"{n} in [{lo:g}, {hi:g}] {u}" for n, u, lo, hi in DESIGN_RANGES)
+    try:
+        values = tuple(float(p) for p in text.split(","))
+    except ValueError:
+        values = ()
+    if len(values) != 3 or not all(lo <= v <= hi for v, (_, _, lo, hi) in zip(values, DESIGN_RANGES)):
+        raise SystemExit(f"--design = {text!r}: three numbers R_end,theta_f,Delta_bf with {ranges}")
+    return values
+
+
+def design_bearing(design: tuple | None):
+    """The reference bearing, with `--design`'s R_end [mm], theta_f [deg], Delta_bf [mm] when
+    given (`jaxbearing.flange.DesignVariables.apply`)."""
+    import math
+
+    import jaxbearing as jb
+    from jaxbearing.flange import DesignVariables
+
+    bearing = jb.reference_bearing()
+    if design is None:
+        return bearing
+    end_radius_mm, layback_deg, clearance_mm = design
+    return DesignVariables(
+        end_radius=end_radius_mm * 1e-3,
+        layback_angle=math.radians(layback_deg),
+        axial_clearance=clearance_mm * 1e-3,
+    ).apply(bearing)
 
 
 def tag_argument(argv: list) -> str | None:
@@ -488,6 +540,7 @@ def main(
     only: tuple | None = None,
     seeds: tuple = SEEDS,
     tag: str | None = None,
+    design: tuple | None = None,
 ) -> dict:
     import jax
     import jax.numpy as jnp
@@ -497,16 +550,16 @@ def main(
     from jaxbearing.dynamics import SCALED_UNITS, Functionals, Params
 
     started = time.perf_counter()
-    name = output_name(only, seeds, tag)
+    name = output_name(only, seeds, tag, design)
     seeds = seeds[:1] if quick else tuple(seeds)
     ref_rtol = QUICK_REF_RTOL if quick else REF_RTOL
-    bearing, op = jb.reference_bearing(), jb.reference_operating_point()
+    bearing, op = design_bearing(design), jb.reference_operating_point()
     jb.validate_bearing(bearing, op)
     params = Params(bearing=bearing, operating=op, functionals=Functionals())
     omega_kin = float(jb.kinematic_cage_speed(bearing, op))
 
     t_settle = time.perf_counter()
-    settled = {s: settled_start(bearing, op, s) for s in seeds}
+    settled = {s: settled_start(bearing, op, s, design) for s in seeds}
     settle_wall = time.perf_counter() - t_settle
     starts = {s: jax.tree_util.tree_map(jnp.asarray, v["state"]) for s, v in settled.items()}
     rpm = float(np.mean([v["info"]["last_revolution_cage_speed_rpm"] for v in settled.values()]))
@@ -557,7 +610,11 @@ def main(
         return r, hist
 
     case = {
-        "bearing": "reference_bearing() (26 rollers, 31 slices, arc ends)",
+        "bearing": "reference_bearing() (26 rollers, 31 slices, arc ends)"
+        + ("" if design is None else ", with --design R_end, theta_f, Delta_bf"),
+        "design": None
+        if design is None
+        else dict(zip(("end_radius_mm", "layback_angle_deg", "axial_clearance_mm"), design)),
         "inner_speed_rpm": float(jb.rad_s_to_rpm(op.inner_speed)),
         "radial_load_N": float(op.radial_load),
         "seeds": list(seeds),
@@ -579,7 +636,7 @@ def main(
         "final_state); per-seed CI from 8 batch means of the reference over the window; cage slip "
         "errors are absolute",
     }
-    names = (NAME, name, output_name(None, seeds))
+    names = (NAME, name, output_name(None, seeds, design=design))
     reference = (stored_reference(case, names) if reuse_reference else None) or {}
     if reference:
         _common.log(f"{NAME}: reference runs from the stored results (--reuse-reference)")
@@ -761,4 +818,5 @@ if __name__ == "__main__":
         only=rows_argument(sys.argv, len(VARIANTS)),
         seeds=seeds_argument(sys.argv),
         tag=tag_argument(sys.argv),
+        design=design_argument(sys.argv),
     )

@@ -13,7 +13,7 @@ corner on the flange: the largest sampled PV with on_arc = 0).
     python benchmarks/diagnose_peak_spread.py    (about 3 min; results/diagnose_peak_spread.json)
 
 The first setting is `solve`'s since 2026-11-25 (third session), chosen by this study; the third
-was every solve's before and stays that of settled windows (`prepare_from`; README, Performance).
+was every solve's before and stays that of settled windows (`prepare_from`; docs/performance.md).
 """
 
 from __future__ import annotations

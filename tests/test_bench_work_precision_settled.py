@@ -61,3 +61,30 @@ def test_rows_and_seeds_options_are_checked_in_one_line():
     for bad in ("", "a/b", "x y"):
         with pytest.raises(SystemExit, match="--tag = "):
             tag_argument(["x", "--tag", bad])
+
+
+def test_design_option_is_checked_and_builds_that_design():
+    """`--design R_end,theta_f,Delta_bf` (mm, deg, mm): parsed, range-checked in one line naming
+    the option, its value and the ranges, named in the results file, and applied to the
+    reference bearing through `DesignVariables`."""
+    import math
+
+    from bench_work_precision_settled import SEEDS, design_argument, design_bearing, output_name
+
+    import jaxbearing as jb
+
+    assert design_argument(["x"]) is None
+    assert design_argument(["x", "--design", "94.31,1.839,0.15"]) == (94.31, 1.839, 0.15)
+    for bad in ("94.31,1.839", "a,b,c", "94.31,45,0.15", "94.31,1.839,-0.1", ""):
+        with pytest.raises(SystemExit, match=r"--design = .*R_end in \[10, 1000\] mm"):
+            design_argument(["x", "--design", bad])
+    assert (
+        output_name((26,), SEEDS, "corner", (94.31, 1.839, 0.15))
+        == "bench_work_precision_settled_rows_corner_design94.31-1.839-0.15"
+    )
+    b = design_bearing((94.31, 1.839, 0.15))
+    assert math.isclose(float(b.roller.end_radius), 94.31e-3)
+    assert math.isclose(float(b.flange.layback_angle), math.radians(1.839))
+    assert math.isclose(float(b.flange.axial_clearance), 0.15e-3)
+    reference_radius = float(jb.reference_bearing().roller.end_radius)
+    assert float(design_bearing(None).roller.end_radius) == reference_radius

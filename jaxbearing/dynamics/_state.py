@@ -128,7 +128,7 @@ class State(eqx.Module):
 #: one unit of scaled state (`state_scales`): (length [m], linear velocity [m/s], angular
 #: velocity [rad/s], axis component [-]). The default absolute tolerance atol = 1e-6 is 1e-6 of
 #: these: 10 nm, 10 um/s, 0.01 rad/s, 1e-8. Chosen with
-#: benchmarks/bench_work_precision_settled.py (README, Performance).
+#: benchmarks/bench_work_precision_settled.py (docs/performance.md).
 SCALED_UNITS = (1e-2, 10.0, 1e4, 1e-2)
 
 
@@ -143,7 +143,7 @@ def state_scales(num_rollers: int, pitch_radius: float) -> State:
     the axis components. That is two orders of magnitude below the micrometre deflections of
     the contacts and far below the sliding speeds (m/s) that a flange statistic reads; smaller
     scales (1 um per unit, an absolute tolerance of 1 pm) made components whose deviation passes
-    through zero hold the step for nothing (README, Performance: 1.54x more field evaluations
+    through zero hold the step for nothing (docs/performance.md: 1.54x more field evaluations
     at agreeing settled statistics). rtol is relative to the deviation and does not depend on
     the scales. Accumulators are scaled large: they must not steer the step size.
     """

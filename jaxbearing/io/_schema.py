@@ -787,7 +787,7 @@ KEYS: tuple[Key, ...] = (
         "",
         "time integrator",
         choices=("tsit5", "ros34pw2"),
-        note="ros34pw2: linearly implicit Rosenbrock-W; costs more at equal error (README, Performance)",
+        note="ros34pw2: linearly implicit Rosenbrock-W; costs more at equal error (docs/performance.md)",
     ),
 )
 

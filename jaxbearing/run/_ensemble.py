@@ -25,7 +25,7 @@ The other way round, the workers end when the process that started them is kille
 Each worker is pinned to one CPU of this process's set, in turn (`_pin_to_one_cpu`, Linux). An
 unpinned worker's XLA threads move between the cores and contend with the other worker's:
 two unpinned workers ran a case in 1.45x the time of one case alone, two pinned ones in 1.04x
-(benchmarks/bench_ensemble.py, README Performance). A pool with more workers than CPUs shares
+(benchmarks/bench_ensemble.py, docs/performance.md). A pool with more workers than CPUs shares
 each CPU between the workers pinned to it.
 
 `as_completed_map(function, items, workers=N)` yields each result as it finishes (the sweep

@@ -8,7 +8,9 @@ stage. `flatten_problem` hands diffrax the state ravelled into one vector instea
 the saving functions see the `State` pytree again (`unravel`), so what they compute and what
 the solve returns are unchanged; the stage sums act on the same numbers element by element.
 
-Measured on the 2-core machine (`benchmarks/diagnose_flat_state.py`, README Performance).
+Measured on the 2-core machine (`benchmarks/bench_work_precision_settled.py --reuse-reference
+--tag flat --rows 26,28`, row 28 the pytree; docs/performance.md): wall time 1.00-1.05x, compile
+0.85-0.96x, the same statistics.
 
 Only explicit solvers take the flat vector: the Rosenbrock-W solver's Jacobian blocks are
 built from the `State`'s roller coordinates (`_rosenbrock.RollerBlockJacobian`).

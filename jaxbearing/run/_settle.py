@@ -31,7 +31,7 @@ measure over a window of whole revolutions (issue 11; docs/model.md 16).
   `_statistics`. With `seeds = N` the whole run is repeated for N seeded initial scatters
   (`Perturbation.seed` = 0 .. N-1), with `workers` > 1 one process per core (`parallel_map`: 1.52x the throughput of
   one case at a time on 2 cores, benchmarks/results/bench_ensemble.json; a vmapped batch is slower
-  per case than one at a time, README, Performance).
+  per case than one at a time, docs/performance.md).
 """
 
 from __future__ import annotations

@@ -18,8 +18,8 @@
   fn=_saved_state)`, without the accumulators), and the flange-contact quantities, cage speed
   and roller loads are evaluated from those states after the loop (`_histories`), so memory
   grows with the samples, not with the state, and the contacts are compiled once for the
-  samples instead of inside diffrax's saving (about 12 % less time to compile; README,
-  Performance).
+  samples instead of inside diffrax's saving (about 12 % less time to compile;
+  docs/performance.md).
 * Smooth peak functionals (p-norm of PV, log-sum-exp of the contact height) are integrated in the
   state and are differentiable with respect to every float parameter.
 * A failed solve (step limit, step size collapse on non-finite states) returns a result whose
@@ -98,7 +98,7 @@ def _histories(ts, saved, args: SolveArgs) -> dict:
     Evaluating `_save` inside diffrax's saving instead (`SaveAt(fn=_save)`) gives the same
     samples to rounding (4e-12 relative): the states are the same interpolants, and the
     trajectory does not depend on what is saved. Here XLA compiles the contacts of the outputs
-    once, which takes about 12 % less time to compile a solve with samples (README)."""
+    once, which takes about 12 % less time to compile a solve with samples (docs/performance.md)."""
     n = ts.shape[0]
     # padded rather than lax.map's own remainder, which would be a second compiled copy of the
     # contacts (a vmap over the leftover samples)
@@ -253,7 +253,7 @@ def solve(
     the third.
     `solver` (static): "tsit5" (default, explicit) or "ros34pw2" (linearly implicit
     Rosenbrock-W with every roller's Jacobian block implicit, `_rosenbrock`; slower at the
-    tolerances measured so far: README, Performance).
+    tolerances measured so far: docs/performance.md).
 
     Every argument is checked before anything is traced (`jaxbearing.io.check_solve_inputs`;
     one-line `UserInputError`/`ConfigError`); under jit/vmap/grad traced values cannot be

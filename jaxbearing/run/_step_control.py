@@ -33,9 +33,9 @@ over each roller's 12 coordinates, over the cage's and over the inner ring's, an
 of these (Hairer, Norsett & Wanner, Solving ODEs I, II.4, eq. 4.11, per body). No roller's
 error hides among the other rollers' (one coordinate may exceed its tolerance by at most
 sqrt(12) = 3.5 when it alone errs), while the several coordinates of one roller that all held
-the step under the max norm (README, Performance) share one tolerance. Chosen by the settled
+the step under the max norm (docs/performance.md) share one tolerance. Chosen by the settled
 work-precision benchmark and by the peak-PV check of `benchmarks/diagnose_error_norms.py`
-(README, Performance; docs/model.md 13):
+(docs/performance.md; docs/model.md 13):
 - "max", the max norm over every coordinate (the default until 2026-11-25, with the
   raceway-normal tolerances 100x looser): every statistic agrees with a tight reference;
 - "rms", the RMS over all 328 coordinates of the bodies (SciPy's and diffrax's default
@@ -53,7 +53,7 @@ coordinates (benchmarks/diagnose_step_control.py --norm body_rms). Their toleran
 settled running, every flange statistic and the cage slip agreeing with the tight reference
 on the seeds used to choose it and on others. The smooth peak PV of a start-up transient
 shows no bias against the max norm, but scatters about three times as much between
-trajectories (standard deviation 3.4 % against 1.1 %; README, Performance), and with the
+trajectories (standard deviation 3.4 % against 1.1 %; docs/performance.md), and with the
 step sequence alone changed it holds spurious corner impacts (`TRANSIENT_ERROR_NORM`), so
 `solve` does not loosen them. The flange contact's own coordinates (a
 roller's axial position and velocity, its axis: skew and tilt) keep their tolerances.
@@ -172,7 +172,7 @@ DEFAULT_ERROR_NORM = "body_rms"
 #: 31 % low; the per-roller RMS alone gives 2 of 8, the max norm with the rotations 10x looser
 #: 2 of 8, this setting 0 of 8 within 2 % (to 3 %) of the tight median
 #: (benchmarks/diagnose_peak_spread.py). Settled windows show no corner contact under their
-#: error control (README, Performance).
+#: error control (docs/performance.md).
 TRANSIENT_ERROR_NORM = "max"
 TRANSIENT_RACEWAY_LOOSEN = 100.0
 TRANSIENT_ROTATION_LOOSEN = 1.0
