@@ -95,8 +95,14 @@ def _loop_time(fn, repeats: int = 7) -> float:
     return best / EVALS
 
 
-def child() -> dict:
-    """The measurements of the module docstring for the `jaxbearing` on `sys.path`."""
+def reference_field() -> tuple:
+    """(bearing, op, x0, y0, field, tangents, looped) of the module docstring, for the
+    `jaxbearing` on `sys.path`: the reference bearing at its seeded quasi-static start, its
+    design x0 = (R_end, theta_f, Delta_bf), `field(x, y)` (`physical_rates`), `tangents(x, y)`
+    (the field with three forward-mode tangents in the state and the design, as inside a
+    `diffrax.ForwardMode` solve) and `looped(fn)`: `EVALS` evaluations of `fn(x0, y)` in one
+    jitted `lax.fori_loop` whose state depends on the carry (no dispatch, nothing hoisted).
+    Also used by `diagnose_field_bound.py`."""
     import jax
     import jax.numpy as jnp
 
@@ -124,6 +130,17 @@ def child() -> dict:
             return acc + 1e-30 * sum(jnp.sum(leaf) for leaf in jax.tree_util.tree_leaves(out))
 
         return jax.jit(lambda: jax.lax.fori_loop(0, EVALS, body, jnp.asarray(0.0)))
+
+    return bearing, op, x0, y0, field, tangents, looped
+
+
+def child() -> dict:
+    """The measurements of the module docstring for the `jaxbearing` on `sys.path`."""
+    import jax
+
+    import jaxbearing as jb
+
+    bearing, op, x0, y0, field, tangents, looped = reference_field()
 
     def flops(fn):
         cost = jax.jit(fn).lower(x0, y0).compile().cost_analysis()

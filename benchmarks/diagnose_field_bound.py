@@ -63,9 +63,9 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import _common  # noqa: E402
+from bench_field_speed import EVALS, reference_field  # noqa: E402  (the same field and loop)
 
 NAME = "diagnose_field_bound"
-EVALS = 400
 UNIT_ELEMENTS = 1612  # 2 raceways x 26 rollers x 31 slices
 UNIT_ITERS = 2000
 
@@ -151,31 +151,11 @@ VARIANTS = {
 def _programs(with_tangents: bool) -> dict:
     """{(variant, kind): compiled no-argument program of EVALS evaluations}."""
     import jax
-    import jax.numpy as jnp
 
-    import jaxbearing as jb
-    from jaxbearing.dynamics import Params, physical_rates
-    from jaxbearing.flange import DesignVariables
-
-    bearing, op = jb.reference_bearing(), jb.reference_operating_point()
-    y0 = jb.run.initial_state(bearing, op, jb.Perturbation(seed=0))
-    x0 = DesignVariables.of(bearing).as_array()
-
-    def field(x, y):
-        b = DesignVariables.from_array(x).apply(bearing)
-        return physical_rates(0.0, y, Params(bearing=b, operating=op))
-
-    def tangents(x, y):
-        ones = jax.tree_util.tree_map(lambda a: jnp.ones((3,) + a.shape), y)
-        return jax.vmap(lambda d, t: jax.jvp(field, (x, y), (d, t)), out_axes=(None, 0))(jnp.eye(3), ones)
+    _, _, x0, y0, field, tangents, loop = reference_field()
 
     def looped(fn):
-        def body(i, acc):
-            y = jax.tree_util.tree_map(lambda a: a + 1e-30 * acc, y0)
-            out = fn(x0, y)
-            return acc + 1e-30 * sum(jnp.sum(leaf) for leaf in jax.tree_util.tree_leaves(out))
-
-        return jax.jit(lambda: jax.lax.fori_loop(0, EVALS, body, jnp.asarray(0.0))).lower().compile()
+        return loop(fn).lower().compile()
 
     kinds = {"field_us": field, **({"tangents_us": tangents} if with_tangents else {})}
     programs, counts = {}, {}
