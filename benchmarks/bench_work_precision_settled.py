@@ -752,8 +752,15 @@ def _table(r: dict) -> str:
                 v["agrees_all"] if len(c["seeds"]) > 1 else None,
             ]
         )
+    design = c.get("design")
+    bearing = "reference bearing" + (
+        ""
+        if not design
+        else f" with R_end {design['end_radius_mm']:g} mm, theta_f {design['layback_angle_deg']:g} deg, "
+        f"Delta_bf {design['axial_clearance_mm']:g} mm,"
+    )
     title = (
-        f"Work-precision in settled running: reference bearing {c['inner_speed_rpm']:.0f} rpm, "
+        f"Work-precision in settled running: {bearing} {c['inner_speed_rpm']:.0f} rpm, "
         f"{c['radial_load_N']:.0f} N; window {ms:.3g} ms from each seed's settled state, seeds {c['seeds']}"
     )
     cost = _common.format_table(
