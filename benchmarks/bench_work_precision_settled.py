@@ -485,43 +485,42 @@ def design_label(design: tuple) -> str:
     return "-".join(f"{v:.4g}" for v in design)
 
 
-#: valid ranges of `--design`'s three numbers: (name, unit, low, high)
-DESIGN_RANGES = (("R_end", "mm", 10.0, 1000.0), ("theta_f", "deg", 0.0, 10.0), ("Delta_bf", "mm", 0.0, 1.0))
+#: the configuration keys of `--design`'s three numbers, in order (engineering units; their valid
+#: ranges are the schema's, `jaxbearing.io`, checked by `Config.replace`)
+DESIGN_KEYS = ("roller.end_radius_mm", "flange.layback_angle_deg", "flange.axial_clearance_mm")
 
 
 def design_argument(argv: list) -> tuple | None:
     """(R_end mm, theta_f deg, Delta_bf mm) of `--design 94.31,1.839,0.15`, None without it;
-    anything else ends the program with one line naming the option, its value and the ranges."""
+    anything else ends the program with one line naming the option and its value (and, for a
+    number out of range, the configuration key and its valid range)."""
+    import jaxbearing as jb
+
     text = _common.option_value(argv, "--design")
     if text is None:
         return None
-    ranges = ", ".join(f"{n} in [{lo:g}, {hi:g}] {u}" for n, u, lo, hi in DESIGN_RANGES)
     try:
         values = tuple(float(p) for p in text.split(","))
     except ValueError:
         values = ()
-    if len(values) != 3 or not all(lo <= v <= hi for v, (_, _, lo, hi) in zip(values, DESIGN_RANGES)):
-        raise SystemExit(f"--design = {text!r}: three numbers R_end,theta_f,Delta_bf with {ranges}")
+    if len(values) != 3:
+        raise SystemExit(f"--design = {text!r}: three numbers R_end,theta_f,Delta_bf in mm, deg, mm")
+    try:
+        design_bearing(values)
+    except jb.ConfigError as err:
+        raise SystemExit(f"--design = {text!r}: {err}") from None
     return values
 
 
 def design_bearing(design: tuple | None):
     """The reference bearing, with `--design`'s R_end [mm], theta_f [deg], Delta_bf [mm] when
-    given (`jaxbearing.flange.DesignVariables.apply`)."""
-    import math
-
+    given: the reference configuration with `DESIGN_KEYS` replaced (validated there)."""
     import jaxbearing as jb
-    from jaxbearing.flange import DesignVariables
 
-    bearing = jb.reference_bearing()
-    if design is None:
-        return bearing
-    end_radius_mm, layback_deg, clearance_mm = design
-    return DesignVariables(
-        end_radius=end_radius_mm * 1e-3,
-        layback_angle=math.radians(layback_deg),
-        axial_clearance=clearance_mm * 1e-3,
-    ).apply(bearing)
+    config = jb.reference_config()
+    if design is not None:
+        config = config.replace(dict(zip(DESIGN_KEYS, design)))
+    return config.bearing()
 
 
 def tag_argument(argv: list) -> str | None:

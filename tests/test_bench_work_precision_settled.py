@@ -64,9 +64,9 @@ def test_rows_and_seeds_options_are_checked_in_one_line():
 
 
 def test_design_option_is_checked_and_builds_that_design():
-    """`--design R_end,theta_f,Delta_bf` (mm, deg, mm): parsed, range-checked in one line naming
-    the option, its value and the ranges, named in the results file, and applied to the
-    reference bearing through `DesignVariables`."""
+    """`--design R_end,theta_f,Delta_bf` (mm, deg, mm): parsed, range-checked by the
+    configuration schema in one line naming the option, its value, the key and its range, named
+    in the results file, and applied to the reference bearing."""
     import math
 
     from bench_work_precision_settled import SEEDS, design_argument, design_bearing, output_name
@@ -75,8 +75,14 @@ def test_design_option_is_checked_and_builds_that_design():
 
     assert design_argument(["x"]) is None
     assert design_argument(["x", "--design", "94.31,1.839,0.15"]) == (94.31, 1.839, 0.15)
-    for bad in ("94.31,1.839", "a,b,c", "94.31,45,0.15", "94.31,1.839,-0.1", ""):
-        with pytest.raises(SystemExit, match=r"--design = .*R_end in \[10, 1000\] mm"):
+    for bad in ("94.31,1.839", "a,b,c", ""):
+        with pytest.raises(SystemExit, match=r"--design = .*three numbers R_end,theta_f,Delta_bf"):
+            design_argument(["x", "--design", bad])
+    for bad, key in (
+        ("94.31,45,0.15", "flange.layback_angle_deg"),
+        ("94.31,1.839,-0.1", "flange.axial_clearance_mm"),
+    ):
+        with pytest.raises(SystemExit, match=rf"--design = .*{key}: .* is out of range: must be in"):
             design_argument(["x", "--design", bad])
     assert (
         output_name((26,), SEEDS, "corner", (94.31, 1.839, 0.15))
