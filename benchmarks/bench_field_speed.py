@@ -51,7 +51,7 @@ Measured 2026-11-25, fifth session (`--baseline HEAD --repeats 4 --output
 bench_field_speed_slice_power`, results/bench_field_speed_slice_power.json; the working tree's
 diff in results/bench_field_speed_slice_power.diff): the slice power `line_power` rewritten
 exactly with cheaper float64 transcendentals, ln(1 + e) through `log` (Goldberg's ln(u) e/(u - 1))
-and delta_s^(10/9) = delta_s exp(ln(delta_s)/9). Alone it took 11-13 against 19-22 ns a slice;
+and delta_s^(10/9) = delta_s exp(ln(delta_s)/9). Alone it took 11-13 against 19-22 ns a slice (a throwaway probe, not in the repository);
 in the field it made XLA count 1.10x more flops, and the field took 370-387 against 347-360 us
 in 4 alternating pairs (one baseline outlier at 260 us makes the minimum 0.70x), three tangents
 1.00x, the plain solve 0.44-0.52 against 0.34-0.41 s per simulated ms (0.77x). Not landed.
