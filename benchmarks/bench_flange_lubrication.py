@@ -1,5 +1,5 @@
 """Flange traction, dry against mixed (issue 14, item 3): the measured consequence of switching
-`bearing.flange_lubrication` from "dry" (constant mu_f = 0.08, the default: MODEL.md 4.1 and the
+`bearing.flange_lubrication` from "dry" (constant mu_f = 0.08, the default: docs/model.md 5 and the
 paper's setting) to "mixed" (mu = f_a(Lambda) mu_f + (1 - f_a(Lambda)) kappa(|u|), the
 load-sharing law of docs/model.md 5.1) at the reference point, in settled running.
 

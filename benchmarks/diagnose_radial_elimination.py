@@ -1,5 +1,5 @@
 """Would a quasi-static radial equilibrium per roller stop paying for the 62 kHz ringing?
-(issue 12, item 2; MODEL.md 6 names it as one admissible treatment.)
+(issue 12, item 2; docs/model.md 13 names it as one admissible treatment.)
 
 The variant, built here and not in the library: every roller's radial position r_b is slaved
 to its radial force balance instead of being integrated with its radial velocity,

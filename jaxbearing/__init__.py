@@ -86,7 +86,7 @@ from .sweep import (  # noqa: E402
 __version__ = "0.1.0"
 
 __all__ = [
-    # parameters (MODEL.md 2)
+    # parameters (docs/model.md 1)
     "Bearing",
     "Cage",
     "Flange",
@@ -108,11 +108,11 @@ __all__ = [
     "loads_config",
     "reference_config",
     "validate_bearing",
-    # roller-end/flange design zone (MODEL.md 4.1; the paper's Figure 14)
+    # roller-end/flange design zone (docs/model.md 5; the paper's Figure 14)
     "DesignZone",
     "design_zone",
     "design_zone_grid",
-    # roller-raceway contact (MODEL.md 4.2) and the quasi-static start (MODEL.md 5)
+    # roller-raceway contact (docs/model.md 8) and the quasi-static start (docs/model.md 12)
     "QuasiStatic",
     "RacewayContact",
     "quasi_static",

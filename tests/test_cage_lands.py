@@ -1,4 +1,4 @@
-"""Cage on the outer-ring guiding lands (jaxbearing.forces, MODEL.md 4.3).
+"""Cage on the outer-ring guiding lands (jaxbearing.forces, docs/model.md 9).
 
 Oracles: Petroff's concentric torque; Ocvirk's closed-form short-bearing load and attitude
 angle (Hamrock, Schmid & Jacobson, Fundamentals of Fluid Film Lubrication, short-width

@@ -33,7 +33,7 @@ def _module_fields(module) -> dict[str, object]:
 
 
 # -- reference ---------------------------------------------------------------------------------
-#: MODEL.md section 2 (the physics contract), in SI: the reference bearing is written down once,
+#: docs/model.md section 1 (the physics contract), in SI: the reference bearing is written down once,
 #: in the configuration schema; this table is the independent copy it is checked against.
 MODEL_MD_REFERENCE = {
     "pitch_diameter": 85e-3,

@@ -47,7 +47,7 @@ from jaxbearing.contact import (
 E_PRIME = 2.2e11  # Pa
 LOAD = 250.0  # N
 
-# the accuracy the physics contract asks for (MODEL.md section 7: 0.1 % over ratios 1 to 1000);
+# the accuracy the physics contract asks for (docs/validation.md: 0.1 % over ratios 1 to 1000);
 # the implementation reaches ~1e-12, so the tests assert a much tighter bound
 CONTRACT = 1e-3
 TIGHT = 1e-9
@@ -150,7 +150,7 @@ RATIOS = np.concatenate([np.geomspace(1.0, 1000.0, 22), [300.0, 1.001, 1.01]])
 @pytest.mark.parametrize("swap", [False, True])
 def test_exact_against_oracle(swap):
     """Stiffness, semi-axes, p_max and approach equal the exact solution over ratios 1 to 1000
-    (MODEL.md section 7 asks for 0.1 %; the assertion is 1e-9)."""
+    (docs/validation.md asks for 0.1 %; the assertion is 1e-9)."""
     r_short = 2e-3
     worst = 0.0
     for alpha in RATIOS:
@@ -182,7 +182,7 @@ def test_exact_against_oracle(swap):
 
 def test_fit_error_that_motivated_the_switch():
     # Hamrock & Brewe's closed forms with their fitted (k, Ecal, Fcal), written out here, against
-    # the exact law now in point_contact_*: MODEL.md section 7 states the fit is about 12 % too
+    # the exact law now in point_contact_*: docs/validation.md states the fit is about 12 % too
     # stiff at the corner contact's curvature ratio of about 300 (and p_max about 4 % low)
     rx, ry = 0.4e-3, 120e-3
     k, e, f = map(float, _params(rx, ry))

@@ -1,6 +1,6 @@
 """Roller-raceway line contact: ISO/TS 16281 approach, slice law, material scaling, derivatives.
 
-Oracles: ISO/TS 16281's total approach delta = (Q / (35948 L_we^(8/9)))^(9/10) mm (MODEL.md 4.2:
+Oracles: ISO/TS 16281's total approach delta = (Q / (35948 L_we^(8/9)))^(9/10) mm (docs/model.md 8:
 6.308 um for L_we = 10 mm, Q = 1000 N), Palmgren's per-contact 3.84e-5 Q^0.9 / l^0.8 mm, and the
 Hertz sphere-on-plane law for the steel basis of the rolling-bearing constants.
 """
@@ -33,7 +33,7 @@ def _series_approach(load, k_c):
 
 
 def test_iso_total_approach_oracle():
-    # MODEL.md 4.2: 10 mm straight roller, 1000 N, two steel raceways -> 6.308 um
+    # docs/model.md 8: 10 mm straight roller, 1000 N, two steel raceways -> 6.308 um
     k_c = line_contact_stiffness(10e-3, STEEL_E_PRIME)
     np.testing.assert_allclose(_series_approach(1000.0, k_c), 6.308e-6, rtol=1e-3)
     # the same from ISO's formula in N, mm, evaluated independently
@@ -44,7 +44,7 @@ def test_iso_total_approach_oracle():
 
 
 def test_palmgren_is_close_but_different():
-    # Palmgren per contact: 3.84e-5 Q^0.9 / l^0.8 mm -> 6.100 um for both contacts (MODEL.md);
+    # Palmgren per contact: 3.84e-5 Q^0.9 / l^0.8 mm -> 6.100 um for both contacts (docs/model.md);
     # ISO's constant is 3.4 % more compliant at this load and length
     palmgren = 2 * 3.84e-5 * 1000.0**0.9 / 10.0**0.8 * 1e-3
     np.testing.assert_allclose(palmgren, 6.100e-6, rtol=1e-3)
@@ -90,7 +90,7 @@ def test_material_scaling():
 
 @pytest.mark.parametrize("num_slices", [1, 7, 30, 31])
 def test_uniform_slices_carry_the_whole_contact_law(num_slices):
-    # MODEL.md 4.2: q_j = (k_c / N_s) delta^(10/9); uniform interference -> sum = k_c delta^(10/9)
+    # docs/model.md 8: q_j = (k_c / N_s) delta^(10/9); uniform interference -> sum = k_c delta^(10/9)
     k_c = line_contact_stiffness(7.2e-3)
     delta = 2.5e-6
     q = line_slice_loads(jnp.full((num_slices,), delta), k_c, num_slices, W)

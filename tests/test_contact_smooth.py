@@ -2,7 +2,7 @@
 
 Oracles: the softplus closed forms (derivative sigmoid, second derivative sigmoid(1-sigmoid)/eps),
 the Hertz power law K delta^n and its derivatives for delta >> eps, the Euclidean norm, and the
-traction curve's closed-form peak du* = (B - A C)/(B C) (MODEL.md 4.2).
+traction curve's closed-form peak du* = (B - A C)/(B C) (docs/model.md 8).
 """
 
 import math
@@ -159,7 +159,7 @@ _kappa_d = jax.jit(jax.grad(traction_coefficient))
 
 
 def test_traction_curve_defaults():
-    # MODEL.md 4.2: kappa(0) = 0, peak 0.06 at 0.5 m/s, asymptote D = 0.04
+    # docs/model.md 8: kappa(0) = 0, peak 0.06 at 0.5 m/s, asymptote D = 0.04
     a, b, c, d = -0.04, 0.2528, 2.926, 0.04
     assert abs(float(_kappa(0.0, LUB))) < 1e-15
     peak = (b - a * c) / (b * c)  # d kappa / du = 0: B - C (A + B u) = 0

@@ -1,6 +1,6 @@
 """Differentiable design metrics (jaxbearing.run.design_metrics): AD through the diffrax solve against
 central finite differences (the acceptance check of issue 5), the contact-height sensitivities
-against the closed form of MODEL.md 4.1, the static margins against `design_zone`, vmapping over
+against the closed form of docs/model.md 5, the static margins against `design_zone`, vmapping over
 designs, and the one-line input errors.
 
 Cost: one forward compile, one forward-mode Jacobian compile and 13 short solves (0.3 ms of
@@ -76,7 +76,7 @@ def test_horizon_contains_flange_contacts(central_differences):
     pv, h_max, h_min = value
     assert np.all(np.isfinite(value))
     assert pv > 1e6  # a real roller-flange contact occurred within the horizon
-    # the contact sits on the arc, between the relief and the upper limit (MODEL.md 4.1)
+    # the contact sits on the arc, between the relief and the upper limit (docs/model.md 5)
     z = jb.design_zone(REF)
     assert 0.3e-3 < h_min <= h_max < 1.8e-3
     assert h_min == pytest.approx(float(z.contact_height), abs=20e-6)
@@ -105,7 +105,7 @@ def test_forward_mode_matches_central_differences(central_differences, forward_j
 
 
 def test_contact_height_sensitivity_matches_closed_form(forward_jacobian):
-    """An aligned arc-end roller touches at h_c = D/2 - R_end sin(theta_f) (MODEL.md 4.1):
+    """An aligned arc-end roller touches at h_c = D/2 - R_end sin(theta_f) (docs/model.md 5):
     dh/dR_end = -sin(theta_f), dh/dtheta_f = -R_end cos(theta_f), independent of Delta_bf."""
     _, jac = forward_jacobian
     r, t = X0[0], X0[1]

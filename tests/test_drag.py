@@ -1,4 +1,4 @@
-"""Oil-air drag on rollers and churning on the cage (jaxbearing.forces, MODEL.md 4.3).
+"""Oil-air drag on rollers and churning on the cage (jaxbearing.forces, docs/model.md 9).
 
 Oracles written out by hand: the quadratic drag law 1/2 rho C_d A v^2 with White's cylinder
 fit C_d = 1 + 10 Re^(-2/3); the creeping-flow limits of the spin torques (Couette torque
@@ -15,7 +15,7 @@ from jaxbearing import reference_bearing
 from jaxbearing.forces import cage_drag_torque, roller_drag
 
 B = reference_bearing()
-RHO = 0.05 * 960.0  # f_oil rho_oil, from MODEL.md section 2
+RHO = 0.05 * 960.0  # f_oil rho_oil, from docs/model.md section 1
 ETA = 0.05 * 0.055  # f_oil eta_0
 D = float(B.roller.diameter)
 LB1 = float(B.roller.length)

@@ -1,4 +1,4 @@
-"""Whole-bearing dynamics: the MODEL.md section 7 checks that concern the integration.
+"""Whole-bearing dynamics: the docs/validation.md checks that concern the integration.
 
 All runs share one compilation (same structure, `num_saves` and `max_steps`): about 10 s to
 compile, a few seconds per 4 ms of simulated time on 2 cores.
@@ -75,7 +75,7 @@ def test_run_ok_and_cage_speed_between_zero_and_kinematic(reference_run):
     assert 0.0 < s["cage_speed_rpm"] < kin
     assert s["flange_contact_events"] > 0
     assert s["on_arc_fraction"] == 1.0  # the reference arc design keeps contacts on the arc
-    # the default flange traction is MODEL.md 4.1's constant mu_f at every saved contact
+    # the default flange traction is docs/model.md 5's constant mu_f at every saved contact
     mu = np.asarray(res.histories["flange_friction_coefficient"])
     assert mu.shape == np.asarray(res.histories["flange_force"]).shape
     np.testing.assert_array_equal(mu, float(res.bearing.flange_traction))
@@ -99,7 +99,7 @@ def test_contact_height_matches_design_zone(reference_run):
 
 
 def test_slip_trend_with_load(reference_run):
-    """Heavy load: slip near zero; light load at high speed: measurable slip (MODEL.md 7)."""
+    """Heavy load: slip near zero; light load at high speed: measurable slip (docs/validation.md)."""
     _, light = reference_run
     heavy_op = eqx.tree_at(lambda o: o.radial_load, jb.reference_operating_point(), jnp.asarray(30_000.0))
     _, heavy = _run(op=heavy_op)

@@ -1,4 +1,4 @@
-"""Roller end against flange (jaxbearing.flange) against MODEL.md 4.1's analytic oracle,
+"""Roller end against flange (jaxbearing.flange) against docs/model.md 5's analytic oracle,
 hand-written sphere and torus geometry, the sphere-on-plane Hertz closed form, and central
 finite differences."""
 
@@ -63,7 +63,7 @@ def _contact(bearing, side, ring_sign, state):
     return _contact_jit(bearing, f64(side), f64(ring_sign), tuple(f64(x) for x in state[:8]))
 
 
-# -- MODEL.md 4.1 analytic oracle ----------------------------------------------------------
+# -- docs/model.md 5 analytic oracle ----------------------------------------------------------
 
 
 @jax.jit

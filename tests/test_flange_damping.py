@@ -97,7 +97,7 @@ def test_end_on_flange_impact_restitution(v_in):
 def test_roller_surface_speed_is_the_papers_definition():
     """An aligned roller spinning at w about its axis: the paper's sliding speed (Figure 7c) is
     its own surface speed w rho_c at the contact radius, rho_c = R_end sin(theta_f) on the arc
-    and R_ce + R_cor sin(theta_f) on the corner (MODEL.md 4.1), so corner > arc by their ratio;
+    and R_ce + R_cor sin(theta_f) on the corner (docs/model.md 5), so corner > arc by their ratio;
     the material sliding speed, which includes the flange's motion, is reported beside it."""
     b = jb.reference_bearing()
     radius = b.inner_raceway_radius

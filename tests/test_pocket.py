@@ -1,4 +1,4 @@
-"""Roller against its cage pocket (jaxbearing.forces, MODEL.md 4.3).
+"""Roller against its cage pocket (jaxbearing.forces, docs/model.md 9).
 
 Oracles: the ISO/TS 16281 line-contact law written out by hand (N, mm), rigid-body statics
 (action = reaction, moment arms), the direction of Coulomb friction, and the Hunt-Crossley

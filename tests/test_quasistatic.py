@@ -1,4 +1,4 @@
-"""Quasi-static load distribution (MODEL.md 5) against closed forms and finite differences.
+"""Quasi-static load distribution (docs/model.md 12) against closed forms and finite differences.
 
 Oracles: Stribeck's maximum roller load F_r / sum cos(psi)^(n+1) (n = 10/9) and its many-roller
 limit 4.08 F_r / Z written with the Gamma function; force balances of every roller and of the

@@ -1,4 +1,4 @@
-"""Roller-raceway sliced contact (MODEL.md 4.2) against independent oracles.
+"""Roller-raceway sliced contact (docs/model.md 8) against independent oracles.
 
 Oracles: the whole-contact line law Q = k_c a^(10/9) (ISO/TS 16281 via `contact`), an explicit
 circular crown, a brute-force search over each slice disc's rim for the interference of a tilted

@@ -1,4 +1,4 @@
-"""Torque-free symmetric rigid body (MODEL.md 7): precession rate, energy, angular momentum."""
+"""Torque-free symmetric rigid body (docs/validation.md): precession rate, energy, angular momentum."""
 
 import diffrax
 import jax.numpy as jnp

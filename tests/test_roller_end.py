@@ -1,6 +1,6 @@
 """Support function, extreme point and principal curvatures of the roller end body
 (jaxbearing.geometry) against independent oracles: a numerical maximisation over the
-end profile (scipy), the closed forms of MODEL.md 4.1, and the principal radii of curvature as
+end profile (scipy), the closed forms of docs/model.md 5, and the principal radii of curvature as
 eigenvalues of the Hessian of the support function (a convex-geometry identity)."""
 
 import math

@@ -115,7 +115,7 @@ def test_auto_settle_hitting_the_cap_is_not_silent(small_config, capsys):
 @pytest.mark.slow
 def test_halving_the_tolerances_moves_settled_pv_and_slip_less_than_their_intervals():
     """Issue 11 acceptance at a reduced size (11 slices per raceway, a 4-revolution window,
-    seeds 0-2 in two processes, skid start, settle auto), MODEL.md 7: halving the tolerances (rtol
+    seeds 0-2 in two processes, skid start, settle auto), docs/validation.md: halving the tolerances (rtol
     and atol; the default atol is 10 nm, 10 um/s, 0.01 rad/s since the state's scales were chosen
     for it, docs/model.md 13) moves the settled mean PV and the cage slip by less than the 95 % CI
     half-width of their difference, sqrt(h_1^2 + h_2^2) for two independent estimates with

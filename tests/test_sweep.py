@@ -187,7 +187,7 @@ def test_reference_dataset(reference):
     kin = ds["speed_rpm"].values * (1 - 7.5 / 85.0) / 2
     np.testing.assert_allclose(ds["kinematic_cage_speed_rpm"].values, np.stack([kin, kin]), rtol=1e-12)
     assert (np.abs(ds["cage_slip"].values) < 0.05).all()
-    # arc end: h_c = D/2 - R_end sin(theta_f) (MODEL.md 4.1), corner: D/2 - R_ce - R_cor sin
+    # arc end: h_c = D/2 - R_end sin(theta_f) (docs/model.md 5), corner: D/2 - R_ce - R_cor sin
     s = np.sin(np.radians(1.6))
     np.testing.assert_allclose(
         ds["zone_contact_height_m"].sel(end="arc").values, (3.75 - 80 * s) * 1e-3, rtol=1e-9
@@ -318,7 +318,7 @@ def test_plot_draws_every_figure_from_assembled_batches(tmp_path, capsys):
     ds = open_results(tmp_path)
     assert ds["flange_pv_Pa_m_s_max"].dims == spec.dims
     np.testing.assert_array_equal(ds["flange_pv_Pa_m_s_max"].values.ravel(), data["flange_pv_Pa_m_s_max"])
-    # design zone per case: arc contact height D/2 - R_end sin(theta_f) (MODEL.md 4.1)
+    # design zone per case: arc contact height D/2 - R_end sin(theta_f) (docs/model.md 5)
     arc = ds.sel(end="arc", speed_rpm=10000.0, central_length_mm=4.5)
     r, t = np.meshgrid(
         arc["end_radius_mm"].values, np.radians(arc["layback_angle_deg"].values), indexing="ij"

@@ -1,4 +1,4 @@
-"""Design zone (jaxbearing.design_zone) against the closed forms of MODEL.md 4.1, its
+"""Design zone (jaxbearing.design_zone) against the closed forms of docs/model.md 5, its
 gradients against the analytic derivatives and finite differences, the Figure 14 maps on the
 grid arrays, and the `jaxbearing zone` command (output, PNGs, errors)."""
 

@@ -28,7 +28,7 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
-#: the source study's stated values (Machines 2025, 13(11), 993, section 3; MODEL.md 8); its
+#: the source study's stated values (Machines 2025, 13(11), 993, section 3; docs/validation.md); its
 #: sliding velocity is the roller's surface speed at the contact (README, "Two sliding definitions")
 PAPER = (
     ("peak pressure, max", "flange_pressure_Pa", "max", 1e-9, "GPa", "about 4.8", "below 0.2"),

@@ -2,14 +2,14 @@
 
 Pure functions of geometry and loads, broadcasting over leading axes, in SI units, and
 jit/vmap/grad-friendly: every law is smoothed so that values, gradients and Hessians are finite
-at, below and above zero penetration and at zero sliding (MODEL.md section 4).
+at, below and above zero penetration and at zero sliding (docs/model.md section 7.3).
 
 - Point contact, exact Hertz solution (Johnson 1985, sec. 4.2): `effective_modulus`,
   `point_contact_stiffness`, `point_contact_ellipse`, `point_contact_peak_pressure`,
   `point_contact_deflection`, `point_contact_ellipticity`, `point_contact_parameters`,
   `complete_elliptic_integrals`; the Hamrock & Brewe (1983) fit for comparison:
   `hamrock_brewe_parameters`.
-- Line contact (ISO/TS 16281, MODEL.md 4.2): `line_contact_stiffness`, `line_slice_loads`,
+- Line contact (ISO/TS 16281, docs/model.md 8): `line_contact_stiffness`, `line_slice_loads`,
   `line_power` (the slice law's power with a hand-written tangent).
 - Smoothing: `smooth_penetration`, `smooth_power`, `hertz_force`, `safe_norm`,
   `smooth_direction`.

@@ -55,7 +55,7 @@ polynomial in Lambda, so C-infinity for Lambda >= 0. The traction coefficient bl
     mu = f_a mu_b + (1 - f_a) kappa(|u|),
 
 the boundary coefficient mu_b of the dry/boundary contact and the full-film EHL traction curve
-kappa of the lubricant (`traction_coefficient`, MODEL.md 4.2). A Zhou & Hoeprich (1991) type
+kappa of the lubricant (`traction_coefficient`, docs/model.md 8). A Zhou & Hoeprich (1991) type
 load-sharing fit was considered; its coefficients could not be verified from the sources
 available here, so it is not used.
 """
@@ -304,7 +304,7 @@ def mixed_traction_force(
     """Traction of a mixed-lubricated contact F = -Q mu(Lambda, s) u / s [N].
 
     s = sqrt(|u|^2 + u_eps^2), mu = `mixed_traction_coefficient` with the lubricant's traction
-    curve kappa(s) (MODEL.md 4.2) as the full-film part. Opposes the sliding velocity u (last
+    curve kappa(s) (docs/model.md 8) as the full-film part. Opposes the sliding velocity u (last
     axis: components), vanishes smoothly at u = 0 and with the load.
 
     Args:

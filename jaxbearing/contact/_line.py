@@ -1,4 +1,4 @@
-"""Roller-raceway line contact: ISO/TS 16281 stiffness and the sliced load law (MODEL.md 4.2).
+"""Roller-raceway line contact: ISO/TS 16281 stiffness and the sliced load law (docs/model.md 8).
 
 ISO/TS 16281:2008 (sec. 5.2, lamina model) gives the load-approach law of a cylindrical roller
 between two steel raceways as Q = c_L delta_tot^(10/9), c_L = 35948 L_we^(8/9) (N, mm), with
@@ -21,11 +21,11 @@ line-contact formula and the point-contact constant K = 2.15e5 (Sum rho)^(-1/2)
 E* = E / (2 (1 - nu^2)) for this steel, which the tests check). ISO/TS 16281 states its constant
 for bearing steel; its text was not available here, so the same steel is assumed
 (E = 207-210 GPa would change k_c by at most 1.2 %). Other materials scale k_c by
-E'/E'_steel (MODEL.md 4.2), E'_steel = E/(1 - nu^2) = `STEEL_E_PRIME`: the Hertz line-contact
+E'/E'_steel (docs/model.md 8), E'_steel = E/(1 - nu^2) = `STEEL_E_PRIME`: the Hertz line-contact
 approach at given load and length is proportional to 1/E', which the 10/9 law carries as k_c
 proportional to E'.
 
-Slices. MODEL.md 4.2: the effective length is cut into N_s slices; slice j carries
+Slices. docs/model.md 8: the effective length is cut into N_s slices; slice j carries
 q_j = (k_c / N_s) delta_j^(10/9). Dividing the whole-contact coefficient by N_s (rather than
 slicing the length inside the 8/9 power) keeps a uniformly loaded roller equal to the
 whole-contact law, as ISO/TS 16281's lamina stiffness c_L / n_s does.
@@ -106,7 +106,7 @@ def line_contact_stiffness(
     """Stiffness k_c of ONE roller-raceway line contact, Q = k_c delta^(10/9) [N/m^(10/9)].
 
     k_c = 2^(10/9) 35948 L_we^(8/9) (E'/E'_steel) in N, mm, converted to SI (ISO/TS 16281
-    c_L per contact; MODEL.md 4.2). Two such contacts in series reproduce ISO's total approach.
+    c_L per contact; docs/model.md 8). Two such contacts in series reproduce ISO's total approach.
 
     Args:
         effective_length: L_we [m] (the roller's `effective_length`, L_b1 - 2 R_cor).
@@ -128,7 +128,7 @@ def line_slice_loads(
     """Loads of the N_s slices of one line contact: q_j = (k_c / N_s) delta_s,j^(10/9) [N].
 
     delta_s = eps softplus(delta/eps) (`smooth_penetration`), evaluated in log space so that
-    unloaded slices give exactly 0 with finite derivatives (MODEL.md 4.2; ISO/TS 16281 sec. 5.2).
+    unloaded slices give exactly 0 with finite derivatives (docs/model.md 8; ISO/TS 16281 sec. 5.2).
 
     Args:
         interference: slice interferences delta_j [m], last axis of length `num_slices`.

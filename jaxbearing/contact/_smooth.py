@@ -1,7 +1,7 @@
 """Smoothed contact primitives: penetration, Hertz-type power laws, norms and directions.
 
 Every contact law of the model is written through these functions so that the vector field is
-C1 in the state and finite in every derivative (MODEL.md section 4): diffrax evaluates the field
+C1 in the state and finite in every derivative (docs/model.md section 7.3): diffrax evaluates the field
 at unphysical states during step rejection, and forward/reverse-mode AD (including Hessians)
 runs through it.
 
@@ -26,7 +26,7 @@ from jaxtyping import Array, ArrayLike, Float
 PENETRATION_WIDTH = 1e-9
 
 #: Default regularising speed of the sliding direction [m/s]. Below about this sliding speed the
-#: friction force fades linearly to zero instead of switching sign (MODEL.md section 4).
+#: friction force fades linearly to zero instead of switching sign (docs/model.md section 7.3).
 SLIDING_EPS = 1e-3
 
 # Below x = delta/eps = _LOG_SOFTPLUS_SWITCH, log(softplus(x)) is replaced by x: the relative
@@ -128,7 +128,7 @@ def smooth_direction(
 ) -> Float[Array, "*batch dim"]:
     """Regularised unit direction u / sqrt(|u|^2 + u_eps^2) along the last axis.
 
-    The direction of a friction force (MODEL.md section 4): equal to u/|u| up to a relative
+    The direction of a friction force (docs/model.md section 7.3): equal to u/|u| up to a relative
     error u_eps^2 / (2 |u|^2) for |u| >> u_eps, linear u/u_eps near u = 0, and C-infinity
     everywhere for u_eps > 0 (no division by |u|).
     """

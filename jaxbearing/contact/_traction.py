@@ -1,4 +1,4 @@
-"""Traction and friction forces of lubricated and dry contacts (MODEL.md 4.2, 4.1, 4.3).
+"""Traction and friction forces of lubricated and dry contacts (docs/model.md 8, 4.1, 4.3).
 
 The traction coefficient of the roller-raceway contacts follows the lubricant's traction curve
 
@@ -7,7 +7,7 @@ The traction coefficient of the roller-raceway contacts follows the lubricant's 
 with A, B, C, D from `jaxbearing.Lubricant` (`traction_a` ... `traction_d`). For the defaults
 (A = -0.04, B = 0.2528 s/m, C = 2.926 s/m, D = 0.04) kappa(0) = A + D = 0, the peak lies at
 du_max = (B - A C) / (B C) = 0.5 m/s with kappa_max = B/C exp(-C du_max) + D = 0.06, and
-kappa -> D = 0.04 at high sliding (MODEL.md 4.2; the curve is a property of the lubricant and
+kappa -> D = 0.04 at high sliding (docs/model.md 8; the curve is a property of the lubricant and
 its defaults are representative, not measured).
 
 The force opposes the sliding velocity u with the regularised direction of
@@ -29,7 +29,7 @@ from ._smooth import SLIDING_EPS
 def traction_coefficient(
     sliding_speed: Float[ArrayLike, "*batch"], lubricant: Lubricant
 ) -> Float[Array, "*batch"]:
-    """Traction coefficient kappa(du) = (A + B du) exp(-C du) + D (MODEL.md 4.2).
+    """Traction coefficient kappa(du) = (A + B du) exp(-C du) + D (docs/model.md 8).
 
     Args:
         sliding_speed: du >= 0 [m/s], the magnitude of the sliding velocity.
@@ -81,7 +81,7 @@ def friction_force(
     """Regularised Coulomb friction F = -mu Q u / sqrt(|u|^2 + u_eps^2) [N].
 
     For contacts with a constant coefficient: roller end on flange (mu_f = 0.08 in the paper's
-    roller-flange model) and roller on cage pocket (mu_p), MODEL.md 4.1 and 4.3.
+    roller-flange model) and roller on cage pocket (mu_p), docs/model.md 5 and 4.3.
 
     Args:
         sliding_velocity: u [m/s] (last axis: components).

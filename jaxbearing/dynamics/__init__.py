@@ -1,12 +1,12 @@
 """Whole-bearing dynamics: state layout, rigid-body rates, the vector field, the quasi-static start.
 
-- state (MODEL.md 3): `State` of `RollerState` (Z rollers), `CageState`, `RingState` and the
+- state (docs/model.md 2): `State` of `RollerState` (Z rollers), `CageState`, `RingState` and the
   integrated `Accumulators`; `state_scales` / `Scaling` for the scaled integration state;
 - rigid bodies: `axisymmetric_body_rates` (Euler's equations with gyroscopic terms, no small
   angles), `angular_momentum`, `kinetic_energy`;
 - the vector field: `physical_rates(t, state, params)` over every roller, the cage and the inner
   ring, with `contact_loads` (every contact of one state) and the smooth `Functionals`;
-- the start (MODEL.md 5): `quasi_static` (load distribution with centrifugal force) and
+- the start (docs/model.md 12): `quasi_static` (load distribution with centrifugal force) and
   `skid_equilibrium` (the speeds of steady running at those positions, issue 11) with the
   `cage_time_constant` of the cage speed's slow approach to it.
 

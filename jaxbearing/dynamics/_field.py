@@ -1,6 +1,6 @@
 """The vector field of the whole bearing: `vector_field(t, state, params) -> d(state)/dt`.
 
-Bodies (MODEL.md 3): every roller (3-D translation, axis direction, angular velocity), the cage
+Bodies (docs/model.md 2): every roller (3-D translation, axis direction, angular velocity), the cage
 (radial translation, rotation) and the inner ring (radial translation; spin prescribed at
 omega_i, motor driven; optionally axial translation and tilt, docs/model.md "Misalignment").
 The outer ring is fixed.
@@ -79,7 +79,7 @@ HEIGHT_DEVIATION_CLIP = 5e-3
 
 
 class Functionals(eqx.Module):
-    """Parameters of the smooth peak functionals integrated inside the solve (MODEL.md 6)."""
+    """Parameters of the smooth peak functionals integrated inside the solve (docs/model.md 13)."""
 
     pv_reference: float = 1e9  # PV_ref [Pa m/s]
     pv_exponent: float = 8.0  # p of the p-norm over time

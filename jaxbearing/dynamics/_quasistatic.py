@@ -1,4 +1,4 @@
-"""Quasi-static radial load distribution: the initial state of the dynamic run (MODEL.md 5).
+"""Quasi-static radial load distribution: the initial state of the dynamic run (docs/model.md 12).
 
 The source study starts from "the quasi-static model in ref. [30] (pp. 64-75)", Harris' Rolling
 Bearing Analysis; here: the radial load distribution of Harris & Kotzalas (Essential Concepts of
@@ -16,7 +16,7 @@ order in |d|/r_j. The neglected term, |d|^2 sin^2(psi_j)/(2 r_j), is 5e-10 m at 
 loaded rollers of the reference operating point (d = 14 um): the dynamic run starts with inner
 loads up to 0.3 % below these on the flank rollers (crowned rollers are sensitive to it), a
 small start-up transient. The linear kinematics is kept because it is the load-distribution
-theory the Stribeck oracle (MODEL.md 5) is stated in:
+theory the Stribeck oracle (docs/model.md 12) is stated in:
 
     inner approach  a_i,j = R_i + D/2 + d.e_j - r_j
     outer approach  a_o,j = r_j + D/2 - R_o

@@ -1,6 +1,6 @@
 """Quasi-static skid start: the bearing's steady running speeds before the dynamic run (issue 11).
 
-The quasi-static load distribution (`_quasistatic`, MODEL.md 5) starts every body at the
+The quasi-static load distribution (`_quasistatic`, docs/model.md 12) starts every body at the
 kinematic (pure rolling) speeds. Drag, the cage lands and the pockets then slow the cage over
 about 100 ms of simulated time at the reference point. This module solves, at the quasi-static
 roller positions, the skid equilibrium of Harris' high-speed analysis (Harris & Kotzalas,

@@ -1,6 +1,6 @@
 """State of the whole bearing and the frames it is expressed in.
 
-Frames (MODEL.md 3): inertial X along the bearing axis, Z along the radial load and gravity.
+Frames (docs/model.md 2): inertial X along the bearing axis, Z along the radial load and gravity.
 A roller at azimuth theta sits at
 
     p = x X + r e_rad(theta),  e_rad(theta) = (0, -sin theta, cos theta),
@@ -16,7 +16,7 @@ assumption for skew or tilt.
 The integrator sees a *scaled deviation* of this state (`ScaledState`): every component is
 measured from a nominal value (azimuths from the kinematic orbit theta_0 + omega_c t) in units of
 a physically meaningful scale (1 um, 1 urad of arc at the pitch radius, 1 mm/s ...), so that
-diffrax's rtol and atol mean the same thing for every component (MODEL.md 6).
+diffrax's rtol and atol mean the same thing for every component (docs/model.md 13).
 """
 
 from __future__ import annotations
@@ -104,7 +104,7 @@ class RingState(eqx.Module):
 
 
 class Accumulators(eqx.Module):
-    """Smooth functionals integrated inside the solve (MODEL.md 6), per roller and flange.
+    """Smooth functionals integrated inside the solve (docs/model.md 13), per roller and flange.
 
     pv_power:        int w(Q) (PV / PV_ref)^p dt              -> smooth peak PV (p-norm over time)
     height_max_power: int w(Q) exp(+beta (h_c - h_ref)) dt   -> smooth max contact height
@@ -137,7 +137,7 @@ def state_scales(num_rollers: int, pitch_radius: float) -> State:
 
     The integrator's tolerances apply to the scaled deviation state (docs/model.md 13), so the
     scales decide what the absolute tolerance means. They are chosen so that the paper's
-    atol = 1e-6 (MODEL.md 6) is 1e-6 of `SCALED_UNITS`: 10 nm in length (and of arc at the
+    atol = 1e-6 (docs/model.md 13) is 1e-6 of `SCALED_UNITS`: 10 nm in length (and of arc at the
     pitch radius for orbital angles and the inner ring's tilt), 10 um/s in linear velocity (and
     at the pitch radius for orbital and cage rates), 0.01 rad/s in angular velocity, 1e-8 in
     the axis components. That is two orders of magnitude below the micrometre deflections of

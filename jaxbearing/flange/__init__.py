@@ -1,4 +1,4 @@
-"""The roller-end/flange model (MODEL.md 4.1; the source paper's subject), in one place.
+"""The roller-end/flange model (docs/model.md 5; the source paper's subject), in one place.
 
 - flange face and end pose: `flange_geometry` (tangent plane of the flange cone at the roller's
   azimuth, extreme point of the end body, interference, contact height, principal radii);

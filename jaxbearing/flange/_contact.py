@@ -1,4 +1,4 @@
-"""Roller end against ring flange: contact geometry, kinematics, Hertz force, PV (MODEL.md 4.1).
+"""Roller end against ring flange: contact geometry, kinematics, Hertz force, PV (docs/model.md 5).
 
 One function, `roller_flange_contact`, handles one roller against one flange for every kind of
 roller end: flat ends with corner radii (R_end = inf), arc (spherical) ends, and the switch from
@@ -29,7 +29,7 @@ z = +rho.
 
 Contact height (`contact_height`) is the height of the contact point above the raceway surface,
 measured radially in the flange's tangent plane: g ((C - c_r) . e_rad - R_r). For an aligned
-roller it is exactly D/2 - rho (MODEL.md 4.1 oracle); the slant distance along the flange face,
+roller it is exactly D/2 - rho (docs/model.md 5 oracle); the slant distance along the flange face,
 (C - P0) . t, differs from it by the factor cos(theta_f) (4e-4 at 1.6 deg).
 
 Smoothness. The support function is C1 in the pose, so the interference and the normal force
@@ -120,7 +120,7 @@ def roller_flange_contact(
     ring_axis: Vec3 | None = None,
     damping: ArrayLike = HUNT_CROSSLEY_ALPHA,
 ) -> FlangeContact:
-    """Contact of one roller end with one ring flange (MODEL.md 4.1; the caller vmaps).
+    """Contact of one roller end with one ring flange (docs/model.md 5; the caller vmaps).
 
     Interference delta = h(n) - (P0 - p) . n with h the support function of the end body
     (`jaxbearing._roller_end.end_support`); contact point C = its extreme point.

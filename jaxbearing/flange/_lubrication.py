@@ -44,7 +44,7 @@ and h_c are reported in both friction modes; Lambda = h_min / sigma with the com
 roughness sigma of end and flange (`Flange.roughness`).
 
 Friction coefficient. `Bearing.flange_lubrication == "dry"`: the constant mu_f
-(`Bearing.flange_traction`, the source paper, MODEL.md 4.1). "mixed": the load-sharing blend
+(`Bearing.flange_traction`, the source paper, docs/model.md 5). "mixed": the load-sharing blend
 mu = f_a(Lambda) mu_f + (1 - f_a(Lambda)) kappa(s), s = sqrt(|u|^2 + u_eps^2), of the boundary
 coefficient mu_f and the lubricant's full-film traction curve kappa (`mixed_traction_coefficient`),
 C-infinity in Lambda and s: mu -> mu_f as Lambda -> 0 and -> kappa(s) for Lambda >> 1 (f_a = 1/82

@@ -4,7 +4,7 @@ For an aligned roller in pure rolling (no skew, no tilt) the flange contact geom
 the design only: the arc end (radius R_end) touches a flange laid back by theta_f at the radius
 rho_c = R_end sin(theta_f) from the roller axis, i.e. at the contact height h_c = D/2 - rho_c
 above the raceway, as long as rho_c stays inside the limited circle rho_lim; beyond it the corner
-touches at rho_c = R_ce + R_cor sin(theta_f) (MODEL.md 4.1). A design is feasible when
+touches at rho_c = R_ce + R_cor sin(theta_f) (docs/model.md 5). A design is feasible when
 
 - the contact stays below the upper contact-height limit: h_up - h_c > 0;
 - the edge of the contact ellipse stays above the flange base relief (undercut) at the given
@@ -13,7 +13,7 @@ touches at rho_c = R_ce + R_cor sin(theta_f) (MODEL.md 4.1). A design is feasibl
 - the actual axial clearance Lambda_bf = Delta_bf - 2 e cos(theta_f) stays positive (or above a
   required minimum): the arc apex of each end protrudes e = R_end - R_cor
   - sqrt((R_end - R_cor)^2 - R_ce^2) beyond the flat end plane (paper Eq. 24), e cos(theta_f)
-  measured along the flange normal, once on each side (MODEL.md 4.1). This is the paper's
+  measured along the flange normal, once on each side (docs/model.md 5). This is the paper's
   conservative criterion: the true gap along the normals of an aligned, centred roller seated on
   the raceway (`seated_gap`) is larger, because the laid-back flange opens away from the roller
   above the raceway edge.

@@ -1,4 +1,4 @@
-"""Body-pair contacts and loads, one module per pair (MODEL.md 4.2-4.5).
+"""Body-pair contacts and loads, one module per pair (docs/model.md 8-4.5).
 
 - roller against raceway (`raceway_contact`, sliced line contact with crown, Hunt-Crossley
   damping and lubricant traction; `RacewayContact`);

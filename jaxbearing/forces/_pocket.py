@@ -1,4 +1,4 @@
-"""Roller against its cage pocket: sliced line contact with two planar walls (MODEL.md 4.3).
+"""Roller against its cage pocket: sliced line contact with two planar walls (docs/model.md 9).
 
 Pocket geometry. Pocket j of a cage with centre c_c and angle theta_c has its centre
 c_p = c_c + (d_m/2) e_rad(theta_c + 2 pi j / Z) and the cage's tangential unit t_c at that azimuth
@@ -25,7 +25,7 @@ sqrt(1 - (e . t_c)^2). Forces act at the middle of the overlap, x_k - (delta_k/2
 Load per slice: q_k = (k_c / N_p) softplus_w(delta_k)^(10/9) (`contact.line_slice_loads`),
 where k_c = `contact.line_contact_stiffness`(L_we, E'(roller, cage)) is the ISO/TS 16281
 stiffness of one whole roller-on-plane line contact scaled to the roller/cage materials, so a
-uniformly loaded roller follows Q = k_c delta^(10/9) (MODEL.md 4.2). (A flat wall is less
+uniformly loaded roller follows Q = k_c delta^(10/9) (docs/model.md 8). (A flat wall is less
 conformal than a raceway; ISO/TS 16281's formula, like Palmgren's, ignores the curvature sum of
 line contacts, so the same law applies.)
 

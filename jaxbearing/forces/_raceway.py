@@ -1,4 +1,4 @@
-"""Roller against raceway: sliced line contact with crown, damping and traction (MODEL.md 4.2).
+"""Roller against raceway: sliced line contact with crown, damping and traction (docs/model.md 8).
 
 The effective length L_we = L_b1 - 2 R_cor of the roller generatrix is cut into N_s slices of
 width L_we/N_s centred at
@@ -44,7 +44,7 @@ differs from a brute-force search over the disc's rim by 2e-12 m (4e-9 m at an e
 100/50 mrad), far below the penetration width of 1e-9 m at any physical attitude (the tests
 check the rim search at up to 10 mrad).
 
-Load per slice (MODEL.md 4.2): q_j = (k_c/N_s) softplus_w(delta_j)^(10/9), with k_c the
+Load per slice (docs/model.md 8): q_j = (k_c/N_s) softplus_w(delta_j)^(10/9), with k_c the
 ISO/TS 16281 stiffness of one whole roller-raceway line contact (`contact.line_contact_stiffness`),
 so that a uniformly loaded roller follows the whole-contact law exactly.
 
@@ -63,7 +63,7 @@ e = 1 - alpha v); the default 0.3 s/m sits at the top of the range because the o
 lubricated contact damps more than a dry one. At the reference operating point it gives the
 most loaded roller's radial contact vibration a damping ratio of about 0.1.
 
-Traction (MODEL.md 4.2): the sliding velocity of slice j is the tangential part of
+Traction (docs/model.md 8): the sliding velocity of slice j is the tangential part of
 v_rel = (v_b + w_b x (x_j - p)) - (v_r + w_r x (x_j - c_r)) at the contact point x_j, and the
 traction on the roller is -N_j kappa(|u|) u/|u| (`contact.traction_force`, direction smoothed
 by SLIDING_EPS), with the lubricant traction curve kappa of `Lubricant`.
@@ -143,7 +143,7 @@ def crown_drop(roller: Roller, xi: ArrayLike) -> Array:
 
 def raceway_stiffness(bearing: Bearing) -> Array:
     """k_c of one roller-raceway line contact, Q = k_c delta^(10/9) [N/m^(10/9)] (ISO/TS 16281,
-    MODEL.md 4.2), for the effective length L_we and E' of the ring and roller materials."""
+    docs/model.md 8), for the effective length L_we and E' of the ring and roller materials."""
     rm, bm = bearing.ring_material, bearing.roller_material
     e_prime = effective_modulus(rm.elastic_modulus, rm.poisson_ratio, bm.elastic_modulus, bm.poisson_ratio)
     return line_contact_stiffness(bearing.roller.effective_length, e_prime)
@@ -152,7 +152,7 @@ def raceway_stiffness(bearing: Bearing) -> Array:
 def slice_loads_from_interference(
     bearing: Bearing, interference: Float[Array, "... N_s"], width: float = PENETRATION_WIDTH
 ) -> Float[Array, "... N_s"]:
-    """q_j = (k_c/N_s) softplus_w(delta_j)^(10/9): elastic slice loads [N] (MODEL.md 4.2).
+    """q_j = (k_c/N_s) softplus_w(delta_j)^(10/9): elastic slice loads [N] (docs/model.md 8).
 
     The one slice law shared by the dynamic contact and the quasi-static solution.
     """

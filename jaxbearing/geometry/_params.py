@@ -104,7 +104,7 @@ class Material(eqx.Module):
 class Lubricant(eqx.Module):
     """Lubricant, oil-air mixture in the cavity, and the traction curve of rolling contacts.
 
-    Traction curve (MODEL.md 4.2): kappa(du) = (A + B du) exp(-C du) + D, with kappa(0) = A + D.
+    Traction curve (docs/model.md 8): kappa(du) = (A + B du) exp(-C du) + D, with kappa(0) = A + D.
     Viscosity at the flange inlet: eta_0 exp(-beta_T (T_in - T_0)) (`contact.viscosity_at_temperature`).
     """
 

@@ -16,7 +16,7 @@ its meaning, symbol and valid range. The schema and the ranges are `jaxbearing.i
                          inner_ring_axial_freedom, inner_ring_tilt_freedom
     [simulation]         end, duration_ms, rtol, atol, max_steps, progress, solver
 
-Missing keys take the reference value (docs/MODEL.md section 2); unknown keys and sections are
+Missing keys take the reference value (docs/model.md section 1); unknown keys and sections are
 errors with a "did you mean ...?" suggestion; wrong types and out-of-range values are errors
 naming the key, the value with its unit and the valid range (`jaxbearing.ConfigError`).
 
@@ -49,7 +49,7 @@ from ._validation import check_values, coerce
 _HEADER = """\
 # jaxbearing configuration. Engineering units: the unit is part of every key's name.
 # Keys left out take the reference value: a representative aero-engine mainshaft cylindrical
-# roller bearing (docs/MODEL.md section 2), not the source paper's Table 1.
+# roller bearing (docs/model.md section 1), not the source paper's Table 1.
 """
 
 
@@ -386,7 +386,7 @@ def reference_config() -> Config:
 
 
 def reference_bearing() -> Bearing:
-    """The embedded reference bearing of MODEL.md section 2, built from the reference values of
+    """The embedded reference bearing of docs/model.md section 1, built from the reference values of
     the configuration schema (the one place they are written down, `io/_schema.py`).
 
     Representative, not the source study's bearing: the paper's Table 1 is not available. The

@@ -14,7 +14,7 @@ value with its unit and the valid range, e.g.
 
     roller.corner_radius_mm: 4.0 mm is out of range: must be in (0, diameter_mm/2 = 3.75) mm
 
-Schema (ranges; "(" open, "[" closed; symbols as in docs/MODEL.md and the source paper):
+Schema (ranges; "(" open, "[" closed; symbols as in docs/model.md and the source paper):
 
 | key | symbol | valid range |
 |---|---|---|
@@ -101,7 +101,7 @@ def _rollers_fit(v) -> str | None:
 
 
 def _odd_slices(v) -> str | None:
-    """MODEL.md 4.2: an odd slice count puts a slice at the roller centre (symmetric slicing)."""
+    """docs/model.md 8: an odd slice count puts a slice at the roller centre (symmetric slicing)."""
     n = v["bearing.num_slices"]
     return None if n % 2 == 1 else f"{n} is even: the slice count must be odd (a slice at the roller centre)"
 

@@ -97,7 +97,7 @@ STARTS = ("skid", "quasi-static")
 
 
 def initial_state(bearing: Bearing, op: OperatingPoint, perturbation: Perturbation | None) -> State:
-    """Quasi-static solution (MODEL.md 5) as the initial state of the dynamic run."""
+    """Quasi-static solution (docs/model.md 12) as the initial state of the dynamic run."""
     qs = quasi_static(bearing, op)
     z = bearing.num_rollers
     omega_c = kinematic_cage_speed(bearing, op)

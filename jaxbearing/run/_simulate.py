@@ -1,4 +1,4 @@
-"""Integration of the whole-bearing dynamics with diffrax (MODEL.md 6).
+"""Integration of the whole-bearing dynamics with diffrax (docs/model.md 13).
 
 * Initial state from the quasi-static solution (`_quasistatic`), plus an optional seeded
   perturbation of the rollers' axial positions and skew (a perfectly symmetric bearing never

@@ -7,7 +7,7 @@ Objective. The smooth mean flange PV over contact time of settled running,
 
 summed over every roller-end/flange contact c, over the window of each sample k (seeds and
 revolutions), with the smooth contact indicator w(Q) = Q / (Q + Q_0), Q_0 = `CONTACT_LOAD`
-(`STEADY_FUNCTIONALS`: the accumulators of MODEL.md 6 with p = 1). It is the time average that
+(`STEADY_FUNCTIONALS`: the accumulators of docs/model.md 13 with p = 1). It is the time average that
 flange wear integrates, weighted by contact time: a ratio estimator, so windows with more contact
 count more.
 
