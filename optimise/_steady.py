@@ -12,7 +12,7 @@ through (every seed's state at the start of its window and at its end: 2 x seeds
 invariant measure), plain trajectories of `gradient_window` seconds; at every saved state the
 flange PV is differentiated in the design at the loads the dynamics gave, through the ratio
 estimator. "window": the short-window forward-mode sensitivities of
-`jaxbearing.run.steady_gradient` over `gradient_window` seconds. benchmarks/bench_steady_gradient
+`jaxbearing.run.steady_gradient` over `gradient_window` seconds. benchmarks/studies/bench_steady_gradient
 measures both against common-random-number central differences (README, Design on steady
 running).
 

@@ -13,7 +13,8 @@ from pathlib import Path
 import pytest
 
 BENCH_DIR = Path(__file__).resolve().parents[1] / "benchmarks"
-sys.path.insert(0, str(BENCH_DIR))
+STUDIES_DIR = BENCH_DIR / "studies"
+sys.path[:0] = [str(BENCH_DIR), str(STUDIES_DIR)]
 
 import _common  # noqa: E402
 import run_all  # noqa: E402
@@ -33,6 +34,50 @@ def test_module_imports_and_has_main(name):
     assert "quick" in params, f"{name}.main must take `quick`"
     if hasattr(module, "self_check"):
         module.self_check()
+
+
+@pytest.mark.parametrize("name", sorted(p.stem for p in STUDIES_DIR.glob("*.py")))
+def test_study_imports_and_has_main(name):
+    """The one-off studies under benchmarks/studies/ stay importable (their helpers come from
+    benchmarks/)."""
+    module = run_all.load(name, STUDIES_DIR)
+    assert callable(getattr(module, "main", None)), f"studies/{name}.py must define main"
+
+
+def test_benchmarks_top_level_holds_only_maintained_scripts():
+    """At most 12 scripts at benchmarks/' top level: the runner, its helpers, every `bench_*` of
+    `make bench`, and any other script documented in benchmarks/README.md as maintained."""
+    scripts = sorted(p.name for p in BENCH_DIR.glob("*.py"))
+    assert len(scripts) <= 12, scripts
+    readme = (BENCH_DIR / "README.md").read_text()
+    for name in scripts:
+        if name in ("run_all.py", "_common.py") or name[:-3] in NAMES:
+            continue
+        assert f"`{name}`" in readme, f"{name}: neither in make bench nor documented as maintained"
+    index = (STUDIES_DIR / "README.md").read_text()
+    for p in STUDIES_DIR.glob("*.py"):
+        assert f"`{p.name}`" in index, f"studies/{p.name} is missing from benchmarks/studies/README.md"
+
+
+def test_every_results_file_has_the_script_that_writes_it():
+    """benchmarks/results/ holds results only (no patches), each named after the script that
+    writes it, or listed with its command in benchmarks/README.md's results table."""
+    readme = (BENCH_DIR / "README.md").read_text()
+    scripts = [p.stem for d in (BENCH_DIR, STUDIES_DIR) for p in d.glob("*.py")]
+    writers = {
+        "throughput": "bench_throughput",
+        "gradients": "bench_gradients",
+        "optimise_vs_grid": "bench_optimise_grid",
+    }
+    for path in sorted((BENCH_DIR / "results").iterdir()):
+        assert path.suffix == ".json", f"{path.name}: not a results file"
+        stem = path.stem
+        named = any(stem == s or stem.startswith(s + "_") for s in scripts) or stem in writers
+        if stem.startswith("accelerator_"):
+            named = "accelerator_throughput" in scripts
+        assert named or f"`{path.name}`" in readme, f"{path.name}: no script writes it"
+    for stem, script in writers.items():
+        assert script in scripts
 
 
 def test_write_json_is_strict_json_with_machine_info(tmp_path):

@@ -1,7 +1,7 @@
 """Misalignment study at reduced size, on settled running (slow: 468 s on the shared 2-core
 machine under a load average of 6-10, `pytest -m slow -k skew`).
 
-benchmarks/bench_misalignment.py's `study` with its QUICK settings: misalignment 0, 1, 2 mrad at
+benchmarks/studies/bench_misalignment.py's `study` with its QUICK settings: misalignment 0, 1, 2 mrad at
 the reference point, each settled (`settle="auto"` from the skid start, docs/model.md 16), then a
 window of 2 cage revolutions, one seed. Asserted: every run settled (no cap hit), and the mean
 roller skew and the mean total flange load increase with misalignment (means). Whether each step
@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+sys.path[:0] = [str(Path(__file__).resolve().parents[1] / "benchmarks" / d) for d in ("studies", ".")]
 
 
 @pytest.mark.slow

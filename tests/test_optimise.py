@@ -5,7 +5,7 @@ and bounds that exclude the design zone, and the `optimise run` command line.
 The search and the grid share one small problem (reference bearing at 20,000 rpm and 1000 N,
 Delta_bf fixed at 0.2 mm, R_end x theta_f over the default bounds, 0.3 ms per evaluation), so
 every model evaluation reuses one compilation. The grid here is 5 x 5; the full >= 15 x 15
-comparison is benchmarks/bench_optimise_grid.py (benchmarks/results/optimise_vs_grid.json)."""
+comparison is benchmarks/studies/bench_optimise_grid.py (benchmarks/results/optimise_vs_grid.json)."""
 
 import json
 import math

@@ -4,7 +4,7 @@ Fast checks at a reduced size (11 slices per raceway): the ratio estimator's der
 its jackknife against closed forms, and the forward-mode short-window sensitivities against
 central differences of the same window integrals from the same settled-running states (common
 random numbers: the estimator differentiates exactly this). The bias of the estimator against
-the derivative of the settled mean is measured in benchmarks/bench_steady_gradient.py."""
+the derivative of the settled mean is measured in benchmarks/studies/bench_steady_gradient.py."""
 
 import dataclasses
 
@@ -175,7 +175,7 @@ def test_frozen_load_derivative_matches_central_differences(running):
 
 @pytest.mark.slow
 def test_frozen_load_estimator_agrees_with_crn_differences_on_settled_running():
-    """The acceptance check of benchmarks/bench_steady_gradient.py at reduced size (11 slices,
+    """The acceptance check of benchmarks/studies/bench_steady_gradient.py at reduced size (11 slices,
     3 seeds, theta_f at the reference design): running from the skid start (which lands on the
     plateau, tests/test_skid.py), then a common-random-number central difference of the ensemble
     objective (both designs continue from the same states and measure two cage revolutions at
@@ -186,14 +186,14 @@ def test_frozen_load_estimator_agrees_with_crn_differences_on_settled_running():
     change, i.e. none to speak of. (The comments used to say 5 ms and half a revolution, and the
     values were seconds passed as ms.) With 5 ms and half a revolution, 3 seeds give
     -4.6e10 +- 6.8e10, not significant: the pair decorrelates over the extra half revolution, so
-    the study needs benchmarks/bench_steady_gradient.py's 8 seeds and one revolution.
+    the study needs benchmarks/studies/bench_steady_gradient.py's 8 seeds and one revolution.
 
     Slow (`make test-slow`; 126-160 s alone, about 3 min of a cold suite). Measured: CRN FD
     -1.737e11 +- 6.4e10 (2.7 standard errors), frozen load -9.69e10 per rad; with 3.53 us
     after the change (the old rev / 2 s passed as ms) -1.358e11 +- 3.9e10. A check this close to
     its significance bound is fragile: 3 seeds are few. The default
     suite keeps the estimator's derivative against finite differences of the same functional
-    (above); the full-size study is benchmarks/bench_steady_gradient.py."""
+    (above); the full-size study is benchmarks/studies/bench_steady_gradient.py."""
     from jaxbearing.run import frozen_load_gradient, steady_design_metrics
 
     b = dataclasses.replace(jb.reference_bearing(), num_slices=11)

@@ -14,7 +14,7 @@ count more.
 Why not the derivative of one long trajectory. Roller-flange impacts make the tangent dynamics
 grow: a design perturbation moves impact times, and the tangent of the state grows like
 exp(lambda t) with a finite-time Lyapunov exponent lambda of the order of 1e3-1e4 1/s here
-(`tangent_growth`, measured in benchmarks/bench_steady_gradient.py). The derivative of a long
+(`tangent_growth`, measured in benchmarks/studies/bench_steady_gradient.py). The derivative of a long
 window average is then dominated by a few impacts and its variance grows like exp(2 lambda T)
 (Lea, Allen & Haine 2000, "Sensitivity analysis of the climate of a chaotic system", Tellus
 52A: 523, the same failure for the Lorenz system); the design trend is in the ensemble average.
@@ -31,7 +31,7 @@ Its standard error is the jackknife over the K samples (Efron & Stein 1981). The
 neglects the slow part of the response (how the distribution of settled states moves with the
 design, e.g. the cage speed or the skew amplitude): its bias against the derivative of the
 settled mean is measured against common-random-number central differences of settled runs
-in benchmarks/bench_steady_gradient.py, with the window length T and ensemble size K it
+in benchmarks/studies/bench_steady_gradient.py, with the window length T and ensemble size K it
 was measured at (README, Design on steady running).
 """
 
@@ -61,7 +61,7 @@ from ._simulate import _diffeqsolve
 CONTACT_LOAD = 1.0
 #: the accumulators of the steady objective: p = 1 (the time integral of PV over contact)
 STEADY_FUNCTIONALS = Functionals(pv_exponent=1.0, contact_load=CONTACT_LOAD)
-#: default window of the short-window sensitivities [s] (benchmarks/bench_steady_gradient.py)
+#: default window of the short-window sensitivities [s] (benchmarks/studies/bench_steady_gradient.py)
 GRADIENT_WINDOW = 1.0e-3
 
 

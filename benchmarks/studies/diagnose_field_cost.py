@@ -19,7 +19,7 @@ Programs, on the reference bearing at 20,000 rpm and 1000 N, at the seeded quasi
 The ratio (value + 3 tangents) / value of the field's operations bounds what forward mode can
 cost relative to one solve, since the Runge-Kutta stages carry the tangents linearly.
 
-    python benchmarks/diagnose_field_cost.py
+    python benchmarks/studies/diagnose_field_cost.py
 """
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path[:0] = [str(Path(__file__).resolve().parent), str(Path(__file__).resolve().parents[1])]
 
 import _common  # noqa: E402
 

@@ -28,7 +28,7 @@ import sys
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path[:0] = [str(Path(__file__).resolve().parent), str(Path(__file__).resolve().parents[1])]
 
 import _common  # noqa: E402
 
@@ -180,7 +180,7 @@ def main(quick: bool = False) -> dict:
     out = study(**cfg, log=_common.log)
     result = {
         "quick": quick,
-        "command": "python benchmarks/bench_misalignment.py" + (" --quick" if quick else ""),
+        "command": "python benchmarks/studies/bench_misalignment.py" + (" --quick" if quick else ""),
         "operating_point": "reference: arc end, 20000 rpm, 1000 N radial, gravity on; inner ring held axially and in tilt",
         "misalignment_axis": "inner-ring tilt about +Y (perpendicular to the radial load along +Z)",
         "settling": "settle='auto' from the skid start (projective steps), tolerance 1e-3, cap 300 ms",

@@ -17,7 +17,7 @@ sampled PV > `VIOLENT` x the norm's median), and the smallest and largest smooth
 the other runs against the median: an error norm that does not resolve the impacts shows as a
 spread (or a bias) there, beyond the max norm's.
 
-    python benchmarks/diagnose_error_norms.py    (about 5 min; results/diagnose_error_norms.json)
+    python benchmarks/studies/diagnose_error_norms.py    (about 5 min; results/diagnose_error_norms.json)
 
 The rows' "default" labels are those of the day they were measured. `diagnose_peak_spread.py`
 (2026-11-25, third session) holds the accuracy and changes only the step sequence, and finds the
@@ -30,7 +30,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path[:0] = [str(Path(__file__).resolve().parent), str(Path(__file__).resolve().parents[1])]
 
 import _common  # noqa: E402
 

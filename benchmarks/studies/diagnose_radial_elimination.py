@@ -27,7 +27,7 @@ radial coordinates loosened as in `solve`):
 * the four settled flange statistics against the stored tight reference of
   `bench_work_precision_settled` (paired over seeds, the same agreement test).
 
-    python benchmarks/diagnose_radial_elimination.py [--quick]
+    python benchmarks/studies/diagnose_radial_elimination.py [--quick]
 """
 
 from __future__ import annotations
@@ -37,7 +37,7 @@ import sys
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path[:0] = [str(Path(__file__).resolve().parent), str(Path(__file__).resolve().parents[1])]
 
 import _common  # noqa: E402
 

@@ -10,7 +10,7 @@ against the tight setting's (the last of `SETTINGS`) is its bias. A run whose sm
 more than `VIOLENT` times the tight median holds an impact the tight runs never show (a roller
 corner on the flange: the largest sampled PV with on_arc = 0).
 
-    python benchmarks/diagnose_peak_spread.py    (about 3 min; results/diagnose_peak_spread.json)
+    python benchmarks/studies/diagnose_peak_spread.py    (about 3 min; results/diagnose_peak_spread.json)
 
 The first setting is `solve`'s since 2026-11-25 (third session), chosen by this study; the third
 was every solve's before and stays that of settled windows (`prepare_from`; docs/performance.md).
@@ -22,7 +22,7 @@ import sys
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path[:0] = [str(Path(__file__).resolve().parent), str(Path(__file__).resolve().parents[1])]
 
 import _common  # noqa: E402
 

@@ -29,7 +29,7 @@ tangent (what a tangent of each law costs against its value), and single element
 26 rollers x 31 slices x 2) inside a compiled loop: the unit costs of XLA CPU's exp, log, log1p,
 pow, sqrt, tanh, division and a multiply-add on this machine.
 
-    python benchmarks/diagnose_field_bound.py [--rounds N] [--no-tangents]
+    python benchmarks/studies/diagnose_field_bound.py [--rounds N] [--no-tangents]
 
 Results: results/diagnose_field_bound.json.
 
@@ -60,7 +60,7 @@ import sys
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path[:0] = [str(Path(__file__).resolve().parent), str(Path(__file__).resolve().parents[1])]
 
 import _common  # noqa: E402
 from bench_field_speed import EVALS, reference_field  # noqa: E402  (the same field and loop)

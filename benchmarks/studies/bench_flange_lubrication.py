@@ -25,7 +25,7 @@ import sys
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path[:0] = [str(Path(__file__).resolve().parent), str(Path(__file__).resolve().parents[1])]
 
 import _common  # noqa: E402
 
@@ -157,7 +157,7 @@ def main(quick: bool = False) -> dict:
                 repro[end] = reproduction(dry, end)
     result = {
         "quick": quick,
-        "command": "python benchmarks/bench_flange_lubrication.py" + (" --quick" if quick else ""),
+        "command": "python benchmarks/studies/bench_flange_lubrication.py" + (" --quick" if quick else ""),
         "equivalent_cli": (
             "jaxbearing simulate --settle auto --seeds 4 --workers 2 --end both, once with the default "
             'configuration and once with [bearing] flange_lubrication = "mixed"'

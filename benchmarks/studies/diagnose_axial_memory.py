@@ -23,7 +23,7 @@ windows of the design objective. This measures it on settled running at that des
 Compared with the objective's window (2 revolutions): tau_int much longer than a window means a
 window average depends on where the window starts, i.e. on the start-up history.
 
-    python benchmarks/diagnose_axial_memory.py      # about 3-5 minutes on 2 cores
+    python benchmarks/studies/diagnose_axial_memory.py      # about 3-5 minutes on 2 cores
 
 Not a `bench_*` (not in `make bench`); writes benchmarks/results/diagnose_axial_memory.json.
 """
@@ -38,7 +38,10 @@ import time
 
 import numpy as np
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+sys.path[:0] = [
+    str(pathlib.Path(__file__).resolve().parent),
+    str(pathlib.Path(__file__).resolve().parents[1]),
+]
 import _common  # noqa: E402
 
 NAME = "diagnose_axial_memory"
@@ -46,7 +49,7 @@ MM, DEG = 1e-3, math.pi / 180
 DESIGN = (100 * MM, 1.4 * DEG, 0.15 * MM)  # bench_steady_gradient's "R100_t1.4"
 WINDOW_REVS = 12
 SEEDS = 4
-KEPT = pathlib.Path(__file__).resolve().parents[1] / "out" / "bench_steady_gradient"
+KEPT = pathlib.Path(__file__).resolve().parents[2] / "out" / "bench_steady_gradient"
 STOP_BAND = 5e-6  # [m] a roller within this of its extreme |x| rests against a flange
 
 

@@ -12,7 +12,7 @@ equal. Throughput = cases / wall; target: workers=2 >= 1.5x workers=1. Also time
 quasi-static start of one case alone and per case inside a vmap of 8 (`quasi_static_start_cost`),
 against a case's share of the sweep's wall time: what moving it out of the vmap could save.
 
-    python benchmarks/bench_sweep_workers.py [--quick]
+    python benchmarks/studies/bench_sweep_workers.py [--quick]
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ import tempfile
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path[:0] = [str(Path(__file__).resolve().parent), str(Path(__file__).resolve().parents[1])]
 
 import _common  # noqa: E402
 

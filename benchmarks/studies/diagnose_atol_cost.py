@@ -19,7 +19,7 @@ measuring the gradient ratio (issue 12).
    `quasi_static` put an optimization barrier on the bearing (2026-11-25: XLA specialised its
    Newton loops on the closed-over constants).
 
-    python benchmarks/diagnose_atol_cost.py      (about 4 min; results/diagnose_atol_cost.json)
+    python benchmarks/studies/diagnose_atol_cost.py      (about 4 min; results/diagnose_atol_cost.json)
 """
 
 from __future__ import annotations
@@ -29,7 +29,7 @@ import sys
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path[:0] = [str(Path(__file__).resolve().parent), str(Path(__file__).resolve().parents[1])]
 
 import _common  # noqa: E402
 

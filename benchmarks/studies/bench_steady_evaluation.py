@@ -1,7 +1,7 @@
-"""One evaluation of the steady design search, timed: ``python benchmarks/bench_steady_evaluation.py``.
+"""One evaluation of the steady design search, timed: ``python benchmarks/studies/bench_steady_evaluation.py``.
 
 From the settled states of start 0 of the default `optimise run` (its checkpoint,
-out/bench_optimise_steady/run/checkpoint.pkl, written by `benchmarks/bench_optimise_steady.py`):
+out/bench_optimise_steady/run/checkpoint.pkl, written by `benchmarks/studies/bench_optimise_steady.py`):
 `steady_design_metrics` (4 seeds, the run's, settle auto, 2-revolution window; continuation) then
 `frozen_load_gradient` (8 x 1 ms), on 2 workers, twice in a row (the second call is the one a
 search iteration pays once compiled), first with a process pool per call, then inside one
@@ -18,11 +18,14 @@ import pickle
 import sys
 import time
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+sys.path[:0] = [
+    str(pathlib.Path(__file__).resolve().parent),
+    str(pathlib.Path(__file__).resolve().parents[1]),
+]
 import _common  # noqa: E402
 
 NAME = "bench_steady_evaluation"
-_RUNS = pathlib.Path(__file__).resolve().parents[1] / "out" / "bench_optimise_steady"
+_RUNS = pathlib.Path(__file__).resolve().parents[2] / "out" / "bench_optimise_steady"
 CHECKPOINT = _RUNS / "run" / "checkpoint.pkl"
 #: `--quick` without the full run's checkpoint: that of `bench_optimise_steady.py --quick`
 QUICK_CHECKPOINT = _RUNS / "run_quick" / "checkpoint.pkl"
@@ -70,7 +73,7 @@ def main(quick: bool = False) -> dict:
     checkpoint = QUICK_CHECKPOINT if quick and not CHECKPOINT.exists() else CHECKPOINT
     if not checkpoint.exists():
         raise SystemExit(
-            f"{checkpoint}: missing; run benchmarks/bench_optimise_steady.py"
+            f"{checkpoint}: missing; run benchmarks/studies/bench_optimise_steady.py"
             f"{' --quick' if quick else ''} first"
         )
     with open(checkpoint, "rb") as f:

@@ -18,7 +18,7 @@ max norm, raceway-normal 100x looser; `diagnose_step_control.json`, the default 
 
 Evaluation counts do not depend on the machine's load (`_common.fsal_rk_evaluations`).
 
-    python benchmarks/diagnose_step_control.py [--norm body_rms]
+    python benchmarks/studies/diagnose_step_control.py [--norm body_rms]
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path[:0] = [str(Path(__file__).resolve().parent), str(Path(__file__).resolve().parents[1])]
 
 import _common  # noqa: E402
 

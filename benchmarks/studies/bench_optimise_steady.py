@@ -1,5 +1,5 @@
 """The default `optimise run` (steady running) against a 7 x 7 grid with the same settled
-objective (issue 13 acceptance): ``python benchmarks/bench_optimise_steady.py [--quick]``.
+objective (issue 13 acceptance): ``python benchmarks/studies/bench_optimise_steady.py [--quick]``.
 
 1. `optimise run --out out/bench_optimise_steady/run` as a separate process with the default
    settings (reference bearing, 20,000 rpm, 1000 N): its wall time (compilation included, as a
@@ -32,11 +32,14 @@ import time
 
 import numpy as np
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+sys.path[:0] = [
+    str(pathlib.Path(__file__).resolve().parent),
+    str(pathlib.Path(__file__).resolve().parents[1]),
+]
 import _common  # noqa: E402
 
 NAME = "bench_optimise_steady"
-ROOT = pathlib.Path(__file__).resolve().parents[1]
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 OUT = ROOT / "out" / NAME
 GRID = 7
 GRID_CLEARANCE = 0.15e-3  # [m] the reference design's Delta_bf

@@ -17,7 +17,7 @@ harness); quick=False the full comparison: 15 x 15 grid, 4 starts x 15 iteration
 `optimise` defaults (0.3 ms per evaluation from the seated start with 1 mrad skew scatter,
 rtol 1e-3, atol 1e-6).
 
-Run: .venv/bin/python benchmarks/bench_optimise_grid.py [--quick]
+Run: .venv/bin/python benchmarks/studies/bench_optimise_grid.py [--quick]
 """
 
 from __future__ import annotations
@@ -30,7 +30,7 @@ import time
 
 import numpy as np
 
-RESULTS = pathlib.Path(__file__).resolve().parent / "results"
+RESULTS = pathlib.Path(__file__).resolve().parents[1] / "results"
 sys.path.insert(0, str(RESULTS.parent))
 
 from _common import machine_info  # noqa: E402

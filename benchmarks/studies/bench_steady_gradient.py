@@ -1,5 +1,5 @@
 """Gradient estimators of the steady design objective against common-random-number central
-differences (issue 13, item 2): ``python benchmarks/bench_steady_gradient.py [--quick]``.
+differences (issue 13, item 2): ``python benchmarks/studies/bench_steady_gradient.py [--quick]``.
 
 Objective J(d): the smooth mean flange PV over contact time of settled running
 (`jaxbearing.run.steady_design_metrics(...).objective`), reference bearing, 20,000 rpm, 1000 N.
@@ -40,7 +40,10 @@ import time
 
 import numpy as np
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+sys.path[:0] = [
+    str(pathlib.Path(__file__).resolve().parent),
+    str(pathlib.Path(__file__).resolve().parents[1]),
+]
 import _common  # noqa: E402
 
 NAME = "bench_steady_gradient"
@@ -57,7 +60,7 @@ SEEDS = 8
 WINDOW_REVS = 2
 WINDOWS = (0.1e-3, 0.25e-3)
 FROZEN_WINDOW = 1.0e-3
-STATE_DIR = pathlib.Path(__file__).resolve().parents[1] / "out" / NAME
+STATE_DIR = pathlib.Path(__file__).resolve().parents[2] / "out" / NAME
 WORKERS = 2
 
 
@@ -305,7 +308,7 @@ def replicate_clearance(first_seed: int = REPLICATE_FIRST_SEED) -> dict:
     repeated with 8 new seeds (8-15) by the same protocol (skid start at the reference design,
     continuation to the design, CRN central difference), with the frozen-load estimate from the
     new states, and the 16-seed pooled difference: is it a property of the design or a
-    2.9-sigma draw among nine checks? ``python benchmarks/bench_steady_gradient.py
+    2.9-sigma draw among nine checks? ``python benchmarks/studies/bench_steady_gradient.py
     --replicate-clearance`` (needs the full study's results for seeds 0-7).
 
     ``--first-seed N`` runs seeds N .. N+7 instead (written under

@@ -23,7 +23,7 @@ quasi-static start:
 * ``flops``: XLA's operation count of the field and of the field with 3 tangents (independent
   of the load).
 
-    python benchmarks/bench_field_speed.py [--baseline REV] [--current REV] [--repeats N] [--quick]
+    python benchmarks/studies/bench_field_speed.py [--baseline REV] [--current REV] [--repeats N] [--quick]
         [--output NAME]
 
 Measured (results/bench_field_speed.json): the raceway slices written by components, tuples of
@@ -39,7 +39,7 @@ a 240 us field.
 
 Measured 2026-11-25, fourth session (`--baseline c695504 --current 0797e02 --repeats 3
 --output bench_field_speed_one_raceway_vmap`, results/bench_field_speed_one_raceway_vmap.json;
-0797e02 is an unlanded probe commit, its diff in results/bench_field_speed_one_raceway_vmap.diff): both raceways in one vmap over the rings, v_rel with one
+0797e02 is an unlanded probe commit, its diff kept in git history (the commit that removed results/bench_field_speed_one_raceway_vmap.diff)): both raceways in one vmap over the rings, v_rel with one
 cross product a slice ((v_b - v_r - w_r x (p - c_r)) + (w_b - w_r) x (x_j - p)) and the ring's
 moment from the roller's (-(M_b + (p - c_r) x F)). XLA counts 1.62x fewer flops in the field
 and 1.20x fewer with three tangents; the field took 311.7 against 336.3 us (1.08x), three
@@ -49,7 +49,7 @@ that day against 165-170 us in earlier sessions: shared and loaded.)
 
 Measured 2026-11-25, fifth session (`--baseline HEAD --repeats 4 --output
 bench_field_speed_slice_power`, results/bench_field_speed_slice_power.json; the working tree's
-diff in results/bench_field_speed_slice_power.diff): the slice power `line_power` rewritten
+diff kept in git history (the commit that removed results/bench_field_speed_slice_power.diff)): the slice power `line_power` rewritten
 exactly with cheaper float64 transcendentals, ln(1 + e) through `log` (Goldberg's ln(u) e/(u - 1))
 and delta_s^(10/9) = delta_s exp(ln(delta_s)/9). Alone it took 11-13 against 19-22 ns a slice (a throwaway probe, not in the repository);
 in the field it made XLA count 1.10x more flops, and the field took 370-387 against 347-360 us
@@ -70,7 +70,7 @@ import tempfile
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path[:0] = [str(Path(__file__).resolve().parent), str(Path(__file__).resolve().parents[1])]
 
 import _common  # noqa: E402
 
@@ -79,7 +79,7 @@ BASELINE = "92d850e"
 EVALS = 400
 DURATION = 0.5e-3  # [s]
 SAMPLES = 500  # samples of the sampled solve (`sampled_solve_*`)
-REPO = Path(__file__).resolve().parent.parent
+REPO = Path(__file__).resolve().parents[2]
 #: the timings of a child process (the minimum over processes is reported)
 TIMED = ("field_us", "tangents_us", "solve_s_per_ms", "sampled_solve_compile_s", "sampled_solve_s_per_ms")
 
