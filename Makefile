@@ -1,13 +1,14 @@
 # jaxbearing: every target creates .venv if missing and installs the project into it.
-PYTHON ?= python3.11
+PYTHON ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test test-slow lint format bench install clean
+.PHONY: demo test test-slow lint format bench install clean docs notebooks
 
 $(BIN)/python:
 	@command -v $(PYTHON) >/dev/null 2>&1 || { echo "error: $(PYTHON) not found (set PYTHON=...)"; exit 1; }
+	@$(PYTHON) -c 'import sys; sys.exit(sys.version_info < (3, 11))' || { echo "error: $(PYTHON) is Python $$($(PYTHON) -c 'import platform; print(platform.python_version())'); jaxbearing needs Python >= 3.11 (set PYTHON=python3.12, for example)"; exit 1; }
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install -q --upgrade pip
 
@@ -38,6 +39,27 @@ test-slow: $(STAMP)
 
 bench: $(STAMP)
 	MPLBACKEND=Agg $(BIN)/python benchmarks/run_all.py
+
+# the documentation site: the tutorials executed (short setting) into build/notebooks, then
+# mkdocs with --strict (a broken link or a missing reference fails); the site is build/site
+DOCS_STAMP := $(VENV)/.installed-docs
+$(DOCS_STAMP): $(STAMP)
+	$(BIN)/python -m pip install -q -e ".[docs]"
+	@touch $(DOCS_STAMP)
+
+docs: $(DOCS_STAMP)
+	$(BIN)/python docs/_execute_notebooks.py build/notebooks
+	JAXBEARING_DOCS_NOTEBOOKS=build/notebooks $(BIN)/mkdocs build --strict
+	@echo "site: build/site/index.html (or: $(BIN)/mkdocs serve)"
+
+# JupyterLab on the notebooks (the notebooks extra); set JAXBEARING_NOTEBOOK_SHORT=1 for the short setting
+NOTEBOOKS_STAMP := $(VENV)/.installed-notebooks
+$(NOTEBOOKS_STAMP): $(STAMP)
+	$(BIN)/python -m pip install -q -e ".[notebooks]"
+	@touch $(NOTEBOOKS_STAMP)
+
+notebooks: $(NOTEBOOKS_STAMP)
+	cd notebooks && ../$(BIN)/jupyter lab
 
 clean:
 	rm -rf $(VENV) build *.egg-info

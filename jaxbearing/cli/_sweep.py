@@ -1,6 +1,6 @@
 """`jaxbearing sweep SPEC.toml --out DIR`: parameter sweeps in vmapped, sharded, resumable batches.
 
-The spec format is documented in `jaxbearing._sweep`; multi-machine runs in docs/cluster.md.
+The spec format is documented in `jaxbearing.sweep` (`sweep/_spec.py`); multi-machine runs in docs/how-to/sweeps.md.
 The spec is parsed and every case validated before JAX is initialised (so `jax.distributed`
 can still be set up) and before anything is computed.
 """
