@@ -3,7 +3,7 @@
 The notebooks run as tests (`tests/test_notebooks.py`) with the environment variable
 JAXBEARING_NOTEBOOK_SHORT=1: short simulated durations, figures written to the gitignored
 notebooks/figures/. Without it (the full setting) they reproduce the study: full durations,
-figures written to docs/figures/ (the ones the README shows).
+figures written to docs/figures/ (the ones the documentation shows).
 
     from _short import SHORT, pick, figure_dir
     duration = pick(short=0.5e-3, full=20e-3)

@@ -13,7 +13,7 @@ invariant measure), plain trajectories of `gradient_window` seconds; at every sa
 flange PV is differentiated in the design at the loads the dynamics gave, through the ratio
 estimator. "window": the short-window forward-mode sensitivities of
 `jaxbearing.run.steady_gradient` over `gradient_window` seconds. benchmarks/studies/bench_steady_gradient
-measures both against common-random-number central differences (README, Design on steady
+measures both against common-random-number central differences (docs/how-to/design-search.md; the study in docs/performance-history.md, Design on steady
 running).
 
 Constraints. The four static design-zone margins of `DesignProblem.constraints` and the
@@ -479,7 +479,7 @@ def _load_checkpoint(path: pathlib.Path) -> dict:
 def _estimates(m) -> dict:
     """One design's verification row: the issue's `mean_pv`, `p95_pv` [Pa m/s, SI] and
     `corner_contact_share`, each as value / ci95_low / ci95_high / n, and the same in the
-    engineering units the README and the CLI print (GPa m/s, mm)."""
+    engineering units the documentation and the CLI print (GPa m/s, mm)."""
     return {
         "mean_pv": _scaled(m.mean_pv, 1.0) | {"unit": "Pa m/s"},
         "p95_pv": _scaled(m.p95_pv, 1.0) | {"unit": "Pa m/s"},

@@ -103,7 +103,7 @@ def _revolution_means(integrate, state, n):
 
 #: the band a revolution-mean cage speed must keep around the plateau from revolution 1 on: the
 #: half-width of the ensemble 95 % CI of the settled cage speed at the reference point (4 seeds,
-#: README: 8417 [8415, 8420] rpm, +/- 0.03 %), the yardstick docs/model.md 16 gives for the cage
+#: docs/performance-history.md: 8417 [8415, 8420] rpm, +/- 0.03 %), the yardstick docs/model.md 16 gives for the cage
 #: speed (one seed's batch-means interval, +/- 0.2 rpm, is narrower than the 0.3 rpm that halving
 #: rtol moves the plateau)
 PLATEAU_BAND = 3e-4

@@ -4,7 +4,7 @@ paper's setting) to "mixed" (mu = f_a(Lambda) mu_f + (1 - f_a(Lambda)) kappa(|u|
 load-sharing law of docs/model.md 5.1) at the reference point, in settled running.
 
 For each end type (arc, corner) and each law: `jaxbearing.simulate(bearing, op, settle="auto",
-window_revs=4, seeds=4, workers=2)` from the skid start, as the README's settled reference table
+window_revs=4, seeds=4, workers=2)` from the skid start, as the settled reference table of docs/performance-history.md
 (`jaxbearing simulate --settle auto --seeds 4`, benchmarks/results/settled_reference_4_seeds.json)
 but with a window of 4 cage revolutions instead of 8 (the shared 2-core machine). Both laws are
 run here with the same code, so the differences are not mixed up with code changes since that

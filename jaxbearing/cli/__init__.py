@@ -2,7 +2,7 @@
 `_simulate`, `_sweep`, `_plot`), each exposing `register(subparsers)`; `main` dispatches.
 
 User errors print one line and exit 2; failed solves exit 1; `EXIT_CODES` lists them all
-(README, "Reliability").
+(docs/how-to/reading-results.md).
 
 May import: every layer below (imports of heavy layers stay inside the command functions, so
 `jaxbearing --help` starts fast).

@@ -29,7 +29,7 @@ def register(sub) -> None:
 
 
 #: the source study's stated values (Machines 2025, 13(11), 993, section 3; docs/validation.md); its
-#: sliding velocity is the roller's surface speed at the contact (README, "Two sliding definitions")
+#: sliding velocity is the roller's surface speed at the contact (docs/validation.md, "What differs")
 PAPER = (
     ("peak pressure, max", "flange_pressure_Pa", "max", 1e-9, "GPa", "about 4.8", "below 0.2"),
     ("surface speed, mean", "flange_roller_surface_speed_m_s", "mean", 1.0, "m/s", "20", "13.5"),
@@ -107,7 +107,7 @@ def run(args) -> int:
     print()
     what = "settled running, 95 % CI" if steady else f"a {args.duration_ms:g} ms start-up transient"
     print(
-        f"Against the source study ({what}; its bearing differs: compare trends and magnitudes, see README):"
+        f"Against the source study ({what}; its bearing differs: compare trends and magnitudes, see docs/validation.md):"
     )
     print(paper_table(summaries))
     write_outputs(pathlib.Path(args.out), results)

@@ -22,7 +22,7 @@ costs nothing in the program: a thread of the calling process prints the elapsed
 every `interval` seconds while an ordinary (cached) solve runs, and the same closing line as
 `SolveProgress` from its result (100 %, or where a failed solve stopped). It cannot know the
 percentage while the solve runs. The command line uses it (`jaxbearing simulate` of 0.2 ms on
-warm caches: 7.9-9.1 s with it, 24.5-30.9 s with `SolveProgress`; README, Command line).
+warm caches: 7.9-9.1 s with it, 24.5-30.9 s with `SolveProgress`; docs/performance-history.md).
 """
 
 from __future__ import annotations

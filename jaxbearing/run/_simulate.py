@@ -13,7 +13,7 @@
   10 times and the rotations 10 times under the largest RMS of a body's coordinates, which is
   faster there and wrong in the start-up transient (spurious roller-corner impacts);
   `max_steps` explicit. `solver="ros34pw2"` selects the linearly implicit
-  Rosenbrock-W method with per-roller Jacobian blocks instead (`_rosenbrock`; slower, README).
+  Rosenbrock-W method with per-roller Jacobian blocks instead (`_rosenbrock`; slower, docs/performance.md).
 * Outputs: the solve keeps only the scaled state at the sample times (`SaveAt(ts=...,
   fn=_saved_state)`, without the accumulators), and the flange-contact quantities, cage speed
   and roller loads are evaluated from those states after the loop (`_histories`), so memory

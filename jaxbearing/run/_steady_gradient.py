@@ -32,7 +32,7 @@ neglects the slow part of the response (how the distribution of settled states m
 design, e.g. the cage speed or the skew amplitude): its bias against the derivative of the
 settled mean is measured against common-random-number central differences of settled runs
 in benchmarks/studies/bench_steady_gradient.py, with the window length T and ensemble size K it
-was measured at (README, Design on steady running).
+was measured at (docs/how-to/design-search.md).
 """
 
 from __future__ import annotations
