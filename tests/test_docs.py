@@ -141,7 +141,8 @@ def test_no_reference_to_a_file_that_does_not_exist():
     to a file, and every path written from the repository root (`docs/model.md`,
     `benchmarks/studies/bench_misalignment.py`, ...) in any file names one that exists."""
     link = re.compile(r"\]\(([^)\s]+)\)")
-    bare = re.compile(r"(?<![\w./-])((?:%s)/[\w./-]*\.(?:%s))\b" % ("|".join(TOP), "|".join(EXTENSIONS)))
+    tops, exts = "|".join(TOP), "|".join(EXTENSIONS)
+    bare = re.compile(rf"(?<![\w./-])((?:{tops})/[\w./-]*\.(?:{exts}))\b")
     bad = []
     for path, text, markdown in _texts():
         where = path.relative_to(ROOT)
