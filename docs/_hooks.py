@@ -39,7 +39,9 @@ def on_files(files, config):
         if not path.exists():
             raise FileNotFoundError(f"{path}: missing ({NOTEBOOKS_ENV}={source}); run `make docs`")
         shutil.copyfile(path, staging / "tutorials" / nb.name)
-        files.append(File(f"tutorials/{nb.name}", str(staging), config["site_dir"], config["use_directory_urls"]))
+        files.append(
+            File(f"tutorials/{nb.name}", str(staging), config["site_dir"], config["use_directory_urls"])
+        )
     return files
 
 
@@ -53,7 +55,13 @@ def configuration_table() -> str:
     for key in KEYS:
         if key.section != section:
             section = key.section
-            out += ["", f"### `[{section}]`", "", "| key | symbol | unit | reference value | meaning and valid range |", "|---|---|---|---|---|"]
+            out += [
+                "",
+                f"### `[{section}]`",
+                "",
+                "| key | symbol | unit | reference value | meaning and valid range |",
+                "|---|---|---|---|---|",
+            ]
         symbol = f"`{key.symbol}`" if key.symbol else ""
         meaning = key.doc().replace("|", "\\|")
         default = format_value(key.default).replace("|", "\\|")
