@@ -7,7 +7,7 @@
 - the vector field: `physical_rates(t, state, params)` over every roller, the cage and the inner
   ring, with `contact_loads` (every contact of one state) and the smooth `Functionals`;
 - the start (docs/model.md 12): `quasi_static` (load distribution with centrifugal force) and
-  `skid_equilibrium` (the speeds of steady running at those positions, issue 11) with the
+  `skid_equilibrium` (the speeds of steady running at those positions) with the
   `cage_time_constant` of the cage speed's slow approach to it.
 
 May import: `jaxbearing._errors`, `contact`, `geometry`, `io`, `flange`, `forces`.

@@ -1,7 +1,7 @@
 """Flange face and roller-end pose: the pose-only part of the roller-end/flange contact.
 
 `flange_geometry` places the flange face (its tangent plane at the roller's azimuth, docs/model.md
-4.1), finds the extreme point of the roller end body in the direction of the flange normal
+5), finds the extreme point of the roller end body in the direction of the flange normal
 (`jaxbearing.geometry.end_support`), and returns the interference, the contact point, its height
 above the raceway, its position on the end face and the principal radii of the active end
 surface. It is shared by the dynamic contact (`roller_flange_contact`) and the static design

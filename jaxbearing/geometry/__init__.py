@@ -3,7 +3,7 @@
 Owns: `Bearing` and its parts (`Roller`, `Flange`, `Cage`, `Material`, `Lubricant`), the
 `OperatingPoint`, the reference bearing (docs/model.md 1), unit conversions, the mass properties
 derived from geometry, the inner ring's tilted axis (`ring_axis`), and the shape of the roller end (corner torus and spherical cap, docs/model.md
-4.1: support function, limited circle, arc protrusion, principal curvatures).
+4: support function, limited circle, arc protrusion, principal curvatures).
 
 The end body lives here rather than in `jaxbearing.flange` because the roller's mass properties
 need it (the arc cap changes the volume), and mass properties sit below every contact.

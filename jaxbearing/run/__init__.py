@@ -4,7 +4,7 @@
   (compiled, with wall times and a `SimulationResult`), `simulation_result`,
   `flange_functionals` (smooth peak PV and contact heights for gradients), `Perturbation`
   (seeded initial roller scatter), `initial_state`, `skid_start` (the speeds of steady running,
-  issue 11; `STARTS`), `smooth_functionals`, `result_code` and
+  `STARTS`), `smooth_functionals`, `result_code` and
   `RESULT_NAMES` (the outcome code of a solve), `SolveProgress` (the text progress meter
   inside a solve) and `HostProgress` (the same from the calling process: cacheable programs);
 - statistics: `contact_events`, `summarise`, `film_statistics` (film over contact time,

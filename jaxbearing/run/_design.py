@@ -1,4 +1,4 @@
-"""Differentiable design metrics of the roller end and flange (docs/model.md and 6; issue 5).
+"""Differentiable design metrics of the roller end and flange (docs/model.md 13 and 17).
 
 The design variables are the three quantities the source study tunes (Machines 2025, 13(11),
 993, Section 3.4 and Figure 14): the end radius R_end, the flange layback angle theta_f and the

@@ -111,7 +111,7 @@ def assemble(out_dir: str | os.PathLike, spec: SweepSpec | None = None):
         base_end=spec.base.simulation.end,
         duration_ms=spec.base.simulation.duration_ms,
         num_saves=spec.num_saves,
-        source="jaxbearing sweep (issue 6)",
+        source="jaxbearing sweep",
     )
     path = out_dir / "results.nc"
     atomic_write(path, lambda f: f.write(ds.to_netcdf(None, engine="scipy")))
