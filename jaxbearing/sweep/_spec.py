@@ -1,5 +1,5 @@
 """Parameter sweeps at scale: vmapped batches of `solve`, sharded over devices and processes,
-resumable, with labelled results (issue 6).
+resumable, with labelled results.
 
 A sweep spec (TOML) names a base configuration and the axes to vary, in engineering units:
 
