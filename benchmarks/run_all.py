@@ -194,7 +194,7 @@ def main(argv: list[str] | None = None) -> int:
         ]
         print(
             _common.format_table(
-                "Targets of issue 8", ["key", "target", "measured", "threshold", "reached"], trows
+                "Performance targets", ["key", "target", "measured", "threshold", "reached"], trows
             )
         )
     print(f"results: {path.parent}/")
