@@ -1,7 +1,7 @@
 """`optimise` command line: `optimise run [...]`.
 
 Objectives: `--objective steady` (default; `_steady`: the mean flange PV of settled running,
-seeds, CIs, the dynamic corner margin, continuation, resume from DIR/checkpoint.pkl,
+seeds, CIs, the dynamic corner margin, continuation, resume from DIR/checkpoint.npz,
 verification on unseen seeds) and `--objective startup` (`_search`: the smooth peak PV of the
 first 0.3 ms from a seated start, the old transient objective: fast, but it measures how hard
 seated rollers are first driven onto their flanges, not how a design runs).
@@ -369,7 +369,7 @@ def run_steady(args, problem, options, settings, out) -> int:
     from jaxbearing.io import write_json
 
     from ._plot import plot_search
-    from ._steady import CONSTRAINT_NAMES, steady_search
+    from ._steady import CHECKPOINT, CONSTRAINT_NAMES, steady_search
 
     k = problem.num_operating_points
     print(
@@ -395,7 +395,7 @@ def run_steady(args, problem, options, settings, out) -> int:
         problem, settings, directory=out, callback=progress, verify=not args.no_verify, **options
     )
     if res.resumed_from >= 0 and not args.quiet:
-        print(f"(resumed after iteration {res.resumed_from} from {out / 'checkpoint.pkl'})")
+        print(f"(resumed after iteration {res.resumed_from} from {out / CHECKPOINT})")
     write_json(out / "result.json", _steady_result_json(problem, options, settings, res))
     plot_path = out / "search_paths.png"
     plot_search(problem, res, plot_path)

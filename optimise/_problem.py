@@ -209,7 +209,7 @@ def load_optimise_toml(path: str) -> dict:
             data = tomllib.load(f)
     except OSError as exc:
         raise UserInputError(f"optimise file {path}: cannot read: {exc.strerror or exc}") from None
-    except tomllib.TOMLDecodeError as exc:
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise UserInputError(f"optimise file {path}: invalid TOML: {exc}") from None
     out = {}
     for section, table in data.items():

@@ -137,7 +137,7 @@ def test_killed_run_resumes_with_the_same_result(tmp_path, config, monkeypatch, 
     monkeypatch.setattr(steady, "evaluate", dying)
     # the command line reports the interruption (exit code 130) and writes no result
     assert main(["run", "--config", config, *args, "--no-verify", "--out", str(killed)]) == 130
-    assert (killed / "checkpoint.pkl").exists() and not (killed / "result.json").exists()
+    assert (killed / "checkpoint.npz").exists() and not (killed / "result.json").exists()
     monkeypatch.setattr(steady, "evaluate", evaluate)
     assert main(["run", "--config", config, *args, "--no-verify", "--out", str(killed)]) == 0
     assert "resumed after iteration 0" in capsys.readouterr().out
@@ -215,7 +215,7 @@ def test_grid_picks_the_best_point_inside_every_margin_and_resumes(tmp_path, con
     """`steady_grid` on the stand-in ensemble: only statically feasible points are evaluated,
     each continuing from the previous one (serpentine order), the best point is the lowest
     objective whose dynamic margin is positive too, and a rerun takes every point from
-    DIR/grid_checkpoint.pkl without evaluating again."""
+    DIR/grid_checkpoint.npz without evaluating again."""
     import jaxbearing as jb
     from optimise import make_problem
 

@@ -6,7 +6,8 @@ TOML in engineering units (`Config`, `load_config`), validation of pytrees built
 solver arguments `SOLVER_ARGUMENTS` and `check_solver_arguments`, `check_solve_inputs` that
 every model entry point calls before tracing), the checks a configuration needs to be run
 (`check_runnable`), and result files that are whole or absent, in strict JSON (`atomic_write`,
-`write_json`, `dumps_strict`), and the lock on an output directory (`acquire_lock`).
+`write_json`, `dumps_strict`), pytrees in data-only files (`save_tree`, `load_tree`: `.npz`
+with `allow_pickle=False` and JSON, never a pickle), and the lock on an output directory (`acquire_lock`).
 
 May import: `jaxbearing._errors`, `jaxbearing.geometry`.
 """
@@ -50,6 +51,7 @@ from ._files import (
 from ._keys import format_value, type_name
 from ._lock import DirectoryInUse, DirectoryLock, acquire_lock
 from ._schema import KEY_BY_PATH, KEYS
+from ._tree import TreeFileError, check_like, load_tree, save_tree, tree_bytes, tree_from_bytes
 from ._validation import validate_bearing
 
 __all__ = [
@@ -65,10 +67,12 @@ __all__ = [
     "DirectoryLock",
     "Rule",
     "SimulationSettings",
+    "TreeFileError",
     "acquire_lock",
     "atomic_write",
     "check_arguments",
     "check_fields",
+    "check_like",
     "check_model_inputs",
     "check_runnable",
     "check_solve_inputs",
@@ -78,6 +82,7 @@ __all__ = [
     "format_value",
     "is_concrete",
     "load_config",
+    "load_tree",
     "loads_config",
     "optional_import",
     "pyplot",
@@ -87,7 +92,10 @@ __all__ = [
     "reference_operating_point",
     "remove_stale_temporaries",
     "require",
+    "save_tree",
     "to_strict_json",
+    "tree_bytes",
+    "tree_from_bytes",
     "type_name",
     "validate_bearing",
     "with_null_reasons",

@@ -125,5 +125,12 @@ def open_results(out_dir: str | os.PathLike):
     path = pathlib.Path(out_dir) / "results.nc"
     if not path.exists():
         return assemble(out_dir)
-    with xr.open_dataset(path, engine="scipy") as ds:
-        return ds.load()
+    try:
+        with xr.open_dataset(path, engine="scipy") as ds:
+            ds = ds.load()
+    except Exception as exc:  # noqa: BLE001 - not a netCDF file of ours: one line naming it
+        reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise UserInputError(f"{path}: not a sweep result file ({reason}); not loaded") from None
+    if "spec" not in ds.attrs or "result_code" not in ds:
+        raise UserInputError(f"{path}: not a sweep result file (no spec or result_code); not loaded")
+    return ds
