@@ -83,7 +83,6 @@ def summary_lines(bearing, op) -> list[str]:
 
 
 def run(args) -> int:
-    import pathlib
 
     from ..io import reference_config
     from . import _steady
@@ -93,6 +92,9 @@ def run(args) -> int:
     print("\n".join(summary_lines(cfg.bearing(), cfg.operating_point())))
     if args.summary_only:
         return 0
+    from ._simulate import _check_out
+
+    _check_out(args.out)
     steady = None
     if not args.transient:
         from ..run import check_steady_options
@@ -110,7 +112,12 @@ def run(args) -> int:
         f"Against the source study ({what}; its bearing differs: compare trends and magnitudes, see README):"
     )
     print(paper_table(summaries))
-    write_outputs(pathlib.Path(args.out), results)
+    from ..io import write_or_fallback
+    from ._main import report_fallback
+
+    used, reason = write_or_fallback(args.out, lambda d: write_outputs(d, results, cfg, steady))
+    if reason is not None:
+        return report_fallback("jaxbearing demo", args.out, used, reason)
     print(f"\nsummary.json, histories and plots written to {args.out}/")
     ok = all(s["status"] == "ok" for s in summaries.values())
     return 0 if ok and (steady is None or _steady.exit_code(summaries) == 0) else 1

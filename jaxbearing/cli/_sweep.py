@@ -84,7 +84,7 @@ def default_workers(spec, num_processes: int) -> int:
 
 
 def run(args) -> int:
-    from ..io import check_arguments, count
+    from ..io import check_arguments, check_output_dir, count, plausibility_warnings
     from ..sweep import initialize_distributed, load_sweep_spec, run_sweep
 
     if args.workers is not None:  # before anything is printed or started
@@ -92,6 +92,8 @@ def run(args) -> int:
     spec = load_sweep_spec(args.spec)
     if args.batch_size is not None:
         spec = spec.with_batch_size(args.batch_size)
+    if not args.dry_run:
+        check_output_dir(args.out, "--out")  # before jax.distributed and any solve
     print(
         f"sweep {args.spec}: {spec.num_cases} cases "
         f"({' x '.join(f'{d} {n}' for d, n in zip(spec.dims, spec.shape))}), "
@@ -102,6 +104,8 @@ def run(args) -> int:
         for a in spec.axes:
             print(f"  {a.key} [{a.dim}]: {', '.join(map(str, a.values))}")
         return 0
+    for line in plausibility_warnings(spec.base):
+        print(f"warning: base configuration: {line}", file=sys.stderr)
     process_id, num_processes = initialize_distributed(args.coordinator, args.num_processes, args.process_id)
     import jax
 
