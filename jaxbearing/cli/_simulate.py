@@ -249,10 +249,12 @@ def summary_document(results: dict, cfg=None, steady: dict | None = None) -> dic
     seeds = list(range(int(steady["seeds"]))) if steady else [0]  # fixed run: Perturbation(seed=0)
     meta = provenance(cfg, seeds=seeds)
     meta["ends"] = list(summaries)
-    meta["settled"] = steady is not None
     if steady:
         meta["steady_options"] = dict(steady)
     meta["units"] = units_of(first)
+    for key in ("seeds",):  # a settled run's block already lists its seeds (the same list)
+        if key in doc:
+            meta.pop(key)
     clash = set(meta) & set(doc)
     if clash:  # pragma: no cover - the summary keys never use these names
         raise RuntimeError(f"summary keys {sorted(clash)} clash with the provenance keys")

@@ -57,9 +57,12 @@ def _bearing(config):
 def _config(config):
     """The configuration of `--config` (the embedded reference configuration without it); its
     errors name the file."""
-    from ._simulate import load_named_config
+    from ..io import load_config
 
-    return load_named_config(config)
+    try:
+        return load_config(config)
+    except UserInputError as exc:
+        raise UserInputError(f"{config}: {exc}" if config is not None else str(exc)) from None
 
 
 def _mm(x) -> str:
