@@ -74,6 +74,89 @@ def test_out_without_write_permission_is_one_line_exit_2(command, tmp_path, caps
         locked.chmod(0o755)
 
 
+@pytest.mark.parametrize(
+    "main,command",
+    [
+        (jb_main, ["simulate"]),
+        (jb_main, ["sweep", str(SPEC)]),
+        (jb_main, ["zone", "--map"]),
+        (opt_main, ["run"]),
+    ],
+    ids=["simulate", "sweep", "zone", "optimise"],
+)
+def test_out_refusing_writes_is_one_line_exit_2_even_as_root(main, command, tmp_path, monkeypatch, capsys):
+    """A directory that refuses the write test (EACCES, as a read-only directory does for a user
+    who is not root; injected here, since root writes anywhere): one line, exit 2, before any
+    solve, and the directory the check created is removed again."""
+    import builtins
+
+    from jaxbearing.io import _files
+
+    def refusing(path, *a, **k):
+        if ".jaxbearing-write-test" in str(path):
+            raise PermissionError(13, "Permission denied", str(path))
+        return builtins.open(path, *a, **k)
+
+    monkeypatch.setattr(_files, "open", refusing, raising=False)
+    out = tmp_path / "ro" / "out"
+    assert main([*command, "--out", str(out)]) == 2
+    line = _err_line(capsys)
+    assert "--out" in line and "cannot write there: Permission denied" in line
+    assert not (tmp_path / "ro").exists()
+
+
+def test_zone_map_out_naming_a_file_is_one_line(tmp_path, capsys):
+    f = tmp_path / "zone.png"
+    f.write_text("x")
+    assert jb_main(["zone", "--map", "--out", str(f)]) == 2
+    assert "exists and is not a directory" in _err_line(capsys)
+
+
+def test_zone_maps_kept_in_the_fallback_directory(tmp_path, monkeypatch, capsys):
+    """The maps are computed, then writing into --out fails (injected): they go to the
+    fallback directory named in one line, exit status 4."""
+    import jaxbearing.cli._zone as zone
+
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    maps = zone.zone_maps
+    monkeypatch.setattr(zone, "zone_maps", lambda bearing, load: maps(bearing, load, 9))
+    out = tmp_path / "maps"
+    real = zone.draw_maps
+
+    def failing(bearing, load, d, maps):
+        if pathlib.Path(d) == out:
+            raise OSError(28, "No space left on device (injected)")
+        return real(bearing, load, d, maps)
+
+    monkeypatch.setattr(zone, "draw_maps", failing)
+    assert jb_main(["zone", "--map", "--out", str(out)]) == EXIT_RESULTS_ELSEWHERE
+    line = _err_line(capsys)
+    kept = pathlib.Path(line.rsplit("they are kept in ", 1)[1])
+    assert (kept / "zone_height_map.png").exists() and (kept / "zone_clearance_map.png").exists()
+
+
+def test_optimise_results_kept_in_the_fallback_directory(tmp_path, monkeypatch, capsys):
+    from optimise._cli import _write_results
+
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    f = tmp_path / "f"
+    f.write_text("x")
+    used, code = _write_results(
+        f / "out", {"status": "ok"}, lambda d: (d / "search_paths.png").write_bytes(b"p")
+    )
+    assert code == EXIT_RESULTS_ELSEWHERE and json.loads((used / "result.json").read_text()) == {
+        "status": "ok"
+    }
+    assert str(used) in _err_line(capsys)
+
+
+def test_config_check_warns_about_unit_slips(tmp_path, capsys):
+    cfg = _toml(tmp_path, "[flange]\nlayback_angle_deg = 0.0279\n")
+    assert jb_main(["config", "check", cfg]) == 0
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "flange.layback_angle_deg = 0.0279 deg" in err[0] and "radians" in err[0]
+
+
 def test_check_output_dir_leaves_nothing_behind(tmp_path):
     from jaxbearing.io import check_output_dir
 

@@ -48,17 +48,21 @@ def run_show(args) -> int:
 
 def run_check(args) -> int:
     """Each file as `jaxbearing simulate --config FILE` would run it (without options): the
-    ranges of every key, then `check_runnable` (one code path with `simulate`)."""
+    ranges of every key, then `check_runnable` (one code path with `simulate`); valid values
+    that look like a unit slip are warned about (`plausibility_warnings`), one line each."""
     from .._errors import ConfigError
-    from ..io import check_runnable, load_config
+    from ..io import check_runnable, load_config, plausibility_warnings
 
     status = 0
     for path in args.files:
         try:
-            check_runnable(load_config(path))
+            cfg = load_config(path)
+            check_runnable(cfg)
         except ConfigError as exc:
             print(f"{path}: {exc}", file=sys.stderr)
             status = 2
         else:
+            for line in plausibility_warnings(cfg):
+                print(f"{path}: warning: {line}", file=sys.stderr)
             print(f"{path}: ok")
     return status
