@@ -434,3 +434,37 @@ def test_write_failure_after_the_solve_keeps_the_results(first_run, tmp_path, mo
     again = json.loads((kept / "summary.json").read_text())
     assert _statistics(again) == _statistics(doc)
     assert (kept / "histories_arc.npz").exists()
+
+
+def test_sweep_batches_kept_in_the_fallback_directory(tmp_path, monkeypatch, capsys):
+    """A batch is solved, then writing it into --out fails (injected): it and every later batch
+    go to the fallback directory named in one line, exit status 4; copied back, they assemble."""
+    import shutil
+
+    from jaxbearing.sweep import _driver
+    from jaxbearing.sweep._storage import read_batch
+
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    out = tmp_path / "sweep"
+    real = _driver.write_batch
+
+    def failing(d, spec, b, data):
+        if pathlib.Path(d) == out:
+            raise OSError(28, "No space left on device (injected)")
+        return real(d, spec, b, data)
+
+    monkeypatch.setattr(_driver, "write_batch", failing)
+    args = ["sweep", str(SPEC), "--out", str(out), "--workers", "1", "--no-progress"]
+    assert jb_main(args) == EXIT_RESULTS_ELSEWHERE
+    err = capsys.readouterr().err.strip().splitlines()
+    assert "injected" in err[-1] and "kept in" in err[-1]
+    kept = pathlib.Path(err[-1].split("kept in ", 1)[1].split("/batches", 1)[0])
+    from jaxbearing.sweep import load_sweep_spec
+
+    spec = load_sweep_spec(SPEC)
+    assert all(read_batch(kept, spec, b) is not None for b in range(spec.num_batches))
+    monkeypatch.setattr(_driver, "write_batch", real)
+    (out / "batches").mkdir(exist_ok=True)
+    for f in (kept / "batches").glob("batch_*.npz"):
+        shutil.copy(f, out / "batches" / f.name)
+    assert jb_main(args) == 0  # nothing left to solve: assembled from the copied batches

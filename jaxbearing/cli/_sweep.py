@@ -85,7 +85,8 @@ def default_workers(spec, num_processes: int) -> int:
 
 def run(args) -> int:
     from ..io import check_arguments, check_output_dir, count, plausibility_warnings
-    from ..sweep import initialize_distributed, load_sweep_spec, run_sweep
+    from ..sweep import ResultsElsewhere, initialize_distributed, load_sweep_spec, run_sweep
+    from ._main import EXIT_RESULTS_ELSEWHERE
 
     if args.workers is not None:  # before anything is printed or started
         check_arguments({"workers": args.workers}, {"workers": count(1)})
@@ -115,17 +116,21 @@ def run(args) -> int:
         f"({jax.local_devices()[0].platform}), {workers} worker process(es)",
         file=sys.stderr,
     )
-    ds = run_sweep(
-        spec,
-        args.out,
-        workers=workers,
-        resume=args.resume,
-        process_id=process_id,
-        num_processes=num_processes,
-        progress=not args.no_progress,
-        wait_timeout_s=args.wait_timeout_s,
-        lock_wait_s=args.wait_for_lock,
-    )
+    try:
+        ds = run_sweep(
+            spec,
+            args.out,
+            workers=workers,
+            resume=args.resume,
+            process_id=process_id,
+            num_processes=num_processes,
+            progress=not args.no_progress,
+            wait_timeout_s=args.wait_timeout_s,
+            lock_wait_s=args.wait_for_lock,
+        )
+    except ResultsElsewhere as exc:
+        print(f"jaxbearing sweep: error: {exc}", file=sys.stderr)
+        return EXIT_RESULTS_ELSEWHERE
     if ds is None:
         print(f"process {process_id}: batches written to {args.out}/batches")
         return 0
