@@ -118,6 +118,11 @@ def test_killed_run_resumes_with_the_same_result(tmp_path, config, monkeypatch, 
     assert main(["run", "--config", config, *args, "--no-verify", "--out", str(whole)]) == 0
     r1, j1, x1 = _history(whole)
     assert r1["objective_kind"] == "steady" and r1["status"] == "ok" and r1["resumed_from_iteration"] == -1
+    # self-describing (issue 38): version, command line, configuration, settings, seeds, units
+    assert r1["jaxbearing_version"] and r1["command"][:2] == ["optimise", "run"]
+    assert r1["config"]["bearing"]["num_slices"] == 11 and "config_toml" in r1
+    assert r1["seeds"]["search"] == [0, 1] and r1["seeds"]["verification"] == [1000, 1001, 1002, 1003]
+    assert r1["optimiser_settings"]["seeds"] == 2 and "units" in r1
     assert j1.shape == (3, 1) and np.all(np.isfinite(j1)) and np.all(j1 > 0)
     assert np.all(np.isfinite(np.asarray(r1["history"]["gradient_per_unit_box"])))
     lo, hi = r1["objective_GPa_m_s"]["ci95_low"], r1["objective_GPa_m_s"]["ci95_high"]

@@ -468,3 +468,28 @@ def test_sweep_batches_kept_in_the_fallback_directory(tmp_path, monkeypatch, cap
     for f in (kept / "batches").glob("batch_*.npz"):
         shutil.copy(f, out / "batches" / f.name)
     assert jb_main(args) == 0  # nothing left to solve: assembled from the copied batches
+
+
+def _parsers(parser, path=()):
+    for a in parser._actions:
+        if a.__class__.__name__ == "_SubParsersAction":
+            for name, sp in a.choices.items():
+                yield (*path, name), sp
+                yield from _parsers(sp, (*path, name))
+
+
+def test_every_command_and_option_has_a_description_and_a_default():
+    from jaxbearing.cli import build_parser as jb_parser
+    from optimise._cli import build_parser as opt_parser
+
+    missing = []
+    for top in (jb_parser(), opt_parser()):
+        for path, sp in _parsers(top):
+            if not sp.description:
+                missing.append(f"{top.prog} {' '.join(path)}: no description")
+            for a in sp._actions:
+                if a.dest == "help" or not a.option_strings or a.__class__.__name__ == "_SubParsersAction":
+                    continue
+                if "(default" not in " ".join((a.help or "").split()):
+                    missing.append(f"{top.prog} {' '.join(path)} {a.option_strings[0]}: no default shown")
+    assert missing == []

@@ -13,18 +13,31 @@ def register(sub) -> None:
         "source study.",
     )
     p.add_argument(
-        "--window-revs", type=float, default=4, help="measurement window [cage revolutions] (default 4)"
+        "--window-revs",
+        type=float,
+        default=4,
+        help="measurement window [cage revolutions] (default: %(default)g)",
     )
     p.add_argument(
         "--transient",
         action="store_true",
-        help="instead: one fixed-duration run per end type from the quasi-static start (--duration-ms)",
+        help="instead: one fixed-duration run per end type from the quasi-static start (--duration-ms) "
+        "(default: settled running from the skid start)",
     )
     p.add_argument(
-        "--duration-ms", type=float, default=20.0, help="with --transient: simulated time per end type [ms]"
+        "--duration-ms",
+        type=float,
+        default=20.0,
+        help="with --transient: simulated time per end type [ms] (default: %(default)g)",
     )
-    p.add_argument("--out", default="out/demo", help="output directory (default: out/demo)")
-    p.add_argument("--summary-only", action="store_true", help="only print the bearing summary")
+    p.add_argument(
+        "--out", default="out/demo", help="output directory, checked before the solve (default: %(default)s)"
+    )
+    p.add_argument(
+        "--summary-only",
+        action="store_true",
+        help="only print the bearing summary (default: summary, runs and outputs)",
+    )
     p.set_defaults(func=run)
 
 

@@ -23,8 +23,16 @@ def register(sub) -> None:
         "batch files that do not load are moved to DIR/batches/damaged/ and computed again.",
     )
     p.add_argument("spec", help="sweep spec (TOML: [sweep], [base], [axes])")
-    p.add_argument("--out", required=True, help="output directory")
-    p.add_argument("--batch-size", type=int, help="cases per vmapped batch (overrides the spec)")
+    p.add_argument(
+        "--out",
+        required=True,
+        help="output directory, checked before anything is computed (default: none; required)",
+    )
+    p.add_argument(
+        "--batch-size",
+        type=int,
+        help="cases per vmapped batch, overrides the spec (default: sweep.batch_size of the spec, 8 if unset)",
+    )
     p.add_argument(
         "--resume",
         action=argparse.BooleanOptionalAction,
@@ -33,17 +41,24 @@ def register(sub) -> None:
     )
     p.add_argument(
         "--coordinator",
-        help="jax.distributed coordinator HOST:PORT (process 0's address; env JAXBEARING_COORDINATOR)",
+        help="jax.distributed coordinator HOST:PORT, process 0's address (default: env "
+        "JAXBEARING_COORDINATOR; none: a single process)",
     )
-    p.add_argument("--num-processes", type=int, help="number of processes (env JAXBEARING_NUM_PROCESSES)")
     p.add_argument(
-        "--process-id", type=int, help="this process, 0..num-processes-1 (env JAXBEARING_PROCESS_ID)"
+        "--num-processes",
+        type=int,
+        help="number of processes (default: env JAXBEARING_NUM_PROCESSES, else 1)",
+    )
+    p.add_argument(
+        "--process-id",
+        type=int,
+        help="this process, 0..num-processes-1 (default: env JAXBEARING_PROCESS_ID, else 0)",
     )
     p.add_argument(
         "--wait-timeout-s",
         type=float,
         default=24 * 3600.0,
-        help="process 0: how long to wait for the other processes' batches",
+        help="process 0: how long to wait for the other processes' batches [s] (default: %(default)g)",
     )
     p.add_argument(
         "--wait-for-lock",
@@ -53,12 +68,13 @@ def register(sub) -> None:
         default=0.0,
         metavar="SECONDS",
         help="when another sweep is writing into DIR, wait for it "
-        "(up to SECONDS; no value: as long as it takes) instead of exiting with status 2",
+        "(up to SECONDS; no value: as long as it takes) instead of exiting with status 2 (default: do not wait)",
     )
     p.add_argument(
         "--dry-run",
         action="store_true",
-        help="validate the spec, list the axes and the number of cases and batches, compute nothing",
+        help="validate the spec, list the axes and the number of cases and batches, compute nothing "
+        "(default: run the sweep)",
     )
     p.add_argument(
         "--workers",
@@ -66,7 +82,7 @@ def register(sub) -> None:
         help="local worker processes that solve this process's batches (default: one per CPU on "
         "a CPU platform, 1 on an accelerator); results are bitwise the same for any number",
     )
-    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar (default: a progress bar)")
     p.set_defaults(func=run)
 
 

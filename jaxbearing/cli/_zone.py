@@ -35,6 +35,10 @@ def register(sub) -> None:
     p = sub.add_parser(
         "zone",
         help="roller-end/flange design zone: contact height, clearance, margins (Figure 14)",
+        description="Print the contact geometry of an aligned roller against its flange and each "
+        "design-zone margin (relief, contact-height limit, limited circle, actual axial clearance) "
+        "with OK/VIOLATED; with --map, draw the paper's Figure 14 maps. Exit status 3 when the "
+        "design is outside the design zone.",
     )
     p.add_argument("--config", help="TOML configuration (default: embedded reference bearing)")
     p.add_argument(
@@ -44,8 +48,16 @@ def register(sub) -> None:
         default=None,
         help="flange normal load for the contact-ellipse half-width [N] (default 100)",
     )
-    p.add_argument("--map", action="store_true", help="write the two design-zone maps (PNG)")
-    p.add_argument("--out", default=".", help="output directory for --map (default: .)")
+    p.add_argument(
+        "--map",
+        action="store_true",
+        help="write the two design-zone maps (PNG) into --out (default: no maps)",
+    )
+    p.add_argument(
+        "--out",
+        default=".",
+        help="output directory for --map, checked before the maps are computed (default: %(default)s)",
+    )
     p.set_defaults(func=run)
 
 
