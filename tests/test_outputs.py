@@ -47,8 +47,9 @@ def blocked(tmp_path):
         ["sweep", str(SPEC)],
         ["zone", "--map"],
         ["demo"],
+        ["plot", str(SPEC.parent)],
     ],
-    ids=["simulate", "sweep", "zone", "demo"],
+    ids=["simulate", "sweep", "zone", "demo", "plot"],
 )
 def test_jaxbearing_out_under_a_file_is_one_line_exit_2(command, blocked, capsys):
     assert jb_main([*command, "--out", str(blocked)]) == 2
