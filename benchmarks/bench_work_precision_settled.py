@@ -12,7 +12,7 @@ Protocol.
 1. Settled start states: per seed, the library's own settled run
    (`jaxbearing.run.simulate_steady`: skid start with its pre-start, settling detection over
    cage revolutions, then the smallest allowed window of 2 revolutions; default integrator, one
-   seed at a time in this process), and its `SeedRun.final_state`. They are pickled under
+   seed at a time in this process), and its `SeedRun.final_state`. They are kept (data-only `.npz`, `jaxbearing.io.save_tree`) under
    `CACHE_DIR` (one file per seed), so that a rerun does not repeat the settling.
 2. From each seed's settled state, a window of W = `WINDOW_REVS` cage revolutions (W =
    revolutions x 2 pi / the settled cage speed, the mean over seeds of the last settled
@@ -77,7 +77,6 @@ designs near their corner limit, which the design search visits. Results:
 from __future__ import annotations
 
 import math
-import pickle
 import sys
 import tempfile
 import time
@@ -227,10 +226,11 @@ def settled_start(bearing, op, seed: int, design: tuple | None = None) -> dict:
 
     rpm, load = float(jb.rad_s_to_rpm(op.inner_speed)), float(op.radial_load)
     stem = "reference" if design is None else "design" + design_label(design)
-    path = CACHE_DIR / f"{stem}_{rpm:.0f}rpm_{load:.0f}N_seed{seed}.pkl"
+    path = CACHE_DIR / f"{stem}_{rpm:.0f}rpm_{load:.0f}N_seed{seed}.npz"
+    from jaxbearing.io import load_tree, save_tree
+
     if path.exists():
-        with path.open("rb") as fh:
-            out = pickle.load(fh)
+        out = load_tree(path, what="settled state")
         out["info"]["cached"] = True
         return out
     _common.log(f"{NAME}: settling seed {seed} (simulate_steady, skid start)")
@@ -248,11 +248,7 @@ def settled_start(bearing, op, seed: int, design: tuple | None = None) -> dict:
         "compile_s": res.compile_time_s,
     }
     out = {"state": run.final_state, "info": info}
-    CACHE_DIR.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_suffix(".tmp")
-    with tmp.open("wb") as fh:
-        pickle.dump(out, fh)
-    tmp.replace(path)
+    save_tree(path, out)
     out["info"]["cached"] = False
     return out
 

@@ -1,7 +1,7 @@
 """`optimise` command line: `optimise run [...]`.
 
 Objectives: `--objective steady` (default; `_steady`: the mean flange PV of settled running,
-seeds, CIs, the dynamic corner margin, continuation, resume from DIR/checkpoint.pkl,
+seeds, CIs, the dynamic corner margin, continuation, resume from DIR/checkpoint.npz,
 verification on unseen seeds) and `--objective startup` (`_search`: the smooth peak PV of the
 first 0.3 ms from a seated start, the old transient objective: fast, but it measures how hard
 seated rollers are first driven onto their flanges, not how a design runs).
@@ -9,8 +9,11 @@ seated rollers are first driven onto their flanges, not how a design runs).
 Prints per-iteration progress (objective, smallest constraint margin and which, design of every
 start), the final design with its constraint status and the improvement over the starting
 design; writes DIR/result.json and DIR/search_paths.png (search paths over the design-zone
-feasibility map). Exit codes: 0 success, 2 bad input (one line on stderr), 3 no feasible
-design found (none in the bounds, or no iterate reached the zone).
+feasibility map), both with the configuration, settings, seeds and command line that produced
+them. Exit codes (`jaxbearing.cli.EXIT_CODES`): 0 success, 2 bad input or an unwritable --out
+(one line on stderr, before anything is computed; a start design with Lambda_bf < 0 is refused),
+3 no feasible design found (none in the bounds, or no iterate reached the zone), 4 the results
+could not be written to --out and were kept in the fallback directory printed.
 """
 
 from __future__ import annotations
@@ -44,99 +47,181 @@ def _pair(text: str | None, name: str):
     return v
 
 
+#: defaults of the search settings that are not `SteadySettings` fields (per objective where
+#: they differ); the help strings below and `problem_from_settings` both read them
+SEARCH_DEFAULTS = {
+    "starts": {"steady": 2, "startup": 4},
+    "iterations": {"steady": 6, "startup": 20},
+    "learning_rate": 0.08,
+    "rtol": 1e-3,
+    "atol": 1e-6,
+    "temperature_GPa_m_s": 0.1,
+    "min_clearance_mm": 0.0,
+    "aggregate": "max",
+    "objective": "steady",
+}
+OBJECTIVES = ("steady", "startup")
+AGGREGATES = ("max", "mean")
+
+
+def _range_text(pair, k: float) -> str:
+    return f"{pair[0] * k:g},{pair[1] * k:g}"
+
+
 def build_parser() -> argparse.ArgumentParser:
+    from jaxbearing.cli import exit_codes_text
+    from jaxbearing.flange import DEFAULT_FLANGE_LOAD
+
+    from ._problem import DEFAULT_DURATION, Bounds
+    from ._steady import ESTIMATORS, SteadySettings
+
+    st, b, d = SteadySettings(), Bounds(), SEARCH_DEFAULTS
+    mm, deg = 1e3, 180 / math.pi
     p = argparse.ArgumentParser(
         prog="optimise",
-        description="Gradient-based design of arc-end rollers and flanges: minimise the smooth "
-        "peak flange PV over R_end, layback angle and axial clearance inside the design zone.",
+        description="Gradient-based design of arc-end rollers and flanges: minimise the mean "
+        "flange PV of settled running (default; or the start-up peak PV with --objective startup) "
+        "over R_end, layback angle and axial clearance inside the design zone.",
+        epilog=exit_codes_text(),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     sub = p.add_subparsers(dest="command", metavar="COMMAND")
-    from jaxbearing.cli import exit_codes_text
 
     r = sub.add_parser(
         "run",
-        help="run the multi-start projected augmented-Lagrangian search",
+        help="run the multi-start projected augmented-Lagrangian design search",
         description="Search the roller-end/flange design (end radius R_end, layback angle "
-        "theta_f, axial clearance Delta_bf) that minimises the smooth peak flange PV of short "
-        "dynamic runs over an envelope of speeds and loads, inside the design zone (relief, "
-        "height limit, limited circle, actual axial clearance). Several starts run in parallel "
-        "(projected augmented Lagrangian with Adam, forward-mode gradients through the solve). "
-        "Writes DIR/result.json (strict JSON) and DIR/search_paths.png when the search ends; a "
-        "killed run writes nothing and leaves earlier results as they were.",
+        "theta_f, axial clearance Delta_bf) that minimises, by default (--objective steady), the "
+        "mean flange PV of settled running over seeds, with 95 % confidence intervals, inside the "
+        "static design zone (relief, height limit, limited circle, actual axial clearance) and a "
+        "dynamic corner margin; the best design is verified on unseen seeds. --objective startup "
+        "minimises the smooth peak PV of short start-up runs instead (fast, but it measures the "
+        "first impacts, not how a design runs). Several starts (projected augmented Lagrangian "
+        "with Adam). Writes DIR/result.json (strict JSON: design, history, the configuration, "
+        "settings, seeds and command that produced it) and DIR/search_paths.png; the steady "
+        "search checkpoints every iteration in DIR/checkpoint.npz and resumes from it. --out is "
+        "checked before anything is computed; results that cannot be written there go to a "
+        "fallback directory (exit status 4).",
         epilog=exit_codes_text(),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     r.add_argument(
         "--config",
-        help="jaxbearing TOML configuration (bearing and operating point; "
-        "default: the embedded reference bearing)",
+        help="jaxbearing TOML configuration (bearing and operating point) (default: the embedded "
+        "reference bearing)",
     )
     r.add_argument(
         "--bounds",
         dest="bounds_file",
-        help="optimiser TOML file with [bounds], "
-        "[constraints], [envelope], [search] sections (command-line options win)",
+        help="optimiser TOML file with [bounds], [constraints], [envelope], [search] sections; "
+        "command-line options win (default: none)",
     )
-    r.add_argument("--end-radius-mm", help="R_end bounds LO,HI [mm] (default 60,120)")
-    r.add_argument("--layback-deg", help="theta_f bounds LO,HI [deg] (default 1.0,2.0)")
-    r.add_argument("--clearance-mm", help="Delta_bf bounds LO,HI [mm] (default 0.10,0.30)")
     r.add_argument(
-        "--min-clearance-mm", type=float, help="required actual axial clearance Lambda_bf [mm] (default 0)"
+        "--end-radius-mm", help=f"R_end bounds LO,HI [mm] (default: {_range_text(b.end_radius, mm)})"
+    )
+    r.add_argument(
+        "--layback-deg", help=f"theta_f bounds LO,HI [deg] (default: {_range_text(b.layback_angle, deg)})"
+    )
+    r.add_argument(
+        "--clearance-mm", help=f"Delta_bf bounds LO,HI [mm] (default: {_range_text(b.axial_clearance, mm)})"
+    )
+    r.add_argument(
+        "--min-clearance-mm",
+        type=float,
+        help=f"required actual axial clearance Lambda_bf [mm] (default: {d['min_clearance_mm']:g})",
     )
     r.add_argument(
         "--flange-load-N",
         type=float,
-        help="flange load of the relief margin's contact ellipse [N] (default 100)",
+        help=f"flange load of the relief margin's contact ellipse [N] (default: {DEFAULT_FLANGE_LOAD:g})",
     )
     r.add_argument(
-        "--speeds-rpm", help="operating speeds, e.g. 5000,15000,30000 (default: the configuration's speed)"
+        "--speeds-rpm",
+        help="operating speeds, e.g. 5000,15000,30000 (default: the configuration's operating.speed_rpm)",
     )
-    r.add_argument("--loads-N", help="radial loads, e.g. 500,1000 (default: the configuration's)")
-    r.add_argument("--weights", help="weights of the operating points (speeds x loads, speed-major)")
+    r.add_argument(
+        "--loads-N", help="radial loads, e.g. 500,1000 (default: the configuration's operating.radial_load_N)"
+    )
+    r.add_argument(
+        "--weights", help="weights of the operating points (speeds x loads, speed-major) (default: equal)"
+    )
     r.add_argument(
         "--aggregate",
-        choices=("max", "mean"),
-        help="robust objective: smooth worst case (max, default) or weighted mean",
+        choices=AGGREGATES,
+        help=f"robust objective over the operating points: smooth worst case (max) or weighted mean "
+        f"(default: {d['aggregate']})",
     )
     r.add_argument(
         "--objective",
-        help="steady (default): mean flange PV of settled running over seeds, verified on unseen "
-        "seeds; startup: the old transient objective (smooth peak PV of the first 0.3 ms)",
+        metavar="{" + ",".join(OBJECTIVES) + "}",  # checked by the code: one-line errors
+        help="steady: mean flange PV of settled running over seeds, verified on unseen seeds; "
+        f"startup: smooth peak PV of the first {DEFAULT_DURATION * 1e3:g} ms (default: {d['objective']})",
     )
-    r.add_argument("--starts", type=int, help="number of starts (default 2 steady, 4 startup)")
-    r.add_argument("--iterations", type=int, help="iterations (default 6 steady, 20 startup)")
-    r.add_argument("--learning-rate", type=float, help="Adam step size in scaled units (default 0.08)")
-    r.add_argument("--seeds", type=int, help="steady: seeds per evaluation (default 4)")
-    r.add_argument("--window-revs", type=int, help="steady: cage revolutions measured (default 2)")
-    r.add_argument("--settle", help="steady: auto (default) or a fixed settling time in ms before the window")
+    r.add_argument(
+        "--starts",
+        type=int,
+        help=f"number of starts (default: {d['starts']['steady']} steady, {d['starts']['startup']} startup)",
+    )
+    r.add_argument(
+        "--iterations",
+        type=int,
+        help=f"iterations (default: {d['iterations']['steady']} steady, {d['iterations']['startup']} startup)",
+    )
+    r.add_argument(
+        "--learning-rate",
+        type=float,
+        help=f"Adam step size in scaled units (default: {d['learning_rate']:g})",
+    )
+    r.add_argument("--seeds", type=int, help=f"steady: seeds per evaluation (default: {st.seeds})")
+    r.add_argument(
+        "--window-revs", type=int, help=f"steady: cage revolutions measured (default: {st.window_revs})"
+    )
+    r.add_argument(
+        "--settle",
+        help=f'steady: "auto" or a fixed settling time in ms before the window (default: {st.settle})',
+    )
     r.add_argument(
         "--gradient-window-ms",
         type=float,
-        help="steady: length of the short-window sensitivities [ms] (default 1.0)",
+        help=f"steady: length of the short-window sensitivities [ms] (default: {st.gradient_window * 1e3:g})",
     )
     r.add_argument(
         "--estimator",
-        help="steady: gradient estimator, frozen-load (default) or short-window forward mode",
+        metavar="{" + ",".join(ESTIMATORS) + "}",  # checked by `SteadySettings`: one-line errors
+        help="steady: gradient estimator, frozen (frozen-load estimate from the settled states) or "
+        f"window (short-window forward-mode sensitivities) (default: {st.estimator})",
     )
     r.add_argument(
         "--corner-margin-mm",
         type=float,
-        help="steady: the largest contact radius this far inside the limited circle (default 0.05)",
+        help="steady: the largest contact radius this far inside the limited circle [mm] "
+        f"(default: {st.corner_margin * mm:g})",
     )
-    r.add_argument("--verify-seeds", type=int, help="steady: unseen seeds of the verification (default 4)")
-    r.add_argument("--no-verify", action="store_true", help="steady: skip the verification")
-    r.add_argument("--workers", type=int, help="steady: processes (default: one per CPU)")
     r.add_argument(
-        "--duration-ms", type=float, help="startup: simulated time per evaluation [ms] (default 0.3)"
+        "--verify-seeds",
+        type=int,
+        help=f"steady: unseen seeds of the verification (default: {st.verify_seeds})",
     )
-    r.add_argument("--rtol", type=float, help="solver rtol (default 1e-3)")
+    r.add_argument("--no-verify", action="store_true", help="steady: skip the verification (default: verify)")
+    r.add_argument(
+        "--workers",
+        type=int,
+        help=f"steady: processes; 0 = one per CPU (default: {st.workers}, one per CPU)",
+    )
+    r.add_argument(
+        "--duration-ms",
+        type=float,
+        help=f"startup: simulated time per evaluation [ms] (default: {DEFAULT_DURATION * 1e3:g})",
+    )
+    r.add_argument("--rtol", type=float, help=f"solver rtol (default: {d['rtol']:g})")
     r.add_argument(
         "--atol",
         type=float,
-        help="solver atol on the scaled state (default 1e-6: 10 nm, 10 um/s, 0.01 rad/s)",
+        help=f"startup: solver atol on the scaled state, {d['atol']:g} = 10 nm, 10 um/s, 0.01 rad/s "
+        f"(default: {d['atol']:g})",
     )
-    r.add_argument("--out", default="optimise_out", help="output directory (default optimise_out)")
-    r.add_argument("--quiet", action="store_true", help="no per-iteration progress")
+    r.add_argument("--out", default="optimise_out", help="output directory (default: %(default)s)")
+    r.add_argument("--quiet", action="store_true", help="no per-iteration progress (default: progress shown)")
     r.set_defaults(func=run)
     return p
 
@@ -204,24 +289,25 @@ def problem_from_settings(bearing, op, s: dict):
         weights=s.get("weights"),
         duration=_positive(s, "duration_ms", DEFAULT_DURATION * 1e3) * 1e-3,
         flange_load=_positive(s, "flange_load_N", 100.0),
-        min_clearance=_positive(s, "min_clearance_mm", 0.0, strict=False) * 1e-3,
-        aggregate=s.get("aggregate", "max"),
-        temperature=_positive(s, "temperature_GPa_m_s", 0.1),
-        rtol=_positive(s, "rtol", 1e-3),
-        atol=_positive(s, "atol", 1e-6),
+        min_clearance=_positive(s, "min_clearance_mm", SEARCH_DEFAULTS["min_clearance_mm"], strict=False)
+        * 1e-3,
+        aggregate=s.get("aggregate", SEARCH_DEFAULTS["aggregate"]),
+        temperature=_positive(s, "temperature_GPa_m_s", SEARCH_DEFAULTS["temperature_GPa_m_s"]),
+        rtol=_positive(s, "rtol", SEARCH_DEFAULTS["rtol"]),
+        atol=_positive(s, "atol", SEARCH_DEFAULTS["atol"]),
     )
-    steady = objective_of(s) == "steady"
+    objective = objective_of(s)
     options = dict(
-        num_starts=int(_positive(s, "starts", 2 if steady else 4, int)),
-        num_iterations=int(_positive(s, "iterations", 6 if steady else 20, int)),
-        learning_rate=_positive(s, "learning_rate", 0.08),
+        num_starts=int(_positive(s, "starts", SEARCH_DEFAULTS["starts"][objective], int)),
+        num_iterations=int(_positive(s, "iterations", SEARCH_DEFAULTS["iterations"][objective], int)),
+        learning_rate=_positive(s, "learning_rate", SEARCH_DEFAULTS["learning_rate"]),
     )
     return problem, options
 
 
 def objective_of(s: dict) -> str:
-    objective = s.get("objective", "steady")
-    if objective not in ("steady", "startup"):
+    objective = s.get("objective", SEARCH_DEFAULTS["objective"])
+    if objective not in OBJECTIVES:
         raise UserInputError(f"objective = {objective!r}: must be 'steady' or 'startup'")
     return objective
 
@@ -230,19 +316,20 @@ def steady_settings_from(s: dict):
     """SteadySettings from merged settings (engineering units)."""
     from ._steady import SteadySettings
 
-    settle = s.get("settle", "auto")
+    st = SteadySettings()
+    settle = s.get("settle", st.settle)
     if settle != "auto":
         settle = _positive({"settle": settle}, "settle", 0.0, strict=False)
     return SteadySettings(
-        seeds=int(_positive(s, "seeds", 4, int)),
-        window_revs=int(_positive(s, "window_revs", 2, int)),
+        seeds=int(_positive(s, "seeds", st.seeds, int)),
+        window_revs=int(_positive(s, "window_revs", st.window_revs, int)),
         settle=settle,
-        gradient_window=_positive(s, "gradient_window_ms", 1.0) * 1e-3,
-        estimator=s.get("estimator", "frozen"),
-        corner_margin=_positive(s, "corner_margin_mm", 0.05, strict=False) * 1e-3,
-        rtol=_positive(s, "rtol", 1e-3),
-        workers=int(_positive(s, "workers", 0, int, strict=False)),
-        verify_seeds=int(_positive(s, "verify_seeds", 4, int)),
+        gradient_window=_positive(s, "gradient_window_ms", st.gradient_window * 1e3) * 1e-3,
+        estimator=s.get("estimator", st.estimator),
+        corner_margin=_positive(s, "corner_margin_mm", st.corner_margin * 1e3, strict=False) * 1e-3,
+        rtol=_positive(s, "rtol", SEARCH_DEFAULTS["rtol"]),
+        workers=int(_positive(s, "workers", st.workers, int, strict=False)),
+        verify_seeds=int(_positive(s, "verify_seeds", st.verify_seeds, int)),
     )
 
 
@@ -285,7 +372,7 @@ def run(args) -> int:
 
     from jaxbearing import load_config
     from jaxbearing.flange import MARGIN_NAMES
-    from jaxbearing.io import write_json
+    from jaxbearing.io import check_output_dir, plausibility_warnings
 
     from ._plot import plot_search
     from ._search import search
@@ -297,14 +384,21 @@ def run(args) -> int:
     bearing, op = cfg.bearing(), cfg.operating_point()
     s = _settings(args)
     problem, options = problem_from_settings(bearing, op, s)
+    steady = steady_settings_from(s) if objective_of(s) == "steady" else None
+    # every input is checked before --out is made, so a rejected command leaves no directory
+    check_output_dir(args.out, "--out")
+    for line in plausibility_warnings(cfg):
+        print(f"warning: {line}", file=sys.stderr)
+    check_start_design(cfg, problem)
     out = pathlib.Path(args.out)
     try:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise UserInputError(f"--out {args.out}: cannot create directory: {exc.strerror}") from None
+    meta = _provenance(cfg, s, steady)
 
-    if objective_of(s) == "steady":
-        return run_steady(args, problem, options, steady_settings_from(s), out)
+    if steady is not None:
+        return run_steady(args, problem, options, steady, out, meta)
     k = problem.num_operating_points
     print(
         f"optimise: {options['num_starts']} starts x {k} operating point(s), "
@@ -322,10 +416,11 @@ def run(args) -> int:
     progress = _progress(args.quiet, start_line)
 
     res = search(problem, callback=progress, **options)
-    result = _result_json(problem, options, res)
-    write_json(out / "result.json", result)
+    result = {**_result_json(problem, options, res), **meta}
+    out, saved = _write_results(args.out, result, lambda d: plot_search(problem, res, d / "search_paths.png"))
+    if saved:
+        return saved
     plot_path = out / "search_paths.png"
-    plot_search(problem, res, plot_path)
 
     print(f"start design: {_design_text(res.start_design)}")
     print(f"  margins: {_margin_text(res.start_margins)}")
@@ -362,14 +457,69 @@ def run(args) -> int:
     return 0
 
 
-def run_steady(args, problem, options, settings, out) -> int:
+def check_start_design(cfg, problem) -> None:
+    """Refuse, in one line naming the keys, a start design whose actual axial clearance
+    Lambda_bf is negative (the rollers do not fit between the flanges: no run of it means
+    anything, and the search would start from a jammed bearing)."""
+    from jaxbearing.flange import design_zone
+
+    bearing = cfg.bearing()
+    lam = float(design_zone(bearing, problem.flange_load).actual_axial_clearance)
+    if not lam >= 0:
+        raise UserInputError(
+            f"flange.axial_clearance_mm = {cfg['flange.axial_clearance_mm']:g} mm with "
+            f"roller.end_radius_mm = {cfg['roller.end_radius_mm']:g} mm and flange.layback_angle_deg = "
+            f"{cfg['flange.layback_angle_deg']:g} deg: the start design's actual axial clearance "
+            f"Lambda_bf = {lam * 1e3:+.4f} mm is negative (the rollers do not fit between the "
+            "flanges); start from a design with Lambda_bf >= 0 (see `jaxbearing zone`)"
+        )
+
+
+def _provenance(cfg, s: dict, steady) -> dict:
+    """What produced result.json (`jaxbearing.io.provenance`): version, command line, the full
+    configuration in engineering units, the merged optimiser settings, the seeds; and the unit
+    convention of its keys."""
+    from jaxbearing.io import provenance
+
+    seeds = None
+    if steady is not None:
+        seeds = {
+            "search": list(range(steady.seeds)),
+            "verification": list(
+                range(steady.verify_first_seed, steady.verify_first_seed + steady.verify_seeds)
+            ),
+        }
+    else:
+        seeds = {"search": [0]}  # every evaluation starts from Perturbation(seed=0)
+    meta = provenance(cfg, seeds=seeds)
+    meta["optimiser_settings"] = dict(s)
+    meta["units"] = (
+        "in each key's suffix: _mm, _deg, _N, _rpm, _ms, _s, _GPa_m_s (GPa m/s), _Pa_m_s; "
+        "margins in mm; design variables R_end [mm], theta_f [deg], Delta_bf [mm]; others dimensionless"
+    )
+    return meta
+
+
+def _write_results(out, result: dict, plot) -> tuple[pathlib.Path, int]:
+    """result.json and the plot into `out`, or into a fallback directory when that fails:
+    (the directory used, 0 or `EXIT_RESULTS_ELSEWHERE` after one line naming it)."""
+    from jaxbearing.cli import report_fallback
+    from jaxbearing.io import write_json, write_or_fallback
+
+    def write(d):
+        write_json(d / "result.json", result)
+        plot(d)
+
+    used, reason = write_or_fallback(out, write)
+    return used, report_fallback("optimise run", out, used, reason)
+
+
+def run_steady(args, problem, options, settings, out, meta=None) -> int:
     """`optimise run --objective steady` (the default): `_steady.steady_search` with progress,
     checkpoint and resume in `out`, verification, result.json and the search-path plot."""
 
-    from jaxbearing.io import write_json
-
     from ._plot import plot_search
-    from ._steady import CONSTRAINT_NAMES, steady_search
+    from ._steady import CHECKPOINT, CONSTRAINT_NAMES, steady_search
 
     k = problem.num_operating_points
     print(
@@ -395,10 +545,12 @@ def run_steady(args, problem, options, settings, out) -> int:
         problem, settings, directory=out, callback=progress, verify=not args.no_verify, **options
     )
     if res.resumed_from >= 0 and not args.quiet:
-        print(f"(resumed after iteration {res.resumed_from} from {out / 'checkpoint.pkl'})")
-    write_json(out / "result.json", _steady_result_json(problem, options, settings, res))
+        print(f"(resumed after iteration {res.resumed_from} from {out / CHECKPOINT})")
+    result = {**_steady_result_json(problem, options, settings, res), **(meta or {})}
+    out, saved = _write_results(out, result, lambda d: plot_search(problem, res, d / "search_paths.png"))
+    if saved:
+        return saved
     plot_path = out / "search_paths.png"
-    plot_search(problem, res, plot_path)
     if res.status != "ok":
         print(
             "optimise: no feasible design within the bounds"

@@ -209,7 +209,7 @@ def load_optimise_toml(path: str) -> dict:
             data = tomllib.load(f)
     except OSError as exc:
         raise UserInputError(f"optimise file {path}: cannot read: {exc.strerror or exc}") from None
-    except tomllib.TOMLDecodeError as exc:
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise UserInputError(f"optimise file {path}: invalid TOML: {exc}") from None
     out = {}
     for section, table in data.items():
@@ -223,8 +223,53 @@ def load_optimise_toml(path: str) -> dict:
                     f"optimise file {path}: unknown key {section}.{key} "
                     f"(valid: {', '.join(OPTIMISE_TOML_KEYS[section])})"
                 )
-            out[key] = value
+            out[key] = _checked_toml_value(path, f"{section}.{key}", key, value)
     return out
+
+
+_PAIRS = ("end_radius_mm", "layback_angle_deg", "axial_clearance_mm")
+_LISTS = ("speeds_rpm", "loads_N", "weights")
+_TEXTS = ("aggregate", "objective", "estimator")
+_INTS = ("starts", "iterations", "seeds", "window_revs", "verify_seeds", "workers")
+#: most values of an envelope list
+_MAX_LIST = 1000
+
+
+def _is_number(v) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool)
+
+
+def _checked_toml_value(path, name: str, key: str, value):
+    """The value of one optimiser-file key, of the right type (ranges are checked where the
+    settings are used); one-line UserInputError naming the file and key otherwise."""
+
+    def bad(expected: str):
+        return UserInputError(f"optimise file {path}: {name} = {value!r}: expected {expected}")
+
+    if key in _PAIRS:
+        if not (isinstance(value, list) and len(value) == 2 and all(_is_number(v) for v in value)):
+            raise bad("[lower, upper] (two numbers)")
+        if not all(math.isfinite(v) for v in value):
+            raise bad("two finite numbers")
+    elif key in _LISTS:
+        if not (
+            isinstance(value, list) and 1 <= len(value) <= _MAX_LIST and all(_is_number(v) for v in value)
+        ):
+            raise bad(f"a list of 1 to {_MAX_LIST} numbers")
+        if not all(math.isfinite(v) for v in value):
+            raise bad("finite numbers")
+    elif key in _TEXTS:
+        if not isinstance(value, str):
+            raise bad("a string")
+    elif key in _INTS:
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise bad("an integer")
+    elif key == "settle":
+        if value != "auto" and not _is_number(value):
+            raise bad('"auto" or a settling time in ms')
+    elif not _is_number(value):
+        raise bad("a number")
+    return value
 
 
 def operating_envelope(

@@ -32,7 +32,9 @@ minimum two revolutions instead of from the skid start.
 
 Resume. After every iteration the whole search state (iterates, optimiser and multiplier
 states, continuation states, history, best design) is written atomically to
-DIR/checkpoint.pkl; a killed run started again with the same settings continues from its last
+DIR/checkpoint.npz (data only: `jaxbearing.io.save_tree`, checked for type and shape against a
+fresh state when read back; a `checkpoint.pkl` of an older version is refused, never
+unpickled); a killed run started again with the same settings continues from its last
 finished iteration and reaches the same result (the runs are deterministic per seed and state).
 
 Verification. The best feasible design and the start design are re-simulated from the skid
@@ -48,7 +50,6 @@ import dataclasses
 import functools
 import hashlib
 import pathlib
-import pickle
 import time
 from collections.abc import Callable
 
@@ -59,7 +60,7 @@ import optax
 
 from jaxbearing import UserInputError
 from jaxbearing.flange import MARGIN_NAMES, DesignVariables
-from jaxbearing.io import atomic_write, require
+from jaxbearing.io import TreeFileError, check_like, load_tree, require, save_tree
 from jaxbearing.run import (
     CORNER_MARGIN,
     SteadyGradient,
@@ -75,7 +76,9 @@ from ._search import _Hyper, start_points
 
 #: names of the five constraints of the steady search (static zone margins, then dynamic)
 CONSTRAINT_NAMES = (*MARGIN_NAMES, "dynamic_corner")
-CHECKPOINT = "checkpoint.pkl"
+CHECKPOINT = "checkpoint.npz"
+#: the name of the pickled checkpoints of older versions: refused, never loaded
+LEGACY_CHECKPOINT = "checkpoint.pkl"
 #: version of the measured objective and margins, part of a checkpoint's fingerprint: a
 #: checkpoint of an older definition (2: the dynamic corner margin on the largest contact
 #: radius instead of the p99) is refused, not resumed
@@ -367,14 +370,16 @@ def steady_search(
     path = None if directory is None else pathlib.Path(directory) / CHECKPOINT
     key = _fingerprint(problem, settings, hyper, u)
     resumed = -1
+    if path is not None:
+        _refuse_legacy(path.with_name(LEGACY_CHECKPOINT))
     if path is not None and path.exists():
         saved = _load_checkpoint(path)
-        if saved.get("fingerprint") != key:
+        if not isinstance(saved, dict) or saved.get("fingerprint") != key:
             raise UserInputError(
                 f"{path}: a checkpoint of a search with other settings; remove it or choose "
                 "another --out to start afresh"
             )
-        state = saved["state"]
+        state = _checked_state(path, saved.get("state"), state, num_iterations)
         resumed = state["iteration"]
     for it in range(state["iteration"] + 1, num_iterations + 1):
         rows = {k: [] for k in empty}
@@ -464,16 +469,53 @@ def steady_search(
 
 
 def _save_checkpoint(path: pathlib.Path, key: str, state: dict) -> None:
-    blob = pickle.dumps({"fingerprint": key, "state": jax.tree_util.tree_map(np.asarray, state)})
-    atomic_write(path, lambda f: f.write(blob))
+    """The search state, data only (`jaxbearing.io.save_tree`: `.npz` and JSON), atomically."""
+    save_tree(path, {"fingerprint": key, "state": jax.tree_util.tree_map(np.asarray, state)})
 
 
 def _load_checkpoint(path: pathlib.Path) -> dict:
+    """A checkpoint written by `_save_checkpoint`; one line naming the file for anything else
+    (a pickle is refused, never unpickled)."""
     try:
-        with open(path, "rb") as f:
-            return pickle.load(f)
-    except (OSError, pickle.UnpicklingError, EOFError, AttributeError) as exc:
-        raise UserInputError(f"{path}: unreadable checkpoint ({exc}); remove it to start afresh") from None
+        return load_tree(path, what="checkpoint")
+    except TreeFileError as exc:
+        raise UserInputError(f"{exc}; remove it to start afresh") from None
+
+
+def _refuse_legacy(path: pathlib.Path) -> None:
+    if path.exists():
+        raise UserInputError(
+            f"{path}: a pickled checkpoint of an older version (not loaded: a pickle can run "
+            "code); remove it to start afresh"
+        )
+
+
+def _checked_state(path: pathlib.Path, state, template: dict, num_iterations: int) -> dict:
+    """`state` read from a checkpoint, checked for type and shape against a fresh `template`."""
+
+    def bad(why: str):
+        return UserInputError(f"{path}: not a checkpoint of this search ({why}); remove it to start afresh")
+
+    if not isinstance(state, dict) or set(state) != set(template):
+        raise bad("its fields differ")
+    it = state["iteration"]
+    it = int(it) if np.ndim(it) == 0 and np.asarray(it).dtype.kind in "iu" else None
+    if it is None or not -1 <= it <= num_iterations:
+        raise bad(f"iteration {state['iteration']!r}")
+    state["iteration"] = it
+    check_like(state["u"], template["u"], path, "checkpoint")
+    check_like(state["lam"], template["lam"], path, "checkpoint")
+    check_like(state["opt"], jax.tree_util.tree_map(np.asarray, template["opt"]), path, "checkpoint")
+    chains, history = state["chains"], state["history"]
+    if not isinstance(chains, list) or len(chains) != len(template["chains"]):
+        raise bad("continuation states")
+    if not isinstance(history, dict) or set(history) != set(template["history"]):
+        raise bad("history")
+    if any(not isinstance(v, list) or len(v) != it + 1 for v in history.values()):
+        raise bad("history length")
+    if not isinstance(state["best"], tuple) or len(state["best"]) != 5:
+        raise bad("best design")
+    return state
 
 
 def _estimates(m) -> dict:
@@ -552,7 +594,7 @@ def steady_grid(
     statically feasible points in a serpentine order, each continuing from the previous point's
     settled states (the first from the skid start). The best point is the lowest objective
     among those with every static and dynamic margin positive. With `directory`, every finished
-    point is kept in DIR/grid_checkpoint.pkl and a rerun resumes."""
+    point is kept in DIR/grid_checkpoint.npz (data only) and a rerun resumes."""
     t0 = time.perf_counter()
     lo, hi = problem.bounds.lower, problem.bounds.upper
     r = np.linspace(lo[0], hi[0], n_end_radius)
@@ -560,8 +602,15 @@ def steady_grid(
     order = [
         (i, j if i % 2 == 0 else n_layback - 1 - j) for i in range(n_end_radius) for j in range(n_layback)
     ]
-    path = None if directory is None else pathlib.Path(directory) / "grid_checkpoint.pkl"
-    done = _load_checkpoint(path)["state"] if path is not None and path.exists() else {}
+    path = None if directory is None else pathlib.Path(directory) / "grid_checkpoint.npz"
+    if path is not None:
+        _refuse_legacy(path.with_name("grid_checkpoint.pkl"))
+    done = (
+        _load_checkpoint(path) if path is not None and path.exists() else {"fingerprint": "grid", "state": {}}
+    )
+    done = done.get("state") if isinstance(done, dict) and done.get("fingerprint") == "grid" else None
+    if not isinstance(done, dict):
+        raise UserInputError(f"{path}: not a grid checkpoint; remove it to start afresh")
     objective = np.full((n_end_radius, n_layback), np.nan)
     ci = np.full((n_end_radius, n_layback, 2), np.nan)
     dynamic = np.full((n_end_radius, n_layback), np.nan)

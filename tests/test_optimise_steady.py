@@ -118,6 +118,11 @@ def test_killed_run_resumes_with_the_same_result(tmp_path, config, monkeypatch, 
     assert main(["run", "--config", config, *args, "--no-verify", "--out", str(whole)]) == 0
     r1, j1, x1 = _history(whole)
     assert r1["objective_kind"] == "steady" and r1["status"] == "ok" and r1["resumed_from_iteration"] == -1
+    # self-describing (issue 38): version, command line, configuration, settings, seeds, units
+    assert r1["jaxbearing_version"] and r1["command"][:2] == ["optimise", "run"]
+    assert r1["config"]["bearing"]["num_slices"] == 11 and "config_toml" in r1
+    assert r1["seeds"]["search"] == [0, 1] and r1["seeds"]["verification"] == [1000, 1001, 1002, 1003]
+    assert r1["optimiser_settings"]["seeds"] == 2 and "units" in r1
     assert j1.shape == (3, 1) and np.all(np.isfinite(j1)) and np.all(j1 > 0)
     assert np.all(np.isfinite(np.asarray(r1["history"]["gradient_per_unit_box"])))
     lo, hi = r1["objective_GPa_m_s"]["ci95_low"], r1["objective_GPa_m_s"]["ci95_high"]
@@ -137,7 +142,7 @@ def test_killed_run_resumes_with_the_same_result(tmp_path, config, monkeypatch, 
     monkeypatch.setattr(steady, "evaluate", dying)
     # the command line reports the interruption (exit code 130) and writes no result
     assert main(["run", "--config", config, *args, "--no-verify", "--out", str(killed)]) == 130
-    assert (killed / "checkpoint.pkl").exists() and not (killed / "result.json").exists()
+    assert (killed / "checkpoint.npz").exists() and not (killed / "result.json").exists()
     monkeypatch.setattr(steady, "evaluate", evaluate)
     assert main(["run", "--config", config, *args, "--no-verify", "--out", str(killed)]) == 0
     assert "resumed after iteration 0" in capsys.readouterr().out
@@ -215,7 +220,7 @@ def test_grid_picks_the_best_point_inside_every_margin_and_resumes(tmp_path, con
     """`steady_grid` on the stand-in ensemble: only statically feasible points are evaluated,
     each continuing from the previous one (serpentine order), the best point is the lowest
     objective whose dynamic margin is positive too, and a rerun takes every point from
-    DIR/grid_checkpoint.pkl without evaluating again."""
+    DIR/grid_checkpoint.npz without evaluating again."""
     import jaxbearing as jb
     from optimise import make_problem
 

@@ -18,7 +18,7 @@ worse than the grid's best within CI, at fewer solve-equivalents (simulated ms);
 run's wall time under 15 minutes on 2 cores.
 
 Results: benchmarks/results/bench_optimise_steady.json. Both stages resume after a kill (the
-search from its checkpoint, the grid from out/bench_optimise_steady/grid/grid_checkpoint.pkl).
+search from its checkpoint, the grid from out/bench_optimise_steady/grid/grid_checkpoint.npz).
 """
 
 from __future__ import annotations

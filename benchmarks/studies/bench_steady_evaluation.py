@@ -1,7 +1,7 @@
 """One evaluation of the steady design search, timed: ``python benchmarks/studies/bench_steady_evaluation.py``.
 
 From the settled states of start 0 of the default `optimise run` (its checkpoint,
-out/bench_optimise_steady/run/checkpoint.pkl, written by `benchmarks/studies/bench_optimise_steady.py`):
+out/bench_optimise_steady/run/checkpoint.npz, written by `benchmarks/studies/bench_optimise_steady.py`):
 `steady_design_metrics` (4 seeds, the run's, settle auto, 2-revolution window; continuation) then
 `frozen_load_gradient` (8 x 1 ms), on 2 workers, twice in a row (the second call is the one a
 search iteration pays once compiled), first with a process pool per call, then inside one
@@ -14,7 +14,6 @@ benchmarks/results/bench_steady_evaluation.json.
 from __future__ import annotations
 
 import pathlib
-import pickle
 import sys
 import time
 
@@ -26,9 +25,9 @@ import _common  # noqa: E402
 
 NAME = "bench_steady_evaluation"
 _RUNS = pathlib.Path(__file__).resolve().parents[2] / "out" / "bench_optimise_steady"
-CHECKPOINT = _RUNS / "run" / "checkpoint.pkl"
+CHECKPOINT = _RUNS / "run" / "checkpoint.npz"
 #: `--quick` without the full run's checkpoint: that of `bench_optimise_steady.py --quick`
-QUICK_CHECKPOINT = _RUNS / "run_quick" / "checkpoint.pkl"
+QUICK_CHECKPOINT = _RUNS / "run_quick" / "checkpoint.npz"
 WORKERS = 2
 
 
@@ -76,8 +75,9 @@ def main(quick: bool = False) -> dict:
             f"{checkpoint}: missing; run benchmarks/studies/bench_optimise_steady.py"
             f"{' --quick' if quick else ''} first"
         )
-    with open(checkpoint, "rb") as f:
-        state = pickle.load(f)["state"]
+    from jaxbearing.io import load_tree
+
+    state = load_tree(checkpoint, what="checkpoint")["state"]
     problem = make_problem(jb.reference_bearing(), jb.reference_operating_point())
     u, chain = state["u"][0], state["chains"][0][0]
     repeats = 1 if quick else 2

@@ -34,7 +34,6 @@ from __future__ import annotations
 import json
 import math
 import pathlib
-import pickle
 import sys
 import time
 
@@ -65,17 +64,15 @@ WORKERS = 2
 
 
 def _cached(key: str, compute):
-    """compute() once; its result pickled in STATE_DIR (resume after a kill)."""
-    path = STATE_DIR / f"{key}.pkl"
+    """compute() once; its result kept in STATE_DIR as data (`jaxbearing.io.save_tree`, an
+    `.npz`, never a pickle) for a resume after a kill."""
+    from jaxbearing.io import load_tree, save_tree
+
+    path = STATE_DIR / f"{key}.npz"
     if path.exists():
-        with open(path, "rb") as f:
-            return pickle.load(f)
+        return load_tree(path, what="benchmark state")
     value = compute()
-    STATE_DIR.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_suffix(".tmp")
-    with open(tmp, "wb") as f:
-        pickle.dump(value, f)
-    tmp.replace(path)
+    save_tree(path, value)
     return value
 
 
@@ -318,7 +315,7 @@ def replicate_clearance(first_seed: int = REPLICATE_FIRST_SEED) -> dict:
     from jaxbearing.flange import DesignVariables
     from jaxbearing.run import frozen_load_gradient
 
-    if not (STATE_DIR / f"full_{REPLICATE}_axial_clearance_plus.pkl").exists():
+    if not (STATE_DIR / f"full_{REPLICATE}_axial_clearance_plus.npz").exists():
         raise SystemExit(f"{STATE_DIR}: the first study's runs are missing; run the full study first")
     first = _results()["designs"][REPLICATE]["central_difference"]["axial_clearance"]
     bearing, op = jb.reference_bearing(), jb.reference_operating_point()

@@ -32,7 +32,6 @@ from __future__ import annotations
 
 import math
 import pathlib
-import pickle
 import sys
 import time
 
@@ -86,11 +85,12 @@ def kept_runs() -> dict:
     for batch, seeds in (("full", "0-7"), ("rep8", "8-15")):
         runs = {}
         for part in ("base", "axial_clearance_plus", "axial_clearance_minus"):
-            path = KEPT / f"{batch}_R100_t1.4_{part}.pkl"
+            path = KEPT / f"{batch}_R100_t1.4_{part}.npz"
             if not path.exists():
                 return {"missing": str(path)}
-            with open(path, "rb") as f:
-                r = pickle.load(f)
+            from jaxbearing.io import load_tree
+
+            r = load_tree(path, what="benchmark state")
             ax = np.array([np.asarray(s.rollers.axial) for s in r["final"]]) * 1e6
             runs[part] = dict(
                 roller_mean_um=ax.mean(1).round(2).tolist(),

@@ -20,7 +20,12 @@ def register(sub) -> None:
         "and valid range) or check configuration files.",
     )
     cmds = p.add_subparsers(dest="config_command", metavar="ACTION", required=True)
-    show = cmds.add_parser("show", help="print the full configuration as commented TOML")
+    show = cmds.add_parser(
+        "show",
+        help="print the full configuration as commented TOML",
+        description="Print every key of the configuration (the file merged over the reference) as "
+        "TOML with a comment per key: meaning, symbol, unit and valid range.",
+    )
     show.add_argument(
         "--config",
         metavar="FILE",
@@ -28,7 +33,13 @@ def register(sub) -> None:
         help="configuration file to merge over the reference (default: reference)",
     )
     show.set_defaults(func=run_show)
-    check = cmds.add_parser("check", help="validate configuration files")
+    check = cmds.add_parser(
+        "check",
+        help="validate configuration files",
+        description="Check each file as `jaxbearing simulate --config FILE` would run it: every "
+        "key's type and range, then what a run needs; one line per error (exit 2) and one "
+        "warning line per valid value that looks like a unit slip.",
+    )
     check.add_argument("files", metavar="FILE", nargs="+", help="TOML configuration file(s)")
     check.set_defaults(func=run_check)
 
@@ -48,17 +59,21 @@ def run_show(args) -> int:
 
 def run_check(args) -> int:
     """Each file as `jaxbearing simulate --config FILE` would run it (without options): the
-    ranges of every key, then `check_runnable` (one code path with `simulate`)."""
+    ranges of every key, then `check_runnable` (one code path with `simulate`); valid values
+    that look like a unit slip are warned about (`plausibility_warnings`), one line each."""
     from .._errors import ConfigError
-    from ..io import check_runnable, load_config
+    from ..io import check_runnable, load_config, plausibility_warnings
 
     status = 0
     for path in args.files:
         try:
-            check_runnable(load_config(path))
+            cfg = load_config(path)
+            check_runnable(cfg)
         except ConfigError as exc:
             print(f"{path}: {exc}", file=sys.stderr)
             status = 2
         else:
+            for line in plausibility_warnings(cfg):
+                print(f"{path}: warning: {line}", file=sys.stderr)
             print(f"{path}: ok")
     return status

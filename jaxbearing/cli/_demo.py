@@ -13,18 +13,31 @@ def register(sub) -> None:
         "source study.",
     )
     p.add_argument(
-        "--window-revs", type=float, default=4, help="measurement window [cage revolutions] (default 4)"
+        "--window-revs",
+        type=float,
+        default=4,
+        help="measurement window [cage revolutions] (default: %(default)g)",
     )
     p.add_argument(
         "--transient",
         action="store_true",
-        help="instead: one fixed-duration run per end type from the quasi-static start (--duration-ms)",
+        help="instead: one fixed-duration run per end type from the quasi-static start (--duration-ms) "
+        "(default: settled running from the skid start)",
     )
     p.add_argument(
-        "--duration-ms", type=float, default=20.0, help="with --transient: simulated time per end type [ms]"
+        "--duration-ms",
+        type=float,
+        default=20.0,
+        help="with --transient: simulated time per end type [ms] (default: %(default)g)",
     )
-    p.add_argument("--out", default="out/demo", help="output directory (default: out/demo)")
-    p.add_argument("--summary-only", action="store_true", help="only print the bearing summary")
+    p.add_argument(
+        "--out", default="out/demo", help="output directory, checked before the solve (default: %(default)s)"
+    )
+    p.add_argument(
+        "--summary-only",
+        action="store_true",
+        help="only print the bearing summary (default: summary, runs and outputs)",
+    )
     p.set_defaults(func=run)
 
 
@@ -83,7 +96,6 @@ def summary_lines(bearing, op) -> list[str]:
 
 
 def run(args) -> int:
-    import pathlib
 
     from ..io import reference_config
     from . import _steady
@@ -93,6 +105,9 @@ def run(args) -> int:
     print("\n".join(summary_lines(cfg.bearing(), cfg.operating_point())))
     if args.summary_only:
         return 0
+    from ._simulate import _check_out
+
+    _check_out(args.out)
     steady = None
     if not args.transient:
         from ..run import check_steady_options
@@ -110,7 +125,12 @@ def run(args) -> int:
         f"Against the source study ({what}; its bearing differs: compare trends and magnitudes, see docs/validation.md):"
     )
     print(paper_table(summaries))
-    write_outputs(pathlib.Path(args.out), results)
+    from ..io import write_or_fallback
+    from ._main import report_fallback
+
+    used, reason = write_or_fallback(args.out, lambda d: write_outputs(d, results, cfg, steady))
+    if reason is not None:
+        return report_fallback("jaxbearing demo", args.out, used, reason)
     print(f"\nsummary.json, histories and plots written to {args.out}/")
     ok = all(s["status"] == "ok" for s in summaries.values())
     return 0 if ok and (steady is None or _steady.exit_code(summaries) == 0) else 1

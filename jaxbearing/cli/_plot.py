@@ -20,7 +20,9 @@ def register(sub) -> None:
         "`jaxbearing sweep`, as far as the sweep has the needed axes.",
     )
     p.add_argument("dir", help="sweep output directory (holds spec.json, results.nc)")
-    p.add_argument("--out", help="where to write the figures (default: DIR/figures)")
+    p.add_argument(
+        "--out", help="where to write the figures, checked before anything is read (default: DIR/figures)"
+    )
     p.set_defaults(func=run)
 
 
@@ -31,8 +33,11 @@ def run(args) -> int:
     directory = pathlib.Path(args.dir)
     if not directory.is_dir():
         raise UserInputError(f"DIR {str(directory)!r} is not a directory")
-    ds = open_results(directory)
+    from ..io import check_output_dir
+
     out = pathlib.Path(args.out) if args.out else directory / "figures"
+    check_output_dir(out, "--out")
+    ds = open_results(directory)
     drawn, skipped = plot_sweep(ds, out)
     for label, path in drawn:
         print(f"drew {label}: {path}")

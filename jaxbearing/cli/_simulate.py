@@ -28,16 +28,56 @@ def register(sub) -> None:
         "start until settled, then over a window of cage revolutions with 95 % confidence intervals; "
         "without it, one fixed-duration run from the quasi-static start.",
     )
-    p.add_argument("--config", help="TOML configuration (default: embedded reference bearing)")
-    p.add_argument("--end", choices=("arc", "corner", "both"), help="roller end type (default: from config)")
-    p.add_argument("--speed-rpm", type=float, help="inner-ring speed [rpm]")
-    p.add_argument("--load-N", type=float, dest="load_N", help="radial load [N]")
-    p.add_argument("--duration-ms", type=float, help="simulated time [ms]")
-    p.add_argument("--out", help="output directory (summary.json, histories .npz, plots)")
-    p.add_argument("--no-progress", action="store_true", help="no progress meter")
-    p.add_argument("--solver", help="time integrator: tsit5 (default) or ros34pw2 (simulation.solver)")
+    p.add_argument("--config", help="TOML configuration (default: the embedded reference bearing)")
+    p.add_argument(
+        "--end",
+        choices=_choices("simulation.end"),
+        help="roller end type " + _from_config("simulation.end"),
+    )
+    p.add_argument(
+        "--speed-rpm", type=float, help="inner-ring speed [rpm] " + _from_config("operating.speed_rpm")
+    )
+    p.add_argument(
+        "--load-N",
+        type=float,
+        dest="load_N",
+        help="radial load [N] " + _from_config("operating.radial_load_N"),
+    )
+    p.add_argument(
+        "--duration-ms",
+        type=float,
+        help="simulated time [ms] of a fixed-duration run " + _from_config("simulation.duration_ms"),
+    )
+    p.add_argument(
+        "--out",
+        help="output directory for summary.json (statistics, configuration, command, seeds, units), "
+        "histories_<end>.npz and plots; checked before the solve (default: none, nothing written)",
+    )
+    p.add_argument(
+        "--no-progress", action="store_true", help="no progress meter (default: simulation.progress)"
+    )
+    p.add_argument(
+        "--solver",
+        metavar="{" + ",".join(_choices("simulation.solver")) + "}",  # checked with the configuration
+        help="time integrator " + _from_config("simulation.solver"),
+    )
     _steady.add_arguments(p)
     p.set_defaults(func=run)
+
+
+def _choices(path: str) -> tuple:
+    from ..io import KEY_BY_PATH
+
+    return tuple(KEY_BY_PATH[path].choices)
+
+
+def _from_config(path: str) -> str:
+    """ "(default: KEY of the configuration; reference VALUE)" for an option that overrides KEY."""
+    from ..io import KEY_BY_PATH, format_value
+
+    key = KEY_BY_PATH[path]
+    value = format_value(key.default).strip('"')
+    return f"(default: {path} of the configuration, {value}{' ' + key.unit if key.unit else ''} in the reference)"
 
 
 #: command-line option -> the configuration key it overrides
@@ -88,16 +128,12 @@ def load_named_config(path):
 
 
 def _check_out(out: str | None) -> None:
-    """--out must be a directory or creatable as one (checked before anything is computed)."""
-    if out is None:
-        return
-    path = pathlib.Path(out)
-    if path.exists() and not path.is_dir():
-        raise UserInputError(f"--out {out}: exists and is not a directory; name a directory")
-    try:
-        path.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise UserInputError(f"--out {out}: cannot create the directory: {exc.strerror or exc}") from None
+    """--out must be a directory this process can write, or creatable as one (checked before
+    anything is computed; nothing is left behind by the check: `jaxbearing.io.check_output_dir`)."""
+    if out is not None:
+        from ..io import check_output_dir
+
+        check_output_dir(out, "--out")
 
 
 def run_cases(cfg, progress: bool = True, steady: dict | None = None) -> dict:
@@ -199,19 +235,57 @@ def _film_line(end: str, s: dict) -> str:
     )
 
 
-def write_outputs(out_dir: pathlib.Path, results: dict) -> None:
+def summary_document(results: dict, cfg=None, steady: dict | None = None) -> dict:
+    """summary.json: the statistics (one block, or one per end type), and what produced them
+    (`jaxbearing.io.provenance`: package version, command line, the full configuration in
+    engineering units, the seeds) and the unit of every quantity (`units`)."""
+    from ..io import provenance, units_of
+
+    summaries = {e: _strict_summary(s) for e, (_, s) in results.items()}
+    doc = summaries[next(iter(summaries))] if len(summaries) == 1 else dict(summaries)
+    if cfg is None:
+        return doc
+    first = next(iter(summaries.values()))
+    seeds = list(range(int(steady["seeds"]))) if steady else [0]  # fixed run: Perturbation(seed=0)
+    meta = provenance(cfg, seeds=seeds)
+    meta["ends"] = list(summaries)
+    if steady:
+        meta["steady_options"] = dict(steady)
+    meta["units"] = units_of(first)
+    for key in ("seeds",):  # a settled run's block already lists its seeds (the same list)
+        if key in doc:
+            meta.pop(key)
+    clash = set(meta) & set(doc)
+    if clash:  # pragma: no cover - the summary keys never use these names
+        raise RuntimeError(f"summary keys {sorted(clash)} clash with the provenance keys")
+    return {**doc, **meta}
+
+
+def write_outputs(out_dir: pathlib.Path, results: dict, cfg=None, steady: dict | None = None) -> None:
+    """summary.json (`summary_document`), histories_<end>.npz and the plots into `out_dir`."""
     import numpy as np
 
     from ..io import write_json
     from ..run import plot_run
 
     out_dir.mkdir(parents=True, exist_ok=True)
-    summaries = {e: _strict_summary(s) for e, (_, s) in results.items()}
-    doc = summaries[next(iter(summaries))] if len(summaries) == 1 else dict(summaries)
-    write_json(out_dir / "summary.json", doc)
+    write_json(out_dir / "summary.json", summary_document(results, cfg, steady))
     for end, (res, _) in results.items():
         np.savez_compressed(out_dir / f"histories_{end}.npz", **res.histories)
     plot_run(out_dir, results)
+
+
+def save_outputs(prog: str, out: str, results: dict, cfg, steady: dict | None = None) -> int:
+    """`write_outputs` into `out`, or into a fallback directory when that fails
+    (`jaxbearing.io.write_or_fallback`); returns 0, or `EXIT_RESULTS_ELSEWHERE` after one line
+    naming the fallback directory."""
+    from ..io import write_or_fallback
+    from ._main import report_fallback
+
+    used, reason = write_or_fallback(out, lambda d: write_outputs(d, results, cfg, steady))
+    if reason is None:
+        print(f"results written to {out}")
+    return report_fallback(prog, out, used, reason)
 
 
 def _strict_summary(summary: dict) -> dict:
@@ -230,15 +304,35 @@ def _strict_summary(summary: dict) -> dict:
 
 def run(args) -> int:
     cfg = _load(args)
-    _check_out(args.out)
-    progress = cfg.simulation.progress and not args.no_progress
     steady = _steady.options(args)
+    _check_out(args.out)
+    warn_implausible(cfg)
+    progress = cfg.simulation.progress and not args.no_progress
     results = run_cases(cfg, progress=progress, steady=steady)
     summaries = {e: s for e, (_, s) in results.items()}
     print(_steady.format_table(summaries) if steady else format_table(summaries))
-    if args.out:
-        write_outputs(pathlib.Path(args.out), results)
-        print(f"results written to {args.out}")
+    saved = save_outputs("jaxbearing simulate", args.out, results, cfg, steady) if args.out else 0
+    if saved:
+        return saved
     if steady:
         return _steady.exit_code(summaries)
     return 0 if all(s["status"] == "ok" for s in summaries.values()) else 1
+
+
+def warn_implausible(cfg) -> None:
+    """One line on stderr per value that is valid but almost certainly a unit slip
+    (`jaxbearing.io.plausibility_warnings`), and per violated margin of the design zone of an
+    arc-end run (`_zone.outside_zone_lines`)."""
+    import sys
+
+    from ..io import plausibility_warnings
+
+    for line in plausibility_warnings(cfg):
+        print(f"warning: {line}", file=sys.stderr)
+    if cfg.simulation.end != "corner" and math.isfinite(cfg["roller.end_radius_mm"]):
+        from ..flange import design_zone
+        from ._zone import outside_zone_lines
+
+        bearing = cfg.bearing()
+        for line in outside_zone_lines(bearing, design_zone(bearing)):
+            print(f"warning: {line}", file=sys.stderr)

@@ -28,17 +28,25 @@ def add_arguments(p) -> None:
     g.add_argument(
         "--settle",
         help='"auto" (detect settling), "off" (measure from the start) or a '
-        "settling time in ms; without it, one fixed-duration run from the start",
+        "settling time in ms (default: none: one fixed-duration run from the quasi-static start)",
     )
     g.add_argument(
-        "--window-revs", type=float, default=8, help="measurement window [cage revolutions] (default 8)"
+        "--window-revs",
+        type=float,
+        default=8,
+        help="measurement window [cage revolutions] (default: %(default)g)",
     )
-    g.add_argument("--seeds", type=float, default=1, help="independent seeded runs (default 1: batch means)")
+    g.add_argument(
+        "--seeds",
+        type=float,
+        default=1,
+        help="independent seeded runs, seeds 0 .. N-1 (default: %(default)g: batch means)",
+    )
     g.add_argument(
         "--settle-tolerance",
         type=float,
         default=1e-3,
-        help="relative change of the revolution-mean cage speed that counts as settled (default 1e-3)",
+        help="relative change of the revolution-mean cage speed that counts as settled (default: %(default)g)",
     )
     g.add_argument(
         "--workers",
@@ -49,10 +57,10 @@ def add_arguments(p) -> None:
     g.add_argument(
         "--start",
         default="skid",
-        help='"skid" (default: skid equilibrium, projective steps of the cage speed) or "quasi-static"',
+        help='"skid" (skid equilibrium, projective steps of the cage speed) or "quasi-static" (default: %(default)s)',
     )
     g.add_argument(
-        "--settle-cap-ms", type=float, default=300.0, help="longest settling time [ms] (default 300)"
+        "--settle-cap-ms", type=float, default=300.0, help="longest settling time [ms] (default: %(default)g)"
     )
 
 

@@ -23,8 +23,16 @@ def register(sub) -> None:
         "batch files that do not load are moved to DIR/batches/damaged/ and computed again.",
     )
     p.add_argument("spec", help="sweep spec (TOML: [sweep], [base], [axes])")
-    p.add_argument("--out", required=True, help="output directory")
-    p.add_argument("--batch-size", type=int, help="cases per vmapped batch (overrides the spec)")
+    p.add_argument(
+        "--out",
+        required=True,
+        help="output directory, checked before anything is computed (default: none; required)",
+    )
+    p.add_argument(
+        "--batch-size",
+        type=int,
+        help="cases per vmapped batch, overrides the spec (default: sweep.batch_size of the spec, 8 if unset)",
+    )
     p.add_argument(
         "--resume",
         action=argparse.BooleanOptionalAction,
@@ -33,17 +41,24 @@ def register(sub) -> None:
     )
     p.add_argument(
         "--coordinator",
-        help="jax.distributed coordinator HOST:PORT (process 0's address; env JAXBEARING_COORDINATOR)",
+        help="jax.distributed coordinator HOST:PORT, process 0's address (default: env "
+        "JAXBEARING_COORDINATOR; none: a single process)",
     )
-    p.add_argument("--num-processes", type=int, help="number of processes (env JAXBEARING_NUM_PROCESSES)")
     p.add_argument(
-        "--process-id", type=int, help="this process, 0..num-processes-1 (env JAXBEARING_PROCESS_ID)"
+        "--num-processes",
+        type=int,
+        help="number of processes (default: env JAXBEARING_NUM_PROCESSES, else 1)",
+    )
+    p.add_argument(
+        "--process-id",
+        type=int,
+        help="this process, 0..num-processes-1 (default: env JAXBEARING_PROCESS_ID, else 0)",
     )
     p.add_argument(
         "--wait-timeout-s",
         type=float,
         default=24 * 3600.0,
-        help="process 0: how long to wait for the other processes' batches",
+        help="process 0: how long to wait for the other processes' batches [s] (default: %(default)g)",
     )
     p.add_argument(
         "--wait-for-lock",
@@ -53,12 +68,13 @@ def register(sub) -> None:
         default=0.0,
         metavar="SECONDS",
         help="when another sweep is writing into DIR, wait for it "
-        "(up to SECONDS; no value: as long as it takes) instead of exiting with status 2",
+        "(up to SECONDS; no value: as long as it takes) instead of exiting with status 2 (default: do not wait)",
     )
     p.add_argument(
         "--dry-run",
         action="store_true",
-        help="validate the spec, list the axes and the number of cases and batches, compute nothing",
+        help="validate the spec, list the axes and the number of cases and batches, compute nothing "
+        "(default: run the sweep)",
     )
     p.add_argument(
         "--workers",
@@ -66,7 +82,7 @@ def register(sub) -> None:
         help="local worker processes that solve this process's batches (default: one per CPU on "
         "a CPU platform, 1 on an accelerator); results are bitwise the same for any number",
     )
-    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar (default: a progress bar)")
     p.set_defaults(func=run)
 
 
@@ -84,14 +100,17 @@ def default_workers(spec, num_processes: int) -> int:
 
 
 def run(args) -> int:
-    from ..io import check_arguments, count
-    from ..sweep import initialize_distributed, load_sweep_spec, run_sweep
+    from ..io import check_arguments, check_output_dir, count, plausibility_warnings
+    from ..sweep import ResultsElsewhere, initialize_distributed, load_sweep_spec, run_sweep
+    from ._main import EXIT_RESULTS_ELSEWHERE
 
     if args.workers is not None:  # before anything is printed or started
         check_arguments({"workers": args.workers}, {"workers": count(1)})
     spec = load_sweep_spec(args.spec)
     if args.batch_size is not None:
         spec = spec.with_batch_size(args.batch_size)
+    if not args.dry_run:
+        check_output_dir(args.out, "--out")  # before jax.distributed and any solve
     print(
         f"sweep {args.spec}: {spec.num_cases} cases "
         f"({' x '.join(f'{d} {n}' for d, n in zip(spec.dims, spec.shape))}), "
@@ -102,6 +121,8 @@ def run(args) -> int:
         for a in spec.axes:
             print(f"  {a.key} [{a.dim}]: {', '.join(map(str, a.values))}")
         return 0
+    for line in plausibility_warnings(spec.base):
+        print(f"warning: base configuration: {line}", file=sys.stderr)
     process_id, num_processes = initialize_distributed(args.coordinator, args.num_processes, args.process_id)
     import jax
 
@@ -111,17 +132,21 @@ def run(args) -> int:
         f"({jax.local_devices()[0].platform}), {workers} worker process(es)",
         file=sys.stderr,
     )
-    ds = run_sweep(
-        spec,
-        args.out,
-        workers=workers,
-        resume=args.resume,
-        process_id=process_id,
-        num_processes=num_processes,
-        progress=not args.no_progress,
-        wait_timeout_s=args.wait_timeout_s,
-        lock_wait_s=args.wait_for_lock,
-    )
+    try:
+        ds = run_sweep(
+            spec,
+            args.out,
+            workers=workers,
+            resume=args.resume,
+            process_id=process_id,
+            num_processes=num_processes,
+            progress=not args.no_progress,
+            wait_timeout_s=args.wait_timeout_s,
+            lock_wait_s=args.wait_for_lock,
+        )
+    except ResultsElsewhere as exc:
+        print(f"jaxbearing sweep: error: {exc}", file=sys.stderr)
+        return EXIT_RESULTS_ELSEWHERE
     if ds is None:
         print(f"process {process_id}: batches written to {args.out}/batches")
         return 0

@@ -10,6 +10,10 @@ Prints the contact geometry of an aligned roller and each design margin with OK/
   Delta_bf (0..0.3 mm) at the current theta_f, with the Lambda_bf = 0 line.
 
 Each map is one jit-compiled vmap over its grid (`jaxbearing._zone.design_zone_grid`).
+
+Exit status 0 when the design is feasible, 3 (`EXIT_INFEASIBLE`) when it is outside the design
+zone (the report says which margin is violated), 4 when the maps could not be written to --out
+and went to the fallback directory printed. --out is checked before anything is computed.
 """
 
 from __future__ import annotations
@@ -31,6 +35,10 @@ def register(sub) -> None:
     p = sub.add_parser(
         "zone",
         help="roller-end/flange design zone: contact height, clearance, margins (Figure 14)",
+        description="Print the contact geometry of an aligned roller against its flange and each "
+        "design-zone margin (relief, contact-height limit, limited circle, actual axial clearance) "
+        "with OK/VIOLATED; with --map, draw the paper's Figure 14 maps. Exit status 3 when the "
+        "design is outside the design zone.",
     )
     p.add_argument("--config", help="TOML configuration (default: embedded reference bearing)")
     p.add_argument(
@@ -40,16 +48,33 @@ def register(sub) -> None:
         default=None,
         help="flange normal load for the contact-ellipse half-width [N] (default 100)",
     )
-    p.add_argument("--map", action="store_true", help="write the two design-zone maps (PNG)")
-    p.add_argument("--out", default=".", help="output directory for --map (default: .)")
+    p.add_argument(
+        "--map",
+        action="store_true",
+        help="write the two design-zone maps (PNG) into --out (default: no maps)",
+    )
+    p.add_argument(
+        "--out",
+        default=".",
+        help="output directory for --map, checked before the maps are computed (default: %(default)s)",
+    )
     p.set_defaults(func=run)
 
 
 def _bearing(config):
     """The bearing of `--config` (the embedded reference bearing without it)."""
+    return _config(config).bearing()
+
+
+def _config(config):
+    """The configuration of `--config` (the embedded reference configuration without it); its
+    errors name the file."""
     from ..io import load_config
 
-    return load_config(config).bearing()
+    try:
+        return load_config(config)
+    except UserInputError as exc:
+        raise UserInputError(f"{config}: {exc}" if config is not None else str(exc)) from None
 
 
 def _mm(x) -> str:
@@ -155,11 +180,17 @@ def _draw_map(
 def write_maps(bearing, flange_load: float, out_dir: str) -> list[str]:
     """The paper's Figure 14 for `bearing`: contact height over (R_end, theta_f) and actual
     axial clearance over (R_end, Delta_bf), with the design-zone limits and the current design."""
+    return draw_maps(bearing, flange_load, out_dir, zone_maps(bearing, flange_load))
+
+
+def draw_maps(bearing, flange_load: float, out_dir, maps) -> list[str]:
+    """Draw the two maps of `zone_maps` into `out_dir` (`write_maps`)."""
     import numpy as np
     from matplotlib.colors import TwoSlopeNorm
 
+    out_dir = os.fspath(out_dir)
     os.makedirs(out_dir, exist_ok=True)
-    (r_mm, t_deg, hz), (_, c_mm, cz) = zone_maps(bearing, flange_load)
+    (r_mm, t_deg, hz), (_, c_mm, cz) = maps
     r_now = float(bearing.roller.end_radius) / MM
     t_now = math.degrees(float(bearing.flange.layback_angle))
     c_now = float(bearing.flange.axial_clearance) / MM
@@ -216,16 +247,53 @@ def write_maps(bearing, flange_load: float, out_dir: str) -> list[str]:
     return [height, clearance]
 
 
+def outside_zone_lines(bearing, zone) -> list[str]:
+    """One line per violated design-zone margin (empty for a feasible design)."""
+    why = {
+        "relief_margin": "the contact ellipse reaches the flange relief (h_c - a_t < h_rel)",
+        "height_margin": "the contact is above the contact-height limit (h_c > h_up)",
+        "limited_circle_margin": "the contact is on the corner, not on the arc end (rho_c > rho_lim)",
+        "clearance_margin": "the actual axial clearance Lambda_bf is negative: the roller does not fit "
+        "between the flanges",
+    }
+    return [
+        f"the design is outside the design zone (docs/model.md 4.1): {name.removesuffix('_margin')} "
+        f"margin {float(getattr(zone, name)) / MM:+.4f} mm: {text}"
+        for name, text in why.items()
+        if not float(getattr(zone, name)) > 0
+    ]
+
+
 def run(args) -> int:
+    import sys
+
     from ..flange import DEFAULT_FLANGE_LOAD, design_zone
+    from ..io import check_output_dir, plausibility_warnings, write_or_fallback
+    from ._main import EXIT_INFEASIBLE, report_fallback
 
     load = DEFAULT_FLANGE_LOAD if args.flange_load_N is None else args.flange_load_N
     if not (load > 0 and math.isfinite(load)):
         raise UserInputError(f"--flange-load-N = {load}: must be a finite load > 0 N")
-    bearing = _bearing(args.config)
+    if args.map:
+        check_output_dir(args.out, "--out")
+    cfg = _config(args.config)
+    for line in plausibility_warnings(cfg):
+        print(f"warning: {line}", file=sys.stderr)
+    bearing = cfg.bearing()
     zone = design_zone(bearing, load)
     print("\n".join(zone_lines(bearing, zone, load)))
+    code = 0
     if args.map:
-        for path in write_maps(bearing, load, args.out):
+        maps = zone_maps(bearing, load)
+        written: list[str] = []
+        used, reason = write_or_fallback(
+            args.out, lambda d: written.extend(draw_maps(bearing, load, d, maps))
+        )
+        for path in written[-2:]:
             print(f"wrote {path}")
-    return 0
+        code = report_fallback("jaxbearing zone", args.out, used, reason)
+    if not bool(zone.feasible):
+        for line in outside_zone_lines(bearing, zone):
+            print(f"jaxbearing zone: {line}", file=sys.stderr)
+        return code or EXIT_INFEASIBLE
+    return code

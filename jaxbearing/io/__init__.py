@@ -6,7 +6,10 @@ TOML in engineering units (`Config`, `load_config`), validation of pytrees built
 solver arguments `SOLVER_ARGUMENTS` and `check_solver_arguments`, `check_solve_inputs` that
 every model entry point calls before tracing), the checks a configuration needs to be run
 (`check_runnable`), and result files that are whole or absent, in strict JSON (`atomic_write`,
-`write_json`, `dumps_strict`), and the lock on an output directory (`acquire_lock`).
+`write_json`, `dumps_strict`), pytrees in data-only files (`save_tree`, `load_tree`: `.npz`
+with `allow_pickle=False` and JSON, never a pickle), the lock on an output directory (`acquire_lock`), and output directories checked before
+work and results kept in a fallback directory when writing fails (`check_output_dir`,
+`write_or_fallback`).
 
 May import: `jaxbearing._errors`, `jaxbearing.geometry`.
 """
@@ -41,19 +44,28 @@ from ._extras import optional_import, pyplot
 from ._files import (
     NULL_REASONS,
     atomic_write,
+    check_output_dir,
     dumps_strict,
+    fallback_dir,
+    provenance,
     remove_stale_temporaries,
+    set_command_line,
     to_strict_json,
+    unit_of,
+    units_of,
     with_null_reasons,
     write_json,
+    write_or_fallback,
 )
 from ._keys import format_value, type_name
 from ._lock import DirectoryInUse, DirectoryLock, acquire_lock
 from ._schema import KEY_BY_PATH, KEYS
-from ._validation import validate_bearing
+from ._tree import TreeFileError, check_like, load_tree, save_tree, tree_bytes, tree_from_bytes
+from ._validation import IMPLAUSIBLY_SMALL, plausibility_warnings, validate_bearing
 
 __all__ = [
     "FUNCTIONALS_FIELDS",
+    "IMPLAUSIBLY_SMALL",
     "KEYS",
     "KEY_BY_PATH",
     "NULL_REASONS",
@@ -65,21 +77,28 @@ __all__ = [
     "DirectoryLock",
     "Rule",
     "SimulationSettings",
+    "TreeFileError",
     "acquire_lock",
     "atomic_write",
     "check_arguments",
     "check_fields",
+    "check_like",
     "check_model_inputs",
+    "check_output_dir",
     "check_runnable",
     "check_solve_inputs",
     "check_solver_arguments",
     "count",
     "dumps_strict",
+    "fallback_dir",
     "format_value",
     "is_concrete",
     "load_config",
+    "load_tree",
     "loads_config",
     "optional_import",
+    "plausibility_warnings",
+    "provenance",
     "pyplot",
     "real",
     "reference_bearing",
@@ -87,9 +106,16 @@ __all__ = [
     "reference_operating_point",
     "remove_stale_temporaries",
     "require",
+    "save_tree",
+    "set_command_line",
     "to_strict_json",
+    "tree_bytes",
+    "tree_from_bytes",
     "type_name",
+    "unit_of",
+    "units_of",
     "validate_bearing",
     "with_null_reasons",
     "write_json",
+    "write_or_fallback",
 ]

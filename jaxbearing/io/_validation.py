@@ -83,6 +83,16 @@ def check_key(key: Key, values: Mapping[str, Any]) -> None:
             hi = key.hi.value(values)
             ok &= v <= hi if key.hi.closed else v < hi
         if not ok:
+            culprit = _culprit(key, values)
+            if culprit is not None:
+                dep = KEY_BY_PATH[culprit]
+                dep_unit = f" {dep.unit}" if dep.unit else ""
+                raise ConfigError(
+                    culprit,
+                    f"{format_value(values[culprit])}{dep_unit} puts {key.path} = {format_value(v)}{unit} "
+                    f"(its reference value) out of range: {key.name} must be {key.range_text(values)}{unit}; "
+                    f"check {dep.name}'s value and unit",
+                )
             raise ConfigError(
                 key.path, f"{format_value(v)}{unit} is out of range: must be {key.range_text(values)}{unit}"
             )
@@ -90,6 +100,17 @@ def check_key(key: Key, values: Mapping[str, Any]) -> None:
         msg = extra.check(values)
         if msg is not None:
             raise ConfigError(key.path, msg)
+
+
+def _culprit(key: Key, values: Mapping[str, Any]) -> str | None:
+    """The key to blame when `key` fails a range that depends on other keys: when `key` still
+    has its reference value and a key its range reads does not, that key is the wrong one (e.g.
+    `bearing.pitch_diameter_mm = 0.085`, metres typed as mm, makes the reference radial
+    clearance too large); None otherwise."""
+    if values[key.path] != REFERENCE_VALUES.get(key.path):
+        return None
+    changed = [d for d in key.deps if d != key.path and values.get(d) != REFERENCE_VALUES.get(d)]
+    return changed[0] if changed else None
 
 
 def check_values(values: Mapping[str, Any], paths: Iterable[str] | None = None) -> None:
@@ -187,3 +208,34 @@ def _check_switch(path: str, v: np.ndarray, shape: tuple) -> None:
         raise ConfigError(
             path, f"{where}{format_value(float(v[idx]))} is out of range: must be 1.0 (true) or 0.0 (false)"
         )
+
+
+# -- plausibility --------------------------------------------------------------------------------
+#: (key, limit, what the value probably is): a value in (0, limit) is valid but almost certainly
+#: a unit slip; `plausibility_warnings` names it (0 itself is a deliberate choice and passes)
+IMPLAUSIBLY_SMALL: tuple[tuple[str, float, str], ...] = (
+    ("bearing.pitch_diameter_mm", 1.0, "below 1 mm: a pitch diameter in metres?"),
+    ("bearing.radial_clearance_um", 0.1, "below 0.1 um: a clearance in mm?"),
+    ("roller.diameter_mm", 0.5, "below 0.5 mm: a diameter in metres?"),
+    ("roller.length_mm", 0.5, "below 0.5 mm: a length in metres?"),
+    ("roller.crown_drop_um", 0.1, "below 0.1 um: a crown drop in mm?"),
+    ("flange.height_mm", 0.1, "below 0.1 mm: a height in metres?"),
+    ("flange.layback_angle_deg", 0.1, "below 0.1 deg: an angle in radians?"),
+    ("flange.axial_clearance_mm", 1e-4, "below 0.1 um: a clearance in metres?"),
+    ("cage.pocket_clearance_mm", 1e-3, "below 1 um: a clearance in metres?"),
+    ("cage.guiding_clearance_mm", 1e-3, "below 1 um: a clearance in metres?"),
+    ("operating.speed_rpm", 1.0, "below 1 rpm: a speed in revolutions per second?"),
+)
+
+
+def plausibility_warnings(values) -> list[str]:
+    """One line per value of a valid configuration (a `Config` or a {dotted key: value}
+    mapping) that is almost certainly a unit slip (`IMPLAUSIBLY_SMALL`), naming the key, the
+    value with its unit and why."""
+    out = []
+    for path, limit, why in IMPLAUSIBLY_SMALL:
+        v = values[path]
+        if isinstance(v, (int, float)) and 0 < v < limit:
+            unit = KEY_BY_PATH[path].unit
+            out.append(f"{path} = {format_value(v)} {unit} is valid but implausible: {why}")
+    return out

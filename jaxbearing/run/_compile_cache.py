@@ -26,7 +26,10 @@ Three parts:
   and stored as `jax.export` artefacts (serialized StableHLO, "Exporting and serializing staged
   out computations" in JAX's documentation) in `programs/` inside the cache directory, keyed on
   the argument structure, shapes, dtypes and static arguments and on a digest of jaxbearing's
-  source and the traced packages' versions. A second process deserializes the program instead of
+  source and the traced packages' versions. Each file is data only (`jaxbearing.io.tree_bytes`:
+  the serialized program and the output structure in an `.npz` read with `allow_pickle=False`);
+  a file that is not one (a pickle planted in the directory) is removed with a warning and the
+  program built again, never executed. A second process deserializes the program instead of
   tracing it, and compiles it with a hit in the persistent cache
   (`benchmarks/bench_compile_cache.py`).
 """
@@ -37,12 +40,15 @@ import contextlib
 import functools
 import hashlib
 import os
-import pickle
 import tempfile
+import warnings
 from pathlib import Path
 
 import jax
 import jax.numpy as jnp
+import numpy as np
+
+from ..io import tree_bytes, tree_from_bytes
 
 #: environment variable naming the cache directory (or switching the cache off)
 CACHE_ENV = "JAXBEARING_CACHE_DIR"
@@ -109,8 +115,9 @@ def enable_compilation_cache(directory: str | os.PathLike | None = None) -> Path
 # Traced once per machine: programs exported to disk (jax.export)
 # --------------------------------------------------------------------------------------------
 
-#: bump when the layout of a stored program changes
-PROGRAM_FORMAT = 1
+#: bump when the layout of a stored program changes (2: a data-only `.npz`, `jaxbearing.io`'s
+#: `tree_bytes`, instead of a pickle)
+PROGRAM_FORMAT = 2
 #: packages whose code is traced into a program (their versions are part of its key)
 _TRACED_PACKAGES = ("jax", "jaxlib", "diffrax", "equinox", "lineax", "optimistix")
 _PROGRAMS: dict = {}
@@ -178,26 +185,40 @@ def _program_key(name: str, in_tree, specs: tuple, static) -> str:
 
 def _load(path: Path):
     """(Exported, output tree) stored at `path`, or None (absent, unreadable or damaged: a
-    damaged file is removed and the program built again)."""
+    damaged file, or one that is not a data-only program file, e.g. a pickle, which is never
+    unpickled, is removed with a one-line warning and the program built again)."""
     try:
-        entry = pickle.loads(path.read_bytes())
-        exported = jax.export.deserialize(bytearray(entry["exported"]))
-        with contextlib.suppress(OSError):
-            os.utime(path)  # used now: the last to be evicted (`_evict`)
-        return exported, jax.tree_util.tree_structure(entry["skeleton"])
+        data = path.read_bytes()
     except FileNotFoundError:
         return None
-    except Exception:  # noqa: BLE001 - any damage means: build it again
+    except OSError:
+        return None
+    try:
+        entry = tree_from_bytes(data)
+        exported = jax.export.deserialize(bytearray(np.asarray(entry["exported"], dtype=np.uint8).tobytes()))
+        out_tree = jax.tree_util.tree_structure(entry["skeleton"])
+    except Exception as exc:  # noqa: BLE001 - any damage means: build it again
+        reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        warnings.warn(
+            f"{path}: not a stored program ({reason}); removed, the program is built again", stacklevel=2
+        )
         with contextlib.suppress(OSError):
             path.unlink()
         return None
+    with contextlib.suppress(OSError):
+        os.utime(path)  # used now: the last to be evicted (`_evict`)
+    return exported, out_tree
 
 
 def _store(path: Path, serialized: bytes, out_tree) -> None:
     """Write the serialized program atomically (a temporary file renamed): whole or absent. A
-    full or read-only disk only costs the next process the tracing."""
+    full or read-only disk only costs the next process the tracing; an output structure that is
+    not plain data (`tree_bytes`) is not stored."""
     skeleton = jax.tree_util.tree_unflatten(out_tree, [0] * out_tree.num_leaves)
-    data = pickle.dumps({"exported": serialized, "skeleton": skeleton})
+    try:
+        data = tree_bytes({"exported": np.frombuffer(serialized, dtype=np.uint8), "skeleton": skeleton})
+    except TypeError:
+        return
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         with tempfile.NamedTemporaryFile(dir=path.parent, prefix=path.name, suffix=".tmp", delete=False) as f:

@@ -43,6 +43,34 @@ def _zone_batch(stacked):
     return _zone_fn()(stacked)
 
 
+def _unit(name: str) -> str:
+    """The unit of a dataset variable from its name (a statistic's suffix `_max`... dropped)."""
+    from ..io import unit_of
+
+    for stat in ("_max", "_mean", "_median", "_min"):
+        if name.endswith(stat):
+            name = name.removesuffix(stat)
+            break
+    return unit_of(name)
+
+
+def provenance_attrs(spec: SweepSpec) -> dict:
+    """netCDF attributes (strings and numbers only) saying what produced the dataset: the package
+    version, the command line, the base configuration in engineering units (JSON and TOML; the
+    swept keys vary along the axes), the seeds (every case starts from `Perturbation(seed=0)`)."""
+    from ..io import dumps_strict, provenance
+
+    meta = provenance(spec.base, seeds=[0])
+    return {
+        "jaxbearing_version": str(meta["jaxbearing_version"]),
+        "command": json.dumps(meta["command"]),
+        "config": dumps_strict(meta["config"], indent=None),
+        "config_toml": meta["config_toml"],
+        "seeds": json.dumps(meta["seeds"]),
+        "units_convention": "every variable and coordinate has a 'units' attribute ('1': dimensionless)",
+    }
+
+
 def assemble(out_dir: str | os.PathLike, spec: SweepSpec | None = None):
     """Assemble DIR/results.nc from the batch files (all must exist) and return the Dataset."""
     xr = optional_import("xarray")
@@ -100,11 +128,14 @@ def assemble(out_dir: str | os.PathLike, spec: SweepSpec | None = None):
         )
     coords: dict[str, Any] = {}
     for a in spec.axes:
-        unit = KEY_BY_PATH[a.key].unit if a.key in KEY_BY_PATH else ""
+        unit = (KEY_BY_PATH[a.key].unit if a.key in KEY_BY_PATH else "") or "1"
         vals = np.asarray(a.values, dtype=str if a.key == "end" else float)
         coords[a.name] = (a.dim, vals, {"config_key": a.key, "units": unit})
     coords["end_face_axis"] = ("end_face_axis", np.array(["y", "z"]))
+    for name, (_, _, attrs) in data_vars.items():
+        attrs.setdefault("units", _unit(name))
     ds = xr.Dataset(data_vars, coords=coords)
+    ds.attrs.update(provenance_attrs(spec))
     ds.attrs.update(
         spec_hash=spec.hash,
         spec=json.dumps(spec.canonical(), allow_nan=True),
@@ -125,5 +156,12 @@ def open_results(out_dir: str | os.PathLike):
     path = pathlib.Path(out_dir) / "results.nc"
     if not path.exists():
         return assemble(out_dir)
-    with xr.open_dataset(path, engine="scipy") as ds:
-        return ds.load()
+    try:
+        with xr.open_dataset(path, engine="scipy") as ds:
+            ds = ds.load()
+    except Exception as exc:  # noqa: BLE001 - not a netCDF file of ours: one line naming it
+        reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise UserInputError(f"{path}: not a sweep result file ({reason}); not loaded") from None
+    if "spec" not in ds.attrs or "result_code" not in ds:
+        raise UserInputError(f"{path}: not a sweep result file (no spec or result_code); not loaded")
+    return ds

@@ -12,7 +12,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from .._errors import UserInputError
-from ..io import acquire_lock, check_arguments, count, remove_stale_temporaries
+from ..io import acquire_lock, check_arguments, count, fallback_dir, remove_stale_temporaries
 from ._batch import solve_batch
 from ._dataset import assemble
 from ._spec import SweepSpec
@@ -199,12 +199,23 @@ def _run_locked(
 
     if devices is not None and workers > 1:
         raise UserInputError(f"workers = {workers}: must be 1 when devices are given")
+    target, reason = out_dir, None
     for i, (data, wall) in as_completed_map(_SolveBatch(spec, devices), todo, workers=workers):
         b = todo[i]
         cases = spec.batch_cases(b)
-        write_batch(out_dir, spec, b, data)
+        try:
+            write_batch(target, spec, b, data)
+        except OSError as exc:  # finished work is never lost: the rest goes to a fallback directory
+            if reason is not None:
+                raise
+            reason = f"{exc.strerror or exc}" + (
+                f": {exc.filename}" if getattr(exc, "filename", None) else ""
+            )
+            target = fallback_dir()
+            prepare_dir(target, spec, False, 0)
+            write_batch(target, spec, b, data)
         append_log(
-            out_dir,
+            target,
             {
                 "event": "batch",
                 "batch": b,
@@ -215,6 +226,8 @@ def _run_locked(
             },
         )
         bar.update(len(cases))
+    if reason is not None:
+        raise ResultsElsewhere(out_dir, target, reason)
     if process_id != 0 or not assemble_results:
         return None
     missing = _wait_for_batches(out_dir, spec, wait_timeout_s, progress)
@@ -225,6 +238,19 @@ def _run_locked(
             "finish them"
         )
     return assemble(out_dir, spec)
+
+
+class ResultsElsewhere(Exception):
+    """Batches could not be written into the sweep directory; those finished since are in
+    `fallback`/batches (copy them into DIR/batches/ and run the same command to assemble)."""
+
+    def __init__(self, out_dir, fallback, reason: str):
+        self.out_dir, self.fallback, self.reason = out_dir, fallback, reason
+        super().__init__(
+            f"batches could not be written to {out_dir} ({reason}); the batches finished since are "
+            f"kept in {fallback}/batches: copy them into {out_dir}/batches/ and run the same "
+            "command again to assemble the results"
+        )
 
 
 def missing_batches(out_dir: str | os.PathLike, spec: SweepSpec) -> list[int]:

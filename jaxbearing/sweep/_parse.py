@@ -15,7 +15,16 @@ import numpy as np
 
 from .._errors import ConfigError
 from ..io import KEY_BY_PATH, KEYS, Config, format_value, load_config, type_name
-from ._spec import _RANGE_FIELDS, _STATIC_KEYS, _SWEEP_FIELDS, Axis, SweepSpec, SweepSpecError, _positive_int
+from ._spec import (
+    _RANGE_FIELDS,
+    _STATIC_KEYS,
+    _SWEEP_FIELDS,
+    MAX_CASES,
+    Axis,
+    SweepSpec,
+    SweepSpecError,
+    _positive_int,
+)
 
 
 def _wrong_unit(path: str) -> str | None:
@@ -55,6 +64,8 @@ def _axis_values(key: str, raw) -> tuple:
             raise SweepSpecError(key, f"range num must be an integer, got {type_name(num)}")
         if num < 1:
             raise SweepSpecError(key, f"empty axis: range num = {num} (must be >= 1)")
+        if num > MAX_CASES:
+            raise SweepSpecError(key, f"range num = {num}: at most {MAX_CASES} values (split the sweep)")
         for f in ("start", "stop"):
             v = raw[f]
             if isinstance(v, bool) or not isinstance(v, numbers.Real) or not math.isfinite(v):
@@ -112,12 +123,17 @@ def build_spec(data: Mapping[str, Any], base_dir: str | os.PathLike | None = Non
     if "end" not in values and base.simulation.end == "both":
         values["end"] = ("arc", "corner")
     axes, dims, shape = _dimensions(sweep, values)
+    total = math.prod(shape)
+    if total > MAX_CASES:
+        raise SweepSpecError(
+            "axes", f"{total} cases ({' x '.join(map(str, shape))}): at most {MAX_CASES} per sweep; split it"
+        )
     spec = SweepSpec(
         base=base,
         axes=axes,
         dims=dims,
         shape=shape,
-        batch_size=_positive_int("sweep.batch_size", sweep.get("batch_size", 8)),
+        batch_size=_positive_int("sweep.batch_size", sweep.get("batch_size", 8), MAX_CASES),
         num_saves=_positive_int("sweep.num_saves", sweep.get("num_saves", 400)),
         max_positions=_positive_int("sweep.max_positions", sweep.get("max_positions", 500)),
     )

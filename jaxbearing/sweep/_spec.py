@@ -181,7 +181,13 @@ class SweepSpec:
         return dataclasses.replace(self, batch_size=int(batch_size))
 
 
-def _positive_int(field: str, value) -> int:
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < 1:
-        raise SweepSpecError(field, f"{format_value(value)} must be an integer >= 1")
+#: most cases of one sweep (every case is validated when the spec is read; split larger sweeps)
+MAX_CASES = 100_000
+#: most saved samples per case and contact positions kept per case
+MAX_SAVES = 1_000_000
+
+
+def _positive_int(field: str, value, most: int = MAX_SAVES) -> int:
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or not 1 <= value <= most:
+        raise SweepSpecError(field, f"{format_value(value)} must be an integer in [1, {most}]")
     return int(value)

@@ -95,12 +95,12 @@ def computed_batches(out_dir: str | os.PathLike) -> list[int]:
     if not path.exists():
         return []
     out = []
-    for line in path.read_text().splitlines():
+    for line in path.read_bytes().decode("utf-8", errors="replace").splitlines():
         try:
             rec = json.loads(line)
-        except json.JSONDecodeError:
+        except ValueError:
             continue  # a line cut by a kill
-        if rec.get("event") == "batch":
+        if isinstance(rec, dict) and rec.get("event") == "batch" and isinstance(rec.get("batch"), int):
             out.append(int(rec["batch"]))
     return out
 
@@ -111,10 +111,12 @@ def prepare_dir(out_dir: pathlib.Path, spec: SweepSpec, resume: bool, process_id
     spec_file = out_dir / "spec.json"
     if spec_file.exists() and resume:
         try:
-            old = json.loads(spec_file.read_text())
-        except (OSError, json.JSONDecodeError):
-            old = None
-        if old is not None and old.get("hash") != spec.hash:
+            old = json.loads(spec_file.read_bytes())
+        except (OSError, ValueError):  # unreadable, not UTF-8, not JSON
+            old = {"hash": "(not a spec file)"}
+        if not isinstance(old, dict):
+            old = {"hash": "(not a spec file)"}
+        if old.get("hash") != spec.hash:
             raise SweepSpecError(
                 "--out",
                 f"{out_dir} holds another sweep (spec hash {old.get('hash')}, this one "
@@ -131,7 +133,16 @@ def load_spec_from_dir(out_dir: str | os.PathLike) -> SweepSpec:
     """The spec of the sweep in DIR (from DIR/spec.json)."""
     path = pathlib.Path(out_dir) / "spec.json"
     try:
-        doc = json.loads(path.read_text())
+        doc = json.loads(path.read_bytes())
     except OSError:
         raise SweepSpecError("DIR", f"{out_dir} is not a sweep directory (no spec.json)") from None
-    return SweepSpec.from_canonical(doc["spec"])
+    except ValueError:
+        raise SweepSpecError("DIR", f"{path}: not a sweep spec file (not JSON); not loaded") from None
+    try:
+        return SweepSpec.from_canonical(doc["spec"])
+    except SweepSpecError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - any malformed content: one line naming the file
+        raise SweepSpecError(
+            "DIR", f"{path}: not a sweep spec file ({type(exc).__name__}); not loaded"
+        ) from None
