@@ -25,7 +25,12 @@ class Pair(eqx.Module):
 
 @pytest.fixture
 def programs(monkeypatch, tmp_path):
-    """An empty program directory and no program in memory."""
+    """An empty program directory and no program in memory; `Pair`, a class of this test module,
+    may be named by a stored program (only jaxbearing's, optimise's and optax's classes may be
+    otherwise: `jaxbearing.io._tree.TRUSTED_PACKAGES`)."""
+    from jaxbearing.io import _tree
+
+    monkeypatch.setattr(_tree, "TRUSTED_PACKAGES", (*_tree.TRUSTED_PACKAGES, Pair.__module__))
     monkeypatch.setattr(cc, "program_cache_dir", lambda: tmp_path / "programs")
     monkeypatch.setattr(cc, "_PROGRAMS", {})
     return tmp_path / "programs"

@@ -101,6 +101,13 @@ def test_load_tree_round_trip_and_shape_check(tmp_path):
         load_tree(path)
     with pytest.raises(TypeError):
         save_tree(path, {"x": np.array([object()])})
+    # a class from outside jaxbearing, optimise and optax (here the standard library's) is
+    # refused by name even though it is imported and a plain named tuple
+    import inspect
+
+    save_tree(path, {"x": inspect.getfullargspec(save_tree)})
+    with pytest.raises(TreeFileError, match="unknown class"):
+        load_tree(path)
 
 
 def test_compile_cache_never_unpickles_a_planted_program(tmp_path, plant, monkeypatch):

@@ -9,8 +9,8 @@ kept), and nodes of a pytree class (an `equinox.Module`, a dataclass or a named 
 by module and qualified name with their fields.
 
 `load_tree(path, what=...)` reads it back. A node's class is looked up among the modules
-already imported (`sys.modules`, never importing one) and must be an `equinox.Module`, a
-dataclass or a named tuple; it is rebuilt from its fields without calling its `__init__`.
+already imported (`sys.modules`, never importing one) of jaxbearing, optimise and optax
+(`TRUSTED_PACKAGES`: an optimiser's state) and must be an `equinox.Module`, a dataclass or a named tuple; it is rebuilt from its fields without calling its `__init__`.
 Anything else (a pickle, another archive, damaged JSON, an unknown class, an array of Python
 objects) raises `TreeFileError`, one line naming the file. `check_like(tree, template)`
 compares a loaded tree with a template: the same pytree structure and the same shape and
@@ -36,6 +36,8 @@ from ._files import atomic_write
 #: version of the layout (`__format__` in the JSON)
 TREE_FORMAT = 1
 _STRUCTURE = "__tree__"
+#: a node's class must come from one of these packages (a file cannot name any other class)
+TRUSTED_PACKAGES = ("jaxbearing", "optimise", "optax")
 
 
 class TreeFileError(UserInputError):
@@ -112,6 +114,8 @@ def save_tree(path: str | os.PathLike, tree: Any) -> None:
 
 def _lookup(name: str) -> type:
     module, _, qualname = str(name).partition(":")
+    if module.split(".")[0] not in TRUSTED_PACKAGES:
+        raise ValueError(f"unknown class {name!r}")
     obj: Any = sys.modules.get(module)
     for part in qualname.split("."):
         if obj is None or part.startswith("__"):
