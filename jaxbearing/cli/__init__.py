@@ -1,5 +1,5 @@
 """The `jaxbearing` command line: one module per command (`_demo`, `_config`, `_zone`,
-`_simulate`, `_sweep`, `_plot`), each exposing `register(subparsers)`; `main` dispatches.
+`_simulate`, `_sweep`, `_plot`, `_validate`), each exposing `register(subparsers)`; `main` dispatches.
 
 User errors print one line and exit 2; failed solves exit 1; a design outside the zone (`zone`)
 exits 3; results kept in a fallback directory exit 4; `EXIT_CODES` lists them all

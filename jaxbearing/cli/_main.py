@@ -26,6 +26,7 @@ COMMANDS = {
     "simulate": "jaxbearing.cli._simulate",
     "sweep": "jaxbearing.cli._sweep",
     "plot": "jaxbearing.cli._plot",
+    "validate": "jaxbearing.cli._validate",
 }
 
 

@@ -9,7 +9,8 @@ every model entry point calls before tracing), the checks a configuration needs 
 `write_json`, `dumps_strict`), pytrees in data-only files (`save_tree`, `load_tree`: `.npz`
 with `allow_pickle=False` and JSON, never a pickle), the lock on an output directory (`acquire_lock`), and output directories checked before
 work and results kept in a fallback directory when writing fails (`check_output_dir`,
-`write_or_fallback`).
+`write_or_fallback`), and measured cage speeds from a CSV file with units in its header
+(`read_cage_speed_measurements`).
 
 May import: `jaxbearing._errors`, `jaxbearing.geometry`.
 """
@@ -59,11 +60,13 @@ from ._files import (
 )
 from ._keys import format_value, type_name
 from ._lock import DirectoryInUse, DirectoryLock, acquire_lock
+from ._measurements import CageSpeedMeasurement, read_cage_speed_measurements
 from ._schema import KEY_BY_PATH, KEYS
 from ._tree import TreeFileError, check_like, load_tree, save_tree, tree_bytes, tree_from_bytes
 from ._validation import IMPLAUSIBLY_SMALL, plausibility_warnings, validate_bearing
 
 __all__ = [
+    "CageSpeedMeasurement",
     "FUNCTIONALS_FIELDS",
     "IMPLAUSIBLY_SMALL",
     "KEYS",
@@ -80,6 +83,7 @@ __all__ = [
     "TreeFileError",
     "acquire_lock",
     "atomic_write",
+    "read_cage_speed_measurements",
     "check_arguments",
     "check_fields",
     "check_like",

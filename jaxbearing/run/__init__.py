@@ -16,10 +16,13 @@
   mean and p95 PV over contact time, corner share and margin, static margins; continuation from
   given states), `steady_gradient` (its gradient: ensemble of short-window forward-mode
   sensitivities from settled states), `tangent_growth` (finite-time growth of the tangents),
-  `solve_from` / `prepare_from` (continue from any state), `check_steady_options`;
+  `solve_from` / `prepare_from` (continue from any state), `check_steady_options` and the
+  defaults `SETTLE_TOLERANCE`, `SETTLE_CAP_MS`;
 - design metrics through the dynamics: `design_metrics`, `design_jacobian`, `DesignMetrics`,
   `seated_perturbation`, `forward_jacobian`;
 - `plot_run`: the figures of one run;
+- against measurements: `model_cage_speeds` (a settled run at every measured operating point,
+  the relative error with its interval) and its figure `plot_measured`;
 - speed: `raceway_normal_norm` (the error norm of settled windows, `prepare_from`; `solve`'s
   is `TRANSIENT_ERROR_NORM`), `enable_compilation_cache` (JAX's
   persistent cache in a user directory, `$JAXBEARING_CACHE_DIR`; on at import),
@@ -46,7 +49,8 @@ from ._design import (
 )
 from ._ensemble import as_completed_map, available_cpus, parallel_map, shared_workers, simulate_ensemble
 from ._initial import STARTS, Perturbation, SkidStart, initial_state, skid_start
-from ._plots import plot_run
+from ._measured import model_cage_speeds
+from ._plots import plot_measured, plot_run
 from ._progress import HostProgress, SolveProgress
 from ._result import (
     RESULT_NAMES,
@@ -57,6 +61,8 @@ from ._result import (
     smooth_functionals,
 )
 from ._settle import (
+    SETTLE_CAP_MS,
+    SETTLE_TOLERANCE,
     SeedRun,
     SteadyResult,
     check_steady_options,
@@ -100,6 +106,8 @@ from ._step_control import (
 from ._summary import FILM_KEYS, contact_events, film_statistics
 
 __all__ = [
+    "SETTLE_CAP_MS",
+    "SETTLE_TOLERANCE",
     "GRADIENT_WINDOW",
     "STEADY_FUNCTIONALS",
     "SteadyGradient",
@@ -155,6 +163,8 @@ __all__ = [
     "forward_jacobian",
     "initial_state",
     "skid_start",
+    "model_cage_speeds",
+    "plot_measured",
     "plot_run",
     "result_code",
     "revolution_statistics",

@@ -85,3 +85,68 @@ def plot_run(out_dir: pathlib.Path, results: dict) -> list[pathlib.Path]:
     fig.savefig(files[-1], dpi=110)
     plt.close(fig)
     return files
+
+
+def plot_measured(path, rows: list[dict], title: str = "") -> pathlib.Path:
+    """The model against measured cage speeds (`model_cage_speeds`' rows): cage speed over shaft
+    speed, measured points against the settled model with its 95 % interval, one colour per
+    radial load (left); the relative error (model - measured) / measured with its interval
+    (right). The source study's Figure 16 layout."""
+    plt = _plt()
+    path = pathlib.Path(path)
+    fig, (ax, axe) = plt.subplots(1, 2, figsize=(11, 4.2))
+    loads = sorted({r["radial_load_N"] for r in rows})
+    for i, load in enumerate(loads):
+        sel = sorted((r for r in rows if r["radial_load_N"] == load), key=lambda r: r["shaft_speed_rpm"])
+        colour = f"C{i % 10}"
+        n = np.array([r["shaft_speed_rpm"] for r in sel])
+        meas = np.array([r["measured_cage_speed_rpm"] for r in sel])
+        est = [r["model_cage_speed_rpm"] for r in sel]
+        val = np.array([np.nan if e["value"] is None else e["value"] for e in est])
+        lo = np.array([np.nan if e["ci95_low"] is None else e["ci95_low"] for e in est])
+        hi = np.array([np.nan if e["ci95_high"] is None else e["ci95_high"] for e in est])
+        ax.plot(n, meas, "o", color=colour, mfc="none", label=f"measured, {load:g} N")
+        ax.errorbar(
+            n,
+            val,
+            yerr=[val - lo, hi - val],
+            fmt="-s",
+            ms=3,
+            capsize=3,
+            color=colour,
+            label=f"model (95 % CI), {load:g} N",
+        )
+        err = np.array([np.nan if r["relative_error"] is None else r["relative_error"] for r in sel]) * 100
+        elo = (
+            np.array(
+                [
+                    np.nan if r["relative_error_ci95_low"] is None else r["relative_error_ci95_low"]
+                    for r in sel
+                ]
+            )
+            * 100
+        )
+        ehi = (
+            np.array(
+                [
+                    np.nan if r["relative_error_ci95_high"] is None else r["relative_error_ci95_high"]
+                    for r in sel
+                ]
+            )
+            * 100
+        )
+        axe.errorbar(
+            n, err, yerr=[err - elo, ehi - err], fmt="s", ms=3, capsize=3, color=colour, label=f"{load:g} N"
+        )
+    ax.set_xlabel("shaft speed [rpm]")
+    ax.set_ylabel("cage speed [rpm]")
+    ax.legend(fontsize=7)
+    axe.axhline(0.0, color="k", lw=0.8)
+    axe.set_xlabel("shaft speed [rpm]")
+    axe.set_ylabel("relative error, model - measured [%]")
+    axe.legend(fontsize=7)
+    fig.suptitle(title or "Cage speed: model (settled running, 95 % CI) against measurement")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
