@@ -283,3 +283,30 @@ def test_kinematic_start_settles_only_on_the_skid_plateau():
     old = next(i for i in range(1, len(revs)) if abs(revs[i] - revs[i - 1]) <= tol * abs(revs[i]))
     assert revs[old] - plateau["value"] > tol * plateau["value"]
     assert kin["settle_time_ms"] > kin["per_seed"][0]["revolution_end_ms"][old]
+
+
+def test_running_time_constant_is_conservative():
+    """tau_run = 1.5 tau_s, or the pre-start's longest positive secant -(w_k - w_{k-1}) /
+    (g_k - g_{k-1}) of its measured drifts if longer (every secant, also one far outside the
+    static tau_s); a secant of the wrong sign is ignored."""
+    from types import SimpleNamespace
+
+    from jaxbearing.run._settle import RUNNING_SLOW_MODE_FACTOR, running_time_constant
+
+    def skid(tau_s, speeds=(), drifts=()):
+        return SimpleNamespace(
+            static_time_constant=tau_s, time_constant=tau_s, drift_speeds=speeds, drifts=drifts
+        )
+
+    assert running_time_constant(skid(0.046), None, None, None) == pytest.approx(
+        RUNNING_SLOW_MODE_FACTOR * 0.046
+    )
+    # secants 79.4 / 1198 = 66.3 ms and 32.8 / 530 = 61.9 ms (the reference point, docs/model.md 16)
+    ref = skid(0.046, (8527.4, 8448.0, 8415.2), (-1696.0, -498.0, 32.0))
+    assert running_time_constant(ref, None, None, None) == pytest.approx(RUNNING_SLOW_MODE_FACTOR * 0.046)
+    assert running_time_constant(skid(0.0002, (9000.0, 8900.0), (-2000.0, -400.0)), None, None, None) == (
+        pytest.approx(100.0 / 1600.0)
+    )
+    assert running_time_constant(skid(0.0002, (9000.0, 8900.0), (-400.0, -2000.0)), None, None, None) == (
+        pytest.approx(RUNNING_SLOW_MODE_FACTOR * 0.0002)
+    )

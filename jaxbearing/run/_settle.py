@@ -136,16 +136,20 @@ def running_time_constant(skid, bearing: Bearing, op: OperatingPoint, perturbati
     docs/model.md 16): `RUNNING_SLOW_MODE_FACTOR` times the static slow mode's tau_s
     (`dynamics.cage_time_constant` at the static skid equilibrium of this seed; `skid`, a
     `SkidStart`, carries it, else it is solved here, as for the quasi-static start), or the
-    pre-start's secant if that is longer."""
+    longest positive secant of the pre-start's measured drifts if that is longer (every secant,
+    also those the pre-start's own steps rejected: a static balance far from the running state,
+    e.g. a misaligned one before its quasi-static start knew the tilt, gave tau_s = 0.19 ms)."""
     if skid is None:
         skid = skid_start(bearing, op, perturbation)
     tau_s = float(skid.static_time_constant)
     if not math.isfinite(tau_s):
         tau_s = float(skid.time_constant)
     tau = RUNNING_SLOW_MODE_FACTOR * tau_s
-    if skid.pre_start_status == "ok":
-        tau = max(tau, float(skid.time_constant))
-    return tau
+    w, g = np.asarray(skid.drift_speeds, float), np.asarray(skid.drifts, float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        secants = -np.diff(w) / np.diff(g)
+    secants = secants[np.isfinite(secants) & (secants > 0)]
+    return float(max(tau, *secants)) if secants.size else float(tau)
 
 
 def prepare_from(params: Params, start: State, rtol, atol):
@@ -649,7 +653,7 @@ RESIDUAL_DRIFT_METHOD = (
     "remaining drift of the cage speed on its slow mode, |b| tau_run: b the slope of the least-squares "
     "line through the revolution-mean cage speeds of the last 4-8 revolutions before the window (since "
     "the last projective step), tau_run the running slow mode's time constant (1.5 x the static skid "
-    "equilibrium's tau_s, or the pre-start's secant if longer); bound: (|b| + t_{n-2,0.95} SE(b)) tau_run; "
+    "equilibrium's tau_s, or the pre-start's longest secant if longer); bound: (|b| + t_{n-2,0.95} SE(b)) tau_run; "
     "settled when bound <= tolerance x cage speed"
 )
 
