@@ -109,7 +109,7 @@ def test_auto_settle_hitting_the_cap_is_not_silent(small_config, capsys):
     )
     text = capsys.readouterr().out
     assert code == 1
-    assert "settled false" in text and "NOT SETTLED" in text
+    assert "settled false" in text and "NOT SETTLED" in text and "remaining drift" in text
 
 
 @pytest.mark.slow
