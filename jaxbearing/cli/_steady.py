@@ -46,7 +46,8 @@ def add_arguments(p) -> None:
         "--settle-tolerance",
         type=float,
         default=1e-3,
-        help="relative change of the revolution-mean cage speed that counts as settled (default: %(default)g)",
+        help="largest remaining drift of the cage speed, relative, that counts as settled: the drift of the "
+        "last 4-8 revolution means times the slow mode's time constant (default: %(default)g)",
     )
     g.add_argument(
         "--workers",
@@ -111,6 +112,11 @@ def _ci(est, k, fmt=".4g") -> str:
     return f"{est['value'] * k:{fmt}} [{est['ci95_low'] * k:{fmt}}, {est['ci95_high'] * k:{fmt}}]"
 
 
+def _rpm(value) -> str:
+    """A residual drift [rpm] for the table ('-' where none was estimated)."""
+    return "-" if value is None else f"{value:.1f}"
+
+
 def format_table(summaries: dict) -> str:
     """Statistic per row, one column per end type: value [95 % CI]."""
     ends = list(summaries)
@@ -154,9 +160,15 @@ def format_table(summaries: dict) -> str:
     for e in ends:
         s = summaries[e]
         rho = s.get("limited_circle_radius_m")
+        drift = ""
+        if s.get("residual_drift_rpm") is not None:
+            drift = (
+                f"; residual drift {_rpm(s['residual_drift_rpm'])} rpm, "
+                f"bound {_rpm(s.get('residual_drift_bound_rpm'))} rpm"
+            )
         lines.append(
             f"[{e}] status {s['status']}; settled {str(s['settled']).lower()} ({s['settle_mode']}, "
-            f"{s['settle_time_ms']:.1f} ms); window {s['window_revs']} revolutions = {s['window_ms']:.1f} ms; "
+            f"{s['settle_time_ms']:.1f} ms{drift}); window {s['window_revs']} revolutions = {s['window_ms']:.1f} ms; "
             f"seeds {len(s['seeds'])}; CI: {s.get('ci_method', '-')}; rho_lim "
             f"{'-' if rho is None else format(rho * 1e3, '.3f')} mm; wall {s['wall_time_s']:.1f} s "
             f"(+ compile {s['compile_time_s']:.1f} s)"
@@ -170,9 +182,10 @@ def format_table(summaries: dict) -> str:
             )
         if s["settle_mode"] == "auto" and not s["settled"]:
             lines.append(
-                f"[{e}] NOT SETTLED: the cage speed still changed by more than "
-                f"{s['settle_tolerance']:.2g} per revolution at the cap of {s['settle_cap_ms']:.0f} ms; "
-                "the statistics come from a transient (fix a settling time with --settle MS)"
+                f"[{e}] NOT SETTLED: the cage speed's remaining drift (up to "
+                f"{_rpm(s.get('residual_drift_bound_rpm'))} rpm) still exceeded {s['settle_tolerance']:.2g} "
+                f"of it at the cap of {s['settle_cap_ms']:.0f} ms; the statistics come from a transient "
+                "(fix a settling time with --settle MS)"
             )
     return "\n".join(lines)
 

@@ -63,6 +63,7 @@ from ..contact import PENETRATION_WIDTH
 from ..forces import (
     raceway_stiffness,
     slice_loads_from_interference,
+    slice_positions,
     uniform_approach_interference,
 )
 from ..geometry import Bearing, OperatingPoint, kinematic_cage_speed
@@ -126,11 +127,18 @@ class _Problem(eqx.Module):
     ring_load: Array  # F_r + m_i g [N]
     roller_external: Array  # (Z,) F_c + m_b g cos psi_j, outward [N]
     radial_units_yz: Array  # (Z, 2)
+    #: (Z,) slope of the inner slice interferences along the roller from the imposed
+    #: misalignment psi_m, -sin(psi_m) cos(psi_j), and the approach it adds at the roller centre,
+    #: (d_m/2)(1 - sqrt(1 - sin^2(psi_m) cos^2(psi_j))) (the roller centre's distance from the
+    #: tilted axis; docs/model.md 12; both 0 for an aligned ring)
+    inner_tilt_slope: Array
+    inner_tilt_approach: Array
 
 
 def _loads(prob: _Problem, a_i, a_o):
     b = prob.bearing
-    qi = slice_loads_from_interference(b, uniform_approach_interference(b, a_i), PENETRATION_WIDTH)
+    tilt = prob.inner_tilt_slope[:, None] * slice_positions(b) + prob.inner_tilt_approach[:, None]
+    qi = slice_loads_from_interference(b, uniform_approach_interference(b, a_i) + tilt, PENETRATION_WIDTH)
     qo = slice_loads_from_interference(b, uniform_approach_interference(b, a_o), PENETRATION_WIDTH)
     return qi, qo
 
@@ -168,7 +176,12 @@ def _solve_rollers(prob: _Problem, d):
     half_d = b.roller.diameter / 2
     r_inner_touch = b.inner_raceway_radius + half_d + prob.radial_units_yz @ d
     r_outer_touch = b.outer_raceway_radius - half_d
-    margin = _deflection_bound(prob, prob.roller_external) + b.roller.crown_drop + 1e3 * PENETRATION_WIDTH
+    margin = (
+        _deflection_bound(prob, prob.roller_external)
+        + b.roller.crown_drop
+        + jnp.abs(prob.inner_tilt_slope) * b.roller.effective_length / 2
+        + 1e3 * PENETRATION_WIDTH
+    )
     lo0 = jnp.minimum(r_inner_touch, r_outer_touch) - margin
     hi0 = jnp.maximum(r_inner_touch, r_outer_touch) + margin
 
@@ -267,6 +280,9 @@ def quasi_static(bearing: Bearing, op: OperatingPoint) -> QuasiStatic:
         ring_load=op.radial_load + bearing.inner_ring_mass * op.gravity,
         roller_external=f_c + m_b * op.gravity * e[:, 2],
         radial_units_yz=e[:, 1:],
+        inner_tilt_slope=-jnp.sin(op.misalignment) * jnp.cos(psi),
+        inner_tilt_approach=(bearing.pitch_diameter / 2)
+        * (1 - jnp.sqrt(1 - (jnp.sin(op.misalignment) * jnp.cos(psi)) ** 2)),
     )
 
     d_star = _solve_ring(prob)

@@ -154,6 +154,8 @@ class SkidStart(eqx.Module):
     drifts: tuple = ()
     plateau_speed: float = float("nan")
     pre_start_status: str = eqx.field(static=True, default="static")
+    #: the static slow mode's tau_s [s] (`dynamics.cage_time_constant`), also after a pre-start
+    static_time_constant: float = float("nan")
 
 
 def _skid(bearing, op, scatter):
@@ -166,7 +168,11 @@ def _skid(bearing, op, scatter):
 def _static_skid_start(bearing: Bearing, op: OperatingPoint, perturbation: Perturbation | None) -> SkidStart:
     dyn = (bearing, op, traced_scatter(perturbation))
     static = compiled_program("skid_start", _skid, dyn)(*dyn)
-    return dataclasses.replace(static, plateau_speed=float(static.equilibrium.cage_speed))
+    return dataclasses.replace(
+        static,
+        plateau_speed=float(static.equilibrium.cage_speed),
+        static_time_constant=float(static.time_constant),
+    )
 
 
 #: the pre-start's bursts, in revolutions at the static skid speed: each skips `PRE_START_SKIP`
@@ -247,6 +253,7 @@ def _pre_start(static: SkidStart, integrate) -> SkidStart:
         drifts=tuple(drifts),
         plateau_speed=level + jump,
         pre_start_status="ok",
+        static_time_constant=tau_s,
     )
 
 

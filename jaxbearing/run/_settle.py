@@ -7,8 +7,11 @@ measure over a window of whole revolutions (issue 11; docs/model.md 16).
   restarts at every chunk from the chunk's own start state and cage speed, so the scaled
   azimuths never accumulate the cage slip over a long run.
 * Settling (`settle="auto"`): chunks of one cage revolution (2 pi / the previous revolution's
-  mean cage speed) until the revolution-mean cage speed changes by less than `tolerance`
-  (relative) between two consecutive revolutions, at most `settle_cap_ms`. `settle=MS` runs a
+  mean cage speed) until the settling verdict (`settling_verdict`) finds the cage speed's
+  remaining drift below `tolerance` (relative): the slope of a least-squares line through the
+  last 4-8 revolution means times the running slow mode's time constant, with its one-sided 95 %
+  bound (a drift slower than the tolerance per revolution does not pass; docs/model.md 16), at
+  most `settle_cap_ms` (then not settled, the residual drift reported). `settle=MS` runs a
   fixed MS ms first (declared settled by the user); `settle="off"` measures from the start
   (`settled` is then False: nothing was verified).
 * The start (`start="skid"`, the default): the skid equilibrium (`_initial.skid_start`: cage
@@ -23,8 +26,8 @@ measure over a window of whole revolutions (issue 11; docs/model.md 16).
   d omega/dt, measured by the dynamics themselves, moves the cage speed (and the rollers' orbit
   and spin in proportion) by tau d omega/dt, tau = `dynamics.cage_time_constant` (the Newton
   step of the linear slow mode onto its plateau), while the step exceeds a quarter of `tolerance`;
-  at most `PROJECTIVE_STEPS` times. Settling is then detected as below, on revolutions after the last
-  step only. Since the skid start's pre-start (`_initial`) measures that drift itself and lands
+  at most `PROJECTIVE_STEPS` times. Settling is then detected as above, on revolutions after the
+  last step only. Since the skid start's pre-start (`_initial`) measures that drift itself and lands
   on the plateau, the projective steps are taken only when its pre-start failed.
   `start="quasi-static"`: kinematic speeds, no projective steps.
 * The window is `window_revs` further revolutions; its statistics and intervals come from
@@ -44,6 +47,7 @@ import diffrax
 import jax
 import jax.numpy as jnp
 import numpy as np
+from scipy import stats as _sp_stats
 
 from .._errors import UserInputError
 from ..dynamics import Functionals, Params, Scaling, State, state_scales
@@ -69,11 +73,83 @@ SAVES_PER_REV = 1320  # 5 us at the reference cage speed, as `simulate`'s defaul
 PROJECTIVE_STEPS = 4
 #: a projective step moves the cage speed by at most this fraction
 PROJECTIVE_CAP = 0.05
-#: projective steps go on while a step exceeds this fraction of the settling tolerance (the
-#: criterion compares consecutive revolutions, so a slow drift below the tolerance per revolution
-#: would otherwise stay in the window: at the reference point 1 rpm per revolution after the first
-#: step, 0.09 % of the plateau in tau = 46 ms)
+#: projective steps go on while a step exceeds this fraction of the settling tolerance (chosen
+#: when the criterion compared consecutive revolutions, which let a slow drift below the tolerance
+#: per revolution into the window: at the reference point 1 rpm per revolution after the first
+#: step, 0.09 % of the plateau in tau = 46 ms; the verdict now catches such a drift itself)
 PROJECTIVE_THRESHOLD = 0.25
+
+#: the settling verdict (`settling_verdict`): a line through the revolution-mean cage speeds of at
+#: least `VERDICT_MIN_REVS` and at most `VERDICT_MAX_REVS` revolutions since the last projective step
+VERDICT_MIN_REVS = 4
+VERDICT_MAX_REVS = 8
+#: one-sided confidence of the verdict's upper bound on the remaining drift
+VERDICT_CONFIDENCE = 0.95
+#: the verdict's running slow mode, in multiples of the static tau_s (`running_time_constant`)
+RUNNING_SLOW_MODE_FACTOR = 1.5
+
+
+@dataclasses.dataclass(frozen=True)
+class Verdict:
+    """`settling_verdict`'s answer. `residual_drift_rpm`: how far the cage speed still has to go
+    on its slow mode, |slope| tau_run (nan before `VERDICT_MIN_REVS` revolutions); `bound_rpm`:
+    its one-sided 95 % upper bound (slope + t SE); `slope_rpm_s`, `slope_se_rpm_s`: the line's
+    slope and standard error; `revolutions`: how many revolutions the line ran through."""
+
+    settled: bool
+    residual_drift_rpm: float
+    bound_rpm: float
+    slope_rpm_s: float
+    slope_se_rpm_s: float
+    revolutions: int
+    time_constant_s: float
+
+
+def settling_verdict(centres, speeds, tolerance: float, time_constant: float) -> Verdict:
+    """Whether the revolution-mean cage speeds `speeds` [rpm] at revolution centres `centres`
+    [s] (those since the last projective step, oldest first) have settled (docs/model.md 16):
+    the least-squares line through the last `VERDICT_MAX_REVS` of them (at least
+    `VERDICT_MIN_REVS`) has slope b +/- SE; near its plateau the cage speed relaxes along its slow
+    mode, omega - omega_inf = -tau b, so the remaining drift is |b| tau with tau =
+    `time_constant` [s] (a conservative estimate of the running slow mode). Settled when the
+    one-sided 95 % upper bound (|b| + t_{n-2, 0.95} SE) tau is at most `tolerance` times the
+    last speed. Pure, host-side (numpy)."""
+    t = np.asarray(centres, float)[-VERDICT_MAX_REVS:]
+    w = np.asarray(speeds, float)[-VERDICT_MAX_REVS:]
+    n = t.size
+    nan = float("nan")
+    if n < VERDICT_MIN_REVS:
+        return Verdict(False, nan, nan, nan, nan, n, float(time_constant))
+    tc = t - t.mean()
+    sxx = float(np.sum(tc * tc))
+    slope = float(np.sum(tc * (w - w.mean())) / sxx)
+    resid = w - w.mean() - slope * tc
+    se = float(np.sqrt(np.sum(resid * resid) / (n - 2) / sxx))
+    q = float(_sp_stats.t.ppf(VERDICT_CONFIDENCE, n - 2))
+    drift = abs(slope) * time_constant
+    bound = (abs(slope) + q * se) * time_constant
+    return Verdict(bool(bound <= tolerance * abs(w[-1])), drift, bound, slope, se, n, float(time_constant))
+
+
+def running_time_constant(skid, bearing: Bearing, op: OperatingPoint, perturbation: Perturbation) -> float:
+    """The running slow mode's time constant [s] the verdict uses (`settling_verdict`,
+    docs/model.md 16): `RUNNING_SLOW_MODE_FACTOR` times the static slow mode's tau_s
+    (`dynamics.cage_time_constant` at the static skid equilibrium of this seed; `skid`, a
+    `SkidStart`, carries it, else it is solved here, as for the quasi-static start), or the
+    longest positive secant of the pre-start's measured drifts if that is longer (every secant,
+    also those the pre-start's own steps rejected: a static balance far from the running state,
+    e.g. a misaligned one before its quasi-static start knew the tilt, gave tau_s = 0.19 ms)."""
+    if skid is None:
+        skid = skid_start(bearing, op, perturbation)
+    tau_s = float(skid.static_time_constant)
+    if not math.isfinite(tau_s):
+        tau_s = float(skid.time_constant)
+    tau = RUNNING_SLOW_MODE_FACTOR * tau_s
+    w, g = np.asarray(skid.drift_speeds, float), np.asarray(skid.drifts, float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        secants = -np.diff(w) / np.diff(g)
+    secants = secants[np.isfinite(secants) & (secants > 0)]
+    return float(max(tau, *secants)) if secants.size else float(tau)
 
 
 def prepare_from(params: Params, start: State, rtol, atol):
@@ -174,6 +250,9 @@ class SeedRun:
     window_start_state: object = None
     final_state: object = None
     start_cage_speed_rpm: float = float("nan")
+    #: the settling verdict at the end of settling (`settling_verdict`; with `settle` fixed or
+    #: "off", the one before the window is not evaluated: nan fields)
+    verdict: object = None
 
 
 def check_steady_options(
@@ -238,15 +317,19 @@ def _run_seed(
     saves,
     progress,
     time_constant=None,
+    slow_mode=float("nan"),
     solver=DEFAULT_SOLVER,
 ):
     """Settle then measure one seed (module docstring); `time_constant` [s] (skid start) turns
-    on the projective steps of the cage speed."""
+    on the projective steps of the cage speed; `slow_mode` [s]: the running slow mode's time
+    constant the verdict uses (`settling_verdict`)."""
     compiled = _compiled(params, start, saves, max_steps, solver)
     state, t, steps = start, 0.0, 0
     speeds, ends, windows, edges, jumps, integrals = [], [], [], [], [], []
+    centres = []  # revolution centres [s]
     window_start = start
     since_jump = 0  # revolutions run since the last projective step
+    verdict = settling_verdict([], [], tolerance, slow_mode)
     settled, settle_time, status = settle == "off", 0.0, "ok"
     fixed = None if isinstance(settle, str) else float(settle) * 1e-3
     measuring = settle == "off" or fixed == 0.0
@@ -269,6 +352,7 @@ def _run_seed(
         state = final
         speeds.append(float(rad_s_to_rpm(np.mean(hist["cage_speed"]))))
         ends.append(t)
+        centres.append(t - 0.5 * rev)
         if progress:
             print(
                 f"  t = {t * 1e3:7.2f} ms: cage {speeds[-1]:9.2f} rpm over the last revolution"
@@ -301,7 +385,9 @@ def _run_seed(
         if fixed is not None:
             done = t >= fixed - 1e-12
         else:
-            done = since_jump >= 2 and abs(speeds[-1] - speeds[-2]) <= tolerance * abs(speeds[-1])
+            recent = slice(len(speeds) - since_jump, None)
+            verdict = settling_verdict(centres[recent], speeds[recent], tolerance, slow_mode)
+            done = verdict.settled
         if done:
             settled, settle_time, measuring = True, t, True
         elif t >= cap:
@@ -320,6 +406,7 @@ def _run_seed(
         jumps,
         integrals,
         *host,
+        verdict,
     )
 
 
@@ -468,6 +555,11 @@ def simulate_steady(
             tau = None if skid.pre_start_status == "ok" else float(skid.time_constant)
         else:
             y0, tau = initial_state(bearing, op, pert), None
+        slow_mode = float("nan")
+        if settle == "auto":
+            slow_mode = running_time_constant(
+                skid if given is None and start == "skid" else None, bearing, op, pert
+            )
         c0 = time.perf_counter()
         _compiled(params, y0, int(saves_per_rev), int(max_steps), solver)
         compile_time += time.perf_counter() - c0
@@ -486,9 +578,13 @@ def simulate_steady(
             saves=int(saves_per_rev),
             progress=progress,
             time_constant=tau,
+            slow_mode=slow_mode,
             solver=solver,
         )
-        runs.append(SeedRun(pert.seed, *out, start_cage_speed_rpm=float(rad_s_to_rpm(y0.cage.speed))))
+        *out, verdict = out
+        runs.append(
+            SeedRun(pert.seed, *out, start_cage_speed_rpm=float(rad_s_to_rpm(y0.cage.speed)), verdict=verdict)
+        )
     wall = time.perf_counter() - wall0 - compile_time
     return SteadyResult(
         runs=runs,
@@ -534,9 +630,11 @@ def summarise_steady(result: SteadyResult, threshold: float = 1.0) -> dict:
                 "revolution_cage_speed_rpm": r.revolution_speeds_rpm,
                 "start_cage_speed_rpm": r.start_cage_speed_rpm,
                 "projective_steps_rpm": r.projective_steps_rpm,
+                **_verdict_block(r.verdict),
             }
             for r in runs
         ],
+        **_residual_drift(runs),
         "num_steps": sum(r.num_steps for r in runs),
         "wall_time_s": result.wall_time_s,
         "compile_time_s": result.compile_time_s,
@@ -548,6 +646,49 @@ def summarise_steady(result: SteadyResult, threshold: float = 1.0) -> dict:
             )
         )
     return block
+
+
+#: how the summary's residual drift is estimated (docs/model.md 16)
+RESIDUAL_DRIFT_METHOD = (
+    "remaining drift of the cage speed on its slow mode, |b| tau_run: b the slope of the least-squares "
+    "line through the revolution-mean cage speeds of the last 4-8 revolutions before the window (since "
+    "the last projective step), tau_run the running slow mode's time constant (1.5 x the static skid "
+    "equilibrium's tau_s, or the pre-start's longest secant if longer); bound: (|b| + t_{n-2,0.95} SE(b)) tau_run; "
+    "settled when bound <= tolerance x cage speed"
+)
+
+
+def _verdict_block(verdict) -> dict:
+    """A seed's settling verdict in the summary (nan fields as None: JSON has no nan)."""
+    if verdict is None:
+        return {}
+
+    def num(x):
+        return float(x) if math.isfinite(x) else None
+
+    return {
+        "residual_drift_rpm": num(verdict.residual_drift_rpm),
+        "residual_drift_bound_rpm": num(verdict.bound_rpm),
+        "settling_drift_rpm_s": num(verdict.slope_rpm_s),
+        "settling_drift_se_rpm_s": num(verdict.slope_se_rpm_s),
+        "verdict_revolutions": int(verdict.revolutions),
+        "slow_mode_time_constant_ms": num(verdict.time_constant_s * 1e3),
+    }
+
+
+def _residual_drift(runs) -> dict:
+    """The summary's residual drift: the largest over the seeds (None where no verdict was
+    evaluated: fixed or no settling)."""
+    drifts = [r.verdict.residual_drift_rpm for r in runs if r.verdict is not None]
+    bounds = [r.verdict.bound_rpm for r in runs if r.verdict is not None]
+    finite = [d for d in drifts if math.isfinite(d)]
+    if not finite:
+        return {"residual_drift_rpm": None, "residual_drift_bound_rpm": None}
+    return {
+        "residual_drift_rpm": max(finite),
+        "residual_drift_bound_rpm": max(b for b in bounds if math.isfinite(b)),
+        "residual_drift_method": RESIDUAL_DRIFT_METHOD,
+    }
 
 
 def simulate(bearing: Bearing, op: OperatingPoint, *, settle=None, **kwargs):

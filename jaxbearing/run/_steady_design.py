@@ -33,7 +33,8 @@ of the ensemble average from the states this returns (`final_states`).
 
 Continuation. `initial_states` (one per seed, e.g. a neighbouring design's `final_states`)
 starts every seed from a settled state instead of the skid start, so a design close to the
-previous one settles in the minimum two revolutions instead of from the start.
+previous one settles in the verdict's minimum four revolutions (`_settle.settling_verdict`) instead
+of from the start.
 """
 
 from __future__ import annotations
