@@ -494,3 +494,22 @@ def test_every_command_and_option_has_a_description_and_a_default():
                 if "(default" not in " ".join((a.help or "").split()):
                     missing.append(f"{top.prog} {' '.join(path)} {a.option_strings[0]}: no default shown")
     assert missing == []
+
+
+def test_warnings_of_a_command_are_one_line(capsys):
+    """A warning raised while a command runs (here a two-line one from a stand-in command) is one
+    line on stderr naming the command, as an error is; outside the command the display is Python's."""
+    import argparse
+    import warnings
+
+    from jaxbearing.cli import dispatch
+
+    parser = argparse.ArgumentParser(prog="jaxbearing")
+    sub = parser.add_subparsers(dest="command")
+    p = sub.add_parser("demo")
+    p.set_defaults(func=lambda args: warnings.warn("first line\nsecond line", UserWarning, stacklevel=1) or 0)
+    before = warnings.showwarning
+    assert dispatch(parser, ["demo"]) == 0
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["jaxbearing demo: warning: first line"]
+    assert warnings.showwarning is before

@@ -15,8 +15,10 @@ docs/reference/files-and-exit-codes.md lists them with the files every command w
 from __future__ import annotations
 
 import argparse
+import contextlib
 import importlib
 import sys
+import warnings
 
 #: command name -> module; the order is the order of `jaxbearing --help`.
 COMMANDS = {
@@ -89,13 +91,28 @@ def dispatch(parser: argparse.ArgumentParser, argv: list[str] | None) -> int:
         parser.print_help()
         return 0
     try:
-        return int(args.func(args) or 0)
+        with one_line_warnings(f"{parser.prog} {args.command}"):
+            return int(args.func(args) or 0)
     except UserInputError as exc:
         print(f"{parser.prog} {args.command}: error: {exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print(f"{parser.prog} {args.command}: interrupted", file=sys.stderr)
         return 130
+
+
+@contextlib.contextmanager
+def one_line_warnings(prog: str):
+    """While a command runs, every warning is one line on stderr, "PROG COMMAND: warning: ..."
+    (its first line; no source line or file position), as errors are."""
+    with warnings.catch_warnings():  # restores the previous display on exit
+
+        def show(message, category, filename, lineno, file=None, line=None):
+            text = str(message).strip().splitlines()[0] if str(message).strip() else category.__name__
+            print(f"{prog}: warning: {text}", file=sys.stderr)
+
+        warnings.showwarning = show
+        yield
 
 
 def main(argv: list[str] | None = None) -> int:
