@@ -300,7 +300,7 @@ def _skewed_axis(skew):
 def test_tangent_plane_error_against_the_exact_cone(side, ring_sign):
     """The tangent-plane gap at the contact point differs from the exact cone distance by
     exactly g e(C), e = sin(theta_f) rho (1 - cos psi) = `face_error`, bounded by
-    sin(theta_f) s_c^2 / rho and ~ sin(theta_f) s_c^2 / (2 rho) (docs/model.md 5.5). For the arc
+    sin(theta_f) s_c^2 / rho and ~ sin(theta_f) s_c^2 / (2 rho) (docs/model.md 5.2). For the arc
     end the exact cone interference (maximised numerically over the end sphere) differs from the
     model's by g e(O) at the sphere centre O = C - R_end n, within 7 % of `face_error`; on the
     corner (a union of balls of radius R_cor on the centre circle) by at most e at the plane's

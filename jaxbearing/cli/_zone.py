@@ -257,7 +257,7 @@ def outside_zone_lines(bearing, zone) -> list[str]:
         "between the flanges",
     }
     return [
-        f"the design is outside the design zone (docs/model.md 4.1): {name.removesuffix('_margin')} "
+        f"the design is outside the design zone (docs/model.md 6): {name.removesuffix('_margin')} "
         f"margin {float(getattr(zone, name)) / MM:+.4f} mm: {text}"
         for name, text in why.items()
         if not float(getattr(zone, name)) > 0
