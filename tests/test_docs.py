@@ -173,3 +173,30 @@ def test_readme_links_point_at_existing_anchors():
         if anchor not in slugs:
             bad.append(f"{target}#{anchor}")
     assert not bad, bad
+
+
+def test_model_section_references_exist():
+    """Every "docs/model.md N" (or "model.md, section N") in the code, the tests and the docs
+    names a section heading that docs/model.md has."""
+    heads = set()
+    for line in (ROOT / "docs" / "model.md").read_text().splitlines():
+        m = re.match(r"#+\s+([0-9]+[a-z]?(?:\.[0-9]+)?)[.\s]", line)
+        if m:
+            heads.add(m.group(1))
+    files = [ROOT / "README.md"]
+    for pattern in (
+        "jaxbearing/**/*.py",
+        "optimise/*.py",
+        "tests/*.py",
+        "docs/**/*.md",
+        "benchmarks/**/*.py",
+    ):
+        files += ROOT.glob(pattern)
+    ref = re.compile(r"model\.md(?:\]\([^)]*\))?,?\s+(?:sections?\s+)?([0-9]+[a-z]?(?:\.[0-9]+)?)\b")
+    bad = [
+        f"{p.relative_to(ROOT)}: section {m.group(1)}"
+        for p in files
+        for m in ref.finditer(p.read_text())
+        if m.group(1) not in heads
+    ]
+    assert heads and not bad, bad
