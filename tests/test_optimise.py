@@ -13,6 +13,7 @@ import math
 import jax.numpy as jnp
 import numpy as np
 import pytest
+from _figures import assert_png_drawn
 
 import jaxbearing as jb
 import optimise as opt
@@ -173,7 +174,7 @@ def test_cli_end_to_end(tmp_path, capsys, searched):
     assert all(v > 0 for v in result["margins"].values())
     assert result["design"]["axial_clearance_mm"] == pytest.approx(CLEARANCE_MM)
     assert len(result["history"]["objective_GPa_m_s"]) == ITERATIONS + 1
-    assert (out / "search_paths.png").stat().st_size > 10_000
+    assert_png_drawn(out / "search_paths.png")
 
 
 def test_cli_no_feasible_design_exits_nonzero(tmp_path, capsys):
@@ -212,3 +213,74 @@ def test_cli_bad_input_one_line_exit_2(tmp_path, capsys, args, text):
     assert main(["run", "--out", str(tmp_path), *args]) == 2
     err = capsys.readouterr().err
     assert text in err and err.count("\n") == 1
+
+
+def test_cli_settings_from_a_file_and_options_reach_the_problem(tmp_path, capsys, monkeypatch):
+    """`optimise run --objective startup` with its settings from `--bounds FILE` and the
+    options: the bounds (from the file, one of them overridden by `--layback-deg`), envelope
+    (`--speeds-rpm` x `--loads-N`, speed-major, `--weights`, `--aggregate`), constraints
+    (`--min-clearance-mm`, `--flange-load-N`) and solver and search settings (`--rtol`, `--atol`,
+    `--learning-rate`, `--duration-ms`) are those of the problem the search receives and of
+    result.json. The bounds exclude the design zone, so nothing is integrated (exit 3)."""
+    import optimise._search as search_module
+
+    settings = tmp_path / "opt.toml"
+    settings.write_text(
+        "[bounds]\nend_radius_mm = [60, 70]\nlayback_angle_deg = [1.0, 2.0]\n"
+        "[constraints]\nmin_clearance_mm = 0.5\n[envelope]\nspeeds_rpm = [1000.0]\n"
+    )
+    seen = []
+    real_search = search_module.search
+
+    def recording(problem, **kw):
+        seen.append((problem, kw))
+        return real_search(problem, **kw)
+
+    monkeypatch.setattr(search_module, "search", recording)
+    out = tmp_path / "run"
+    args = [
+        "run",
+        "--objective",
+        "startup",
+        "--bounds",
+        str(settings),
+        "--layback-deg",
+        "1.0,1.1",
+        "--min-clearance-mm",
+        "0.05",
+        "--flange-load-N",
+        "120",
+        "--speeds-rpm",
+        "15000,20000",
+        "--loads-N",
+        "500,1000",
+        "--weights",
+        "1,2,3,4",
+        "--aggregate",
+        "mean",
+        "--rtol",
+        "1e-4",
+        "--atol",
+        "1e-7",
+        "--learning-rate",
+        "0.05",
+        "--duration-ms",
+        "0.2",
+        "--out",
+        str(out),
+    ]
+    assert main(args) == EXIT_INFEASIBLE
+    assert "no feasible design exists within the bounds" in capsys.readouterr().err
+    ((problem, kw),) = seen
+    assert (problem.rtol, problem.atol) == (1e-4, 1e-7)
+    assert kw["learning_rate"] == 0.05
+    r = json.loads((out / "result.json").read_text())
+    assert r["status"] == "no_feasible_design_in_bounds"
+    assert r["bounds"]["end_radius_mm"] == pytest.approx([60, 70])  # from the file
+    assert r["bounds"]["layback_angle_deg"] == pytest.approx([1.0, 1.1])  # the option wins
+    assert r["min_clearance_mm"] == pytest.approx(0.05) and r["flange_load_N"] == 120.0
+    points = [(p["speed_rpm"], p["load_N"]) for p in r["operating_points"]]
+    np.testing.assert_allclose(points, [(15000, 500), (15000, 1000), (20000, 500), (20000, 1000)], rtol=1e-9)
+    assert r["weights"] == [1.0, 2.0, 3.0, 4.0]
+    assert r["aggregate"] == "mean" and r["duration_ms"] == pytest.approx(0.2)
+    assert r["search"]["learning_rate"] == 0.05
