@@ -103,7 +103,7 @@ def test_unknown_solver_one_line_exit_2(capsys):
 
 
 def test_solver_reaches_the_run(monkeypatch):
-    """The configured solver is the one `simulate` receives."""
+    """The configured solver, or `--solver`, is the one `simulate` receives."""
     import jaxbearing as jb
     import jaxbearing.run as run
     from jaxbearing.cli._simulate import run_cases
@@ -118,6 +118,12 @@ def test_solver_reaches_the_run(monkeypatch):
     cfg = jb.loads_config('[simulation]\nsolver = "ros34pw2"\nend = "arc"\n')
     with pytest.raises(SystemExit):
         run_cases(cfg, progress=False)
+    assert seen["solver"] == "ros34pw2"
+    # `--solver` over the configuration's (the reference's tsit5); ROS34PW2 on the bearing runs
+    # in tests/test_rosenbrock.py
+    seen.clear()
+    with pytest.raises(SystemExit):
+        main(["simulate", "--solver", "ros34pw2", "--end", "arc", "--no-progress"])
     assert seen["solver"] == "ros34pw2"
 
 

@@ -251,6 +251,7 @@ _OVERRIDES = "test_cmd_simulate.py::test_command_line_overrides_win_over_the_fil
 _DEMO = "test_cmd_simulate.py::test_demo_transient_writes_both_ends"
 _AUTO = "test_settle.py::test_auto_settle_succeeds_and_reports_intervals"
 _CAP = "test_settle.py::test_auto_settle_hitting_the_cap_is_not_silent"
+_SETTLED_OPTIONS = "test_settle.py::test_settled_options_reach_the_run"
 _STEADY_CLI = "test_optimise_steady.py::test_killed_run_resumes_with_the_same_result"
 _OPT_FILE = "test_optimise.py::test_cli_settings_from_a_file_and_options_reach_the_problem"
 _TWO_PROCESSES = "test_sweep_distributed.py::test_two_processes_match_single_process"
@@ -274,14 +275,12 @@ CLI_CHECKS = {
     ("jaxbearing", "simulate", "--duration-ms"): [_OVERRIDES],
     ("jaxbearing", "simulate", "--out"): [_OVERRIDES, _AUTO],
     ("jaxbearing", "simulate", "--no-progress"): [_OVERRIDES],
-    ("jaxbearing", "simulate", "--solver"): [
-        "test_rosenbrock.py::test_ros34pw2_on_the_bearing_agrees_with_tsit5"
-    ],
+    ("jaxbearing", "simulate", "--solver"): ["test_cmd_simulate.py::test_solver_reaches_the_run"],
     ("jaxbearing", "simulate", "--settle"): [_AUTO, _CAP],
     ("jaxbearing", "simulate", "--window-revs"): [_AUTO],
-    ("jaxbearing", "simulate", "--seeds"): [_CAP],
+    ("jaxbearing", "simulate", "--seeds"): [_SETTLED_OPTIONS],
     ("jaxbearing", "simulate", "--settle-tolerance"): [_AUTO],
-    ("jaxbearing", "simulate", "--workers"): [_CAP],
+    ("jaxbearing", "simulate", "--workers"): [_SETTLED_OPTIONS],
     ("jaxbearing", "simulate", "--start"): [_AUTO, _CAP],
     ("jaxbearing", "simulate", "--settle-cap-ms"): [_CAP],
     ("jaxbearing", "sweep", "--out"): ["test_sweep.py::test_no_resume_recomputes_every_batch"],
