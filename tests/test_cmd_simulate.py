@@ -202,6 +202,21 @@ def test_forced_solver_failure_nonzero_exit(tmp_path, capsys):
     assert "not reliable" in doc["warning"]
 
 
+def test_forced_failure_reports_status():
+    """The Python API's report of a failed solve (moved here from tests/test_dynamics.py: it is
+    the program of the failure run above, default num_saves and max_steps 30, and a step limit
+    is static, so in another file it was a second compilation)."""
+    import jaxbearing as jb
+    from jaxbearing.run import simulate, summarise
+
+    res = simulate(jb.reference_bearing(), jb.reference_operating_point(), duration=0.004, max_steps=30)
+    s = summarise(res)
+    assert not res.ok
+    assert s["status"].startswith("failed: the step limit max_steps was reached")
+    assert "simulated time reached" in s["status"]
+    assert np.isnan(res.smooth_peak_pv)
+
+
 def test_command_line_overrides_win_over_the_file(both_run):
     """`--speed-rpm`, `--load-N`, `--duration-ms`, `--end` and `--no-progress` over the file's
     values: the kinematic cage speed is n_i (1 - D/d_m) / 2 at 20000 rpm, the quasi-static start

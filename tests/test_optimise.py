@@ -26,6 +26,9 @@ CLEARANCE_MM = 0.2
 ITERATIONS = 8
 STARTS = 2
 BOUNDS = opt.bounds_from_engineering([60, 120], [1.0, 2.0], [CLEARANCE_MM, CLEARANCE_MM])
+#: designs per vmapped grid batch: only the feasible points are solved, padded to whole batches
+#: (the default 32 solved 32 designs for the few feasible ones of the 5 x 5 grid)
+GRID_BATCH = 4
 
 
 def _problem(**kw):
@@ -131,16 +134,20 @@ def test_search_no_worse_than_grid(searched):
     no worse than the best feasible point of a 5 x 5 brute-force grid over the same bounds,
     evaluated with the same model."""
     p, res = searched
-    grid = opt.grid_search(p, 5, 5, CLEARANCE_MM * 1e-3)
+    grid = opt.grid_search(p, 5, 5, CLEARANCE_MM * 1e-3, batch=GRID_BATCH)
     assert grid["best_design"] is not None and grid["num_model_evaluations"] > 0
+    feasible = np.isfinite(grid["objective"]) if "objective" in grid else None
+    print(
+        "search", res.objective, "grid best", grid["best_objective"], "grid", grid.get("objective"), feasible
+    )
     # no worse, up to 1e-3 GPa m/s (0.05% of the ~2 GPa m/s at the reference design): at this
     # short horizon the best designs of both have almost no flange load (PV ~ 1e-7 GPa m/s)
     assert res.objective <= grid["best_objective"] + 1e-3
     # the objective the search reports is the model's value at that design (in a batch of the
-    # grid's size, 32: the grid's compiled program, not a second one for a batch of 1)
+    # grid's size: the grid's compiled program, not a second one for a batch of 1)
     from optimise._search import _objective_batch
 
-    u = jnp.repeat(p.bounds.to_scaled(res.design)[None], 32, axis=0)
+    u = jnp.repeat(p.bounds.to_scaled(res.design)[None], GRID_BATCH, axis=0)
     direct = float(_objective_batch(p, u)[0])
     assert res.objective == pytest.approx(direct, rel=1e-6)
 

@@ -180,7 +180,11 @@ def test_frozen_load_estimator_agrees_with_crn_differences_on_settled_running():
     plateau, tests/test_skid.py), then a common-random-number central difference of the ensemble
     objective (both designs continue from the same states and measure two cage revolutions at
     once; paired over the seeds) against the frozen-load estimate from the same states. The difference must
-    be significant (|FD| > 2 SE) and the estimate agree with it in sign and within 30 %.
+    be significant (|FD| > 2 SE) and the estimate agree with it in sign and within two of the
+    difference's standard errors. That is what 3 seeds can resolve: the difference's standard error
+    is about 37 % of its value here, so agreement within 30 % cannot be told from noise (the check
+    used to read `max(30 %, 2 SE)` and passed, through its 2 SE branch, at 44 %); the 30 % claim is
+    measured at full size by benchmarks/bench_steady_gradient.py.
 
     The settling times are in ms: 0.005 ms from the skid start and 0.0035 ms after the design
     change, i.e. none to speak of. (The comments used to say 5 ms and half a revolution, and the
@@ -219,4 +223,4 @@ def test_frozen_load_estimator_agrees_with_crn_differences_on_settled_running():
     )
     assert abs(fd) > 2 * se
     assert np.sign(g.gradient[1]) == np.sign(fd)
-    assert abs(g.gradient[1] - fd) <= max(0.3 * abs(fd), 2 * se)
+    assert abs(g.gradient[1] - fd) <= 2 * se

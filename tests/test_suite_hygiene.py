@@ -387,3 +387,13 @@ def test_every_cli_option_is_invoked_by_a_named_test():
         for ref in tests:
             assert ref in sources, f"{ref} (for {option}) does not exist"
             assert f'"{option}"' in sources[ref], f"{ref} does not invoke {option}"
+
+
+def test_the_slowest_files_first_are_test_files():
+    """`conftest.SLOWEST_FILES_FIRST` names existing test files, each once (a renamed file would
+    silently drop out of the ordering)."""
+    from conftest import SLOWEST_FILES_FIRST
+
+    names = {p.name for p in TEST_FILES}
+    assert len(set(SLOWEST_FILES_FIRST)) == len(SLOWEST_FILES_FIRST)
+    assert set(SLOWEST_FILES_FIRST) <= names, set(SLOWEST_FILES_FIRST) - names
