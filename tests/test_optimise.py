@@ -132,17 +132,26 @@ def test_infeasible_starts_end_feasible(searched):
 def test_search_no_worse_than_grid(searched):
     """Issue 5 acceptance (small form): the final design is feasible and its smooth peak PV is
     no worse than the best feasible point of a 5 x 5 brute-force grid over the same bounds,
-    evaluated with the same model."""
+    evaluated with the same model, by more than 1e-6 of the objective's range over the grid.
+
+    At this short horizon (0.3 ms) the objective has a floor: designs whose flange is not yet
+    loaded give PV of 1e-10 to 1e-7 GPa m/s against 0.4-3 GPa m/s for the loaded ones (measured
+    2026-11-25: search 2.3e-7, grid best 2.1e-10, range 3.0), so which of two points on the floor
+    is lower is the rounding of an unloaded contact, not a ranking; what is claimed, and checked,
+    is that the search reaches the floor the grid's best point is on. (It used to allow 1e-3
+    GPa m/s, 4 000 times the values compared.) The full >= 15 x 15 comparison is
+    benchmarks/bench_optimise_grid.py."""
     p, res = searched
     grid = opt.grid_search(p, 5, 5, CLEARANCE_MM * 1e-3, batch=GRID_BATCH)
     assert grid["best_design"] is not None and grid["num_model_evaluations"] > 0
-    feasible = np.isfinite(grid["objective"]) if "objective" in grid else None
-    print(
-        "search", res.objective, "grid best", grid["best_objective"], "grid", grid.get("objective"), feasible
+    values = np.asarray(grid["objective"])[np.isfinite(grid["objective"])]
+    span = float(values.max() - values.min())
+    assert span > 0.1  # the grid holds loaded designs: a range to compare against
+    assert res.objective <= grid["best_objective"] + 1e-6 * span, (
+        res.objective,
+        grid["best_objective"],
+        span,
     )
-    # no worse, up to 1e-3 GPa m/s (0.05% of the ~2 GPa m/s at the reference design): at this
-    # short horizon the best designs of both have almost no flange load (PV ~ 1e-7 GPa m/s)
-    assert res.objective <= grid["best_objective"] + 1e-3
     # the objective the search reports is the model's value at that design (in a batch of the
     # grid's size: the grid's compiled program, not a second one for a batch of 1)
     from optimise._search import _objective_batch
