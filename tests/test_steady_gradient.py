@@ -195,7 +195,11 @@ def test_frozen_load_estimator_agrees_with_crn_differences_on_settled_running():
     Slow (`make test-slow`; 126-160 s alone, about 3 min of a cold suite). Measured: CRN FD
     -1.737e11 +- 6.4e10 (2.7 standard errors), frozen load -9.69e10 per rad; with 3.53 us
     after the change (the old rev / 2 s passed as ms) -1.358e11 +- 3.9e10. A check this close to
-    its significance bound is fragile: 3 seeds are few. The default
+    its significance bound is fragile: 3 seeds are few. It fails that bound in the session of
+    2026-11-25 (issue 37; same code, this machine): CRN FD -7.53e10 +- 7.8e10 against frozen load
+    -9.70e10, and in a trial with 8 seeds -5.01e10 +- 2.7e10 (1.8 standard errors) against
+    -9.78e10: at this reduced size the difference is not reliably significant, and the frozen-load
+    estimate sat within 2 standard errors of it both times. The default
     suite keeps the estimator's derivative against finite differences of the same functional
     (above); the full-size study is benchmarks/bench_steady_gradient.py."""
     from jaxbearing.run import frozen_load_gradient, steady_design_metrics
