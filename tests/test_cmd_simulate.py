@@ -4,6 +4,7 @@ import json
 
 import numpy as np
 import pytest
+from _figures import assert_png_drawn
 
 from jaxbearing.cli import main
 
@@ -25,15 +26,26 @@ def _config(tmp_path, text):
 
 @pytest.fixture(scope="module")
 def both_run(tmp_path_factory):
+    """The reference bearing, both ends, 2 ms: the configuration file says otherwise (15000 rpm,
+    500 N, 0.5 ms, progress on, arc only) and the command-line options win."""
+    import contextlib
+    import io
+
     out = tmp_path_factory.mktemp("sim")
     cfg = out / "c.toml"
-    cfg.write_text("[simulation]\nduration_ms = 2.0\nprogress = false\n")
-    code = main(["simulate", "--config", str(cfg), "--end", "both", "--out", str(out)])
-    return code, out
+    cfg.write_text(
+        "[operating]\nspeed_rpm = 15000.0\nradial_load_N = 500.0\n"
+        '[simulation]\nduration_ms = 0.5\nprogress = true\nend = "arc"\n'
+    )
+    args = ["--speed-rpm", "20000", "--load-N", "1000", "--duration-ms", "2", "--no-progress"]
+    text = io.StringIO()
+    with contextlib.redirect_stdout(text):
+        code = main(["simulate", "--config", str(cfg), "--end", "both", *args, "--out", str(out)])
+    return code, out, text.getvalue()
 
 
 def test_both_ends_write_summary_histories_plots(both_run, capsys):
-    code, out = both_run
+    code, out, _ = both_run
     assert code == 0
     doc = json.loads((out / "summary.json").read_text())
     assert {"arc", "corner"} <= set(doc) and doc["ends"] == ["arc", "corner"]
@@ -64,7 +76,7 @@ def test_both_ends_write_summary_histories_plots(both_run, capsys):
         for key in ("flange_min_film", "flange_central_film", "flange_film_parameter", "flange_top_edge"):
             assert h[key].shape == h["flange_force"].shape
     for png in ("flange_boxplots.png", "contact_positions.png", "cage_speed.png"):
-        assert (out / png).stat().st_size > 10_000
+        assert_png_drawn(out / png)
     # arc ends press less on the flange than corners (the paper's headline result)
     assert doc["arc"]["flange_pressure_Pa"]["max"] < doc["corner"]["flange_pressure_Pa"]["max"]
 
@@ -91,7 +103,7 @@ def test_unknown_solver_one_line_exit_2(capsys):
 
 
 def test_solver_reaches_the_run(monkeypatch):
-    """The configured solver is the one `simulate` receives."""
+    """The configured solver, or `--solver`, is the one `simulate` receives."""
     import jaxbearing as jb
     import jaxbearing.run as run
     from jaxbearing.cli._simulate import run_cases
@@ -106,6 +118,12 @@ def test_solver_reaches_the_run(monkeypatch):
     cfg = jb.loads_config('[simulation]\nsolver = "ros34pw2"\nend = "arc"\n')
     with pytest.raises(SystemExit):
         run_cases(cfg, progress=False)
+    assert seen["solver"] == "ros34pw2"
+    # `--solver` over the configuration's (the reference's tsit5); ROS34PW2 on the bearing runs
+    # in tests/test_rosenbrock.py
+    seen.clear()
+    with pytest.raises(SystemExit):
+        main(["simulate", "--solver", "ros34pw2", "--end", "arc", "--no-progress"])
     assert seen["solver"] == "ros34pw2"
 
 
@@ -142,14 +160,21 @@ def test_host_progress_prints_elapsed_time_and_the_closing_line(capsys):
     import jaxbearing as jb
     from jaxbearing.run import HostProgress
 
+    # wait for the first tick however loaded the machine is (no wall-clock threshold: the
+    # deadline only keeps a broken meter from hanging the suite)
+    printed = ""
     with HostProgress(interval=0.05) as meter:
-        time.sleep(0.3)
+        deadline = time.monotonic() + 120
+        while "s elapsed" not in printed and time.monotonic() < deadline:
+            time.sleep(0.01)
+            printed += capsys.readouterr().out
     meter.close(1.0)
     with HostProgress(interval=10.0) as meter:
         pass
     meter.close(0.372)
+    ticks = printed.splitlines()
+    assert ticks and all(line.strip().endswith("s elapsed") and "%" not in line for line in ticks)
     lines = capsys.readouterr().out.splitlines()
-    assert any(line.strip().endswith("s elapsed") and "%" not in line for line in lines[:-2])
     assert "100% of the simulated time" in lines[-2]
     assert "stopped at 37.2% of the simulated time" in lines[-1] and "the solve failed" in lines[-1]
     with pytest.raises(jb.UserInputError, match=r"^interval = -1.0: must be > 0 s$"):
@@ -175,3 +200,77 @@ def test_forced_solver_failure_nonzero_exit(tmp_path, capsys):
     assert doc["smooth_peak_pv_Pa_m_s"] is None
     assert doc["null_reasons"]["smooth_peak_pv_Pa_m_s"] == "nan: the run failed (see status)"
     assert "not reliable" in doc["warning"]
+
+
+def test_forced_failure_reports_status():
+    """The Python API's report of a failed solve (moved here from tests/test_dynamics.py: it is
+    the program of the failure run above, default num_saves and max_steps 30, and a step limit
+    is static, so in another file it was a second compilation)."""
+    import jaxbearing as jb
+    from jaxbearing.run import simulate, summarise
+
+    res = simulate(jb.reference_bearing(), jb.reference_operating_point(), duration=0.004, max_steps=30)
+    s = summarise(res)
+    assert not res.ok
+    assert s["status"].startswith("failed: the step limit max_steps was reached")
+    assert "simulated time reached" in s["status"]
+    assert np.isnan(res.smooth_peak_pv)
+
+
+def test_command_line_overrides_win_over_the_file(both_run):
+    """`--speed-rpm`, `--load-N`, `--duration-ms`, `--end` and `--no-progress` over the file's
+    values: the kinematic cage speed is n_i (1 - D/d_m) / 2 at 20000 rpm, the quasi-static start
+    carries 1000 N (the contacts' force on the inner ring balances the radial load and the
+    ring's weight, a few newtons), the histories end at 2 ms and no progress is printed."""
+    code, out, text = both_run
+    assert code == 0
+    doc = json.loads((out / "summary.json").read_text())
+    for end in ("arc", "corner"):
+        assert doc[end]["kinematic_cage_speed_rpm"] == pytest.approx(20000 * (1 - 7.5 / 85.0) / 2, rel=1e-9)
+        h = np.load(out / f"histories_{end}.npz")
+        assert h["t"][-1] == pytest.approx(2e-3, rel=1e-9)
+        assert np.linalg.norm(h["inner_ring_contact_force"][0]) == pytest.approx(1000.0, rel=0.01)
+    assert "simulating" not in text and "elapsed" not in text and "% of the simulated time" not in text
+
+
+def test_demo_transient_writes_both_ends(both_run, tmp_path, capsys):
+    """`jaxbearing demo --transient --duration-ms 0.2 --out DIR`: one fixed-duration run per end
+    type of the reference bearing from the quasi-static start, 0.2 ms each (the program of the
+    `simulate` run above, so nothing new is compiled), the paper table, and the outputs in DIR."""
+    out = tmp_path / "demo"
+    assert main(["demo", "--transient", "--duration-ms", "0.2", "--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "a 0.2 ms start-up transient" in text and "peak pressure, max" in text
+    assert f"written to {out}/" in text
+    doc = json.loads((out / "summary.json").read_text())
+    assert set(doc) == {"arc", "corner"}
+    for end in ("arc", "corner"):
+        assert doc[end]["status"] == "ok"
+        t = np.load(out / f"histories_{end}.npz")["t"]
+        assert t[0] == 0.0 and t[-1] == pytest.approx(0.2e-3, rel=1e-9)
+    for png in ("flange_boxplots.png", "contact_positions.png", "cage_speed.png"):
+        assert_png_drawn(out / png)
+
+
+def test_demo_settled_passes_its_window_to_the_run(tmp_path, capsys, monkeypatch):
+    """`jaxbearing demo --window-revs 3 --out DIR` (the default, settled mode) asks `run_cases`
+    for a settled run of both ends with a 3-revolution window from the skid start, settle auto
+    (a stand-in records the request and stops the command: the real settled demo runs the full
+    bearing for minutes; settled runs on real output are tests/test_settle.py); a window that is
+    not a whole number >= 2 revolutions is refused before anything runs."""
+    import jaxbearing.cli._simulate as simulate_cli
+
+    seen = []
+
+    def stand_in(cfg, progress=True, steady=None):
+        seen.append((cfg.simulation.end, steady))
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(simulate_cli, "run_cases", stand_in)
+    out = tmp_path / "demo"
+    assert main(["demo", "--window-revs", "3", "--out", str(out)]) == 130
+    assert seen == [("both", dict(settle="auto", window_revs=3, seeds=1, start="skid"))]
+    assert not out.exists()
+    capsys.readouterr()
+    assert main(["demo", "--window-revs", "2.5", "--out", str(out)]) == 2
+    assert "--window-revs" in capsys.readouterr().err and len(seen) == 1

@@ -131,14 +131,3 @@ def test_tolerance_halving_convergence(reference_run):
     assert rel(a["contact_height_m"]["median"], b["contact_height_m"]["median"]) < 5e-3
     assert rel(a["flange_sliding_velocity_m_s"]["mean"], b["flange_sliding_velocity_m_s"]["mean"]) < 0.05
     assert rel(a["smooth_peak_pv_Pa_m_s"], b["smooth_peak_pv_Pa_m_s"]) < 0.15
-
-
-def test_forced_failure_reports_status():
-    # the program of tests/test_cmd_simulate.py's failure run (default num_saves, max_steps 30):
-    # a step limit is static, so each distinct one is a compilation of its own
-    res = simulate(jb.reference_bearing(), jb.reference_operating_point(), duration=DURATION, max_steps=30)
-    s = summarise(res)
-    assert not res.ok
-    assert s["status"].startswith("failed: the step limit max_steps was reached")
-    assert "simulated time reached" in s["status"]
-    assert np.isnan(res.smooth_peak_pv)

@@ -29,8 +29,15 @@ def test_examples_exist():
     ids=lambda p: p.name,
 )
 def test_configuration_loads(path):
+    """The file loads, builds its bearing, and every value it sets is the configuration's."""
+    import tomllib
+
     cfg = jb.load_config(path)
-    cfg.bearing()
+    assert cfg.bearing().num_rollers >= 1
+    given, loaded = tomllib.loads(path.read_text()), cfg.to_dict()
+    for section, table in given.items():
+        for key, value in table.items():
+            assert loaded[section][key] == value, (section, key)
 
 
 def test_reference_example_is_the_reference():

@@ -16,6 +16,7 @@ import pathlib
 import subprocess
 import sys
 import threading
+import time
 
 import equinox as eqx
 import numpy as np
@@ -421,6 +422,35 @@ def test_second_sweep_into_a_locked_directory_exits_2(tmp_path, fake_solves, cap
     assert fake_solves == []
     run_sweep(spec, tmp_path, progress=False, assemble_results=False)  # released: runs
     assert fake_solves == [[0, 1], [2, 3]]
+
+
+def test_wait_for_lock_option_waits_for_the_other_sweep(tmp_path, fake_solves, capsys, monkeypatch):
+    """`jaxbearing sweep --wait-for-lock 600` on a locked directory says it waits, and runs once
+    the holder lets go. The holder lets go in the waiting loop's first pause (a stand-in for
+    the lock module's clock), so the command has waited by construction: no race with a timer."""
+    import types
+
+    import jaxbearing.io._lock as lock_module
+    from jaxbearing.io import acquire_lock
+
+    held = acquire_lock(tmp_path, "sweep.0.lock", what="sweep")
+    pauses = []
+
+    def pause(seconds):
+        pauses.append(seconds)
+        held.release()
+
+    monkeypatch.setattr(
+        lock_module,
+        "time",
+        types.SimpleNamespace(monotonic=time.monotonic, strftime=time.strftime, sleep=pause),
+    )
+    spec_path = SWEEPS / "small.toml"
+    args = ["sweep", str(spec_path), "--out", str(tmp_path), "--no-progress", "--workers", "1"]
+    assert cli_main([*args, "--wait-for-lock", "600"]) == 0
+    err = capsys.readouterr().err
+    assert f"{tmp_path} is in use by another sweep" in err and "waiting (up to 600 s)" in err
+    assert len(pauses) == 1 and fake_solves == [[0, 1], [2, 3]]
 
 
 def test_sweep_waits_for_the_lock_when_asked(tmp_path, fake_solves):

@@ -13,6 +13,7 @@ import math
 import jax.numpy as jnp
 import numpy as np
 import pytest
+from _figures import assert_png_drawn
 
 import jaxbearing as jb
 import optimise as opt
@@ -23,8 +24,15 @@ OP = jb.reference_operating_point()
 DURATION_MS = 0.3
 CLEARANCE_MM = 0.2
 ITERATIONS = 8
+#: the command line's run: its plumbing end to end on the search's compiled program (the
+#: search itself is checked on the fixture's 8 iterations)
+CLI_ITERATIONS = 3
 STARTS = 2
 BOUNDS = opt.bounds_from_engineering([60, 120], [1.0, 2.0], [CLEARANCE_MM, CLEARANCE_MM])
+#: designs per vmapped grid batch: the default, 32, whose compiled program the command line's
+#: search-path plot uses too (a batch of 4 solved fewer padded designs, 24 s against 42 s, but
+#: the plot then compiled its own batch-32 program: 34 s against 18 s for the CLI test)
+GRID_BATCH = 32
 
 
 def _problem(**kw):
@@ -128,18 +136,31 @@ def test_infeasible_starts_end_feasible(searched):
 def test_search_no_worse_than_grid(searched):
     """Issue 5 acceptance (small form): the final design is feasible and its smooth peak PV is
     no worse than the best feasible point of a 5 x 5 brute-force grid over the same bounds,
-    evaluated with the same model."""
+    evaluated with the same model, by more than 1e-6 of the objective's range over the grid.
+
+    At this short horizon (0.3 ms) the objective has a floor: designs whose flange is not yet
+    loaded give PV of 1e-10 to 1e-7 GPa m/s against 0.4-3 GPa m/s for the loaded ones (measured
+    2026-11-25: search 2.3e-7, grid best 2.1e-10, range 3.0), so which of two points on the floor
+    is lower is the rounding of an unloaded contact, not a ranking; what is claimed, and checked,
+    is that the search reaches the floor the grid's best point is on. (It used to allow 1e-3
+    GPa m/s, 4 000 times the values compared.) The full >= 15 x 15 comparison is
+    benchmarks/bench_optimise_grid.py."""
     p, res = searched
-    grid = opt.grid_search(p, 5, 5, CLEARANCE_MM * 1e-3)
+    grid = opt.grid_search(p, 5, 5, CLEARANCE_MM * 1e-3, batch=GRID_BATCH)
     assert grid["best_design"] is not None and grid["num_model_evaluations"] > 0
-    # no worse, up to 1e-3 GPa m/s (0.05% of the ~2 GPa m/s at the reference design): at this
-    # short horizon the best designs of both have almost no flange load (PV ~ 1e-7 GPa m/s)
-    assert res.objective <= grid["best_objective"] + 1e-3
+    values = np.asarray(grid["objective"])[np.isfinite(grid["objective"])]
+    span = float(values.max() - values.min())
+    assert span > 0.1  # the grid holds loaded designs: a range to compare against
+    assert res.objective <= grid["best_objective"] + 1e-6 * span, (
+        res.objective,
+        grid["best_objective"],
+        span,
+    )
     # the objective the search reports is the model's value at that design (in a batch of the
-    # grid's size, 32: the grid's compiled program, not a second one for a batch of 1)
+    # grid's size: the grid's compiled program, not a second one for a batch of 1)
     from optimise._search import _objective_batch
 
-    u = jnp.repeat(p.bounds.to_scaled(res.design)[None], 32, axis=0)
+    u = jnp.repeat(p.bounds.to_scaled(res.design)[None], GRID_BATCH, axis=0)
     direct = float(_objective_batch(p, u)[0])
     assert res.objective == pytest.approx(direct, rel=1e-6)
 
@@ -153,7 +174,7 @@ def _cli_args(out):
         "--starts",
         str(STARTS),
         "--iterations",
-        str(ITERATIONS),
+        str(CLI_ITERATIONS),
         "--duration-ms",
         str(DURATION_MS),
         "--clearance-mm",
@@ -172,8 +193,8 @@ def test_cli_end_to_end(tmp_path, capsys, searched):
     assert result["status"] == "ok" and result["feasible"]
     assert all(v > 0 for v in result["margins"].values())
     assert result["design"]["axial_clearance_mm"] == pytest.approx(CLEARANCE_MM)
-    assert len(result["history"]["objective_GPa_m_s"]) == ITERATIONS + 1
-    assert (out / "search_paths.png").stat().st_size > 10_000
+    assert len(result["history"]["objective_GPa_m_s"]) == CLI_ITERATIONS + 1
+    assert_png_drawn(out / "search_paths.png")
 
 
 def test_cli_no_feasible_design_exits_nonzero(tmp_path, capsys):
@@ -212,3 +233,74 @@ def test_cli_bad_input_one_line_exit_2(tmp_path, capsys, args, text):
     assert main(["run", "--out", str(tmp_path), *args]) == 2
     err = capsys.readouterr().err
     assert text in err and err.count("\n") == 1
+
+
+def test_cli_settings_from_a_file_and_options_reach_the_problem(tmp_path, capsys, monkeypatch):
+    """`optimise run --objective startup` with its settings from `--bounds FILE` and the
+    options: the bounds (from the file, one of them overridden by `--layback-deg`), envelope
+    (`--speeds-rpm` x `--loads-N`, speed-major, `--weights`, `--aggregate`), constraints
+    (`--min-clearance-mm`, `--flange-load-N`) and solver and search settings (`--rtol`, `--atol`,
+    `--learning-rate`, `--duration-ms`) are those of the problem the search receives and of
+    result.json. The bounds exclude the design zone, so nothing is integrated (exit 3)."""
+    import optimise._search as search_module
+
+    settings = tmp_path / "opt.toml"
+    settings.write_text(
+        "[bounds]\nend_radius_mm = [60, 70]\nlayback_angle_deg = [1.0, 2.0]\n"
+        "[constraints]\nmin_clearance_mm = 0.5\n[envelope]\nspeeds_rpm = [1000.0]\n"
+    )
+    seen = []
+    real_search = search_module.search
+
+    def recording(problem, **kw):
+        seen.append((problem, kw))
+        return real_search(problem, **kw)
+
+    monkeypatch.setattr(search_module, "search", recording)
+    out = tmp_path / "run"
+    args = [
+        "run",
+        "--objective",
+        "startup",
+        "--bounds",
+        str(settings),
+        "--layback-deg",
+        "1.0,1.1",
+        "--min-clearance-mm",
+        "0.05",
+        "--flange-load-N",
+        "120",
+        "--speeds-rpm",
+        "15000,20000",
+        "--loads-N",
+        "500,1000",
+        "--weights",
+        "1,2,3,4",
+        "--aggregate",
+        "mean",
+        "--rtol",
+        "1e-4",
+        "--atol",
+        "1e-7",
+        "--learning-rate",
+        "0.05",
+        "--duration-ms",
+        "0.2",
+        "--out",
+        str(out),
+    ]
+    assert main(args) == EXIT_INFEASIBLE
+    assert "no feasible design exists within the bounds" in capsys.readouterr().err
+    ((problem, kw),) = seen
+    assert (problem.rtol, problem.atol) == (1e-4, 1e-7)
+    assert kw["learning_rate"] == 0.05
+    r = json.loads((out / "result.json").read_text())
+    assert r["status"] == "no_feasible_design_in_bounds"
+    assert r["bounds"]["end_radius_mm"] == pytest.approx([60, 70])  # from the file
+    assert r["bounds"]["layback_angle_deg"] == pytest.approx([1.0, 1.1])  # the option wins
+    assert r["min_clearance_mm"] == pytest.approx(0.05) and r["flange_load_N"] == 120.0
+    points = [(p["speed_rpm"], p["load_N"]) for p in r["operating_points"]]
+    np.testing.assert_allclose(points, [(15000, 500), (15000, 1000), (20000, 500), (20000, 1000)], rtol=1e-9)
+    assert r["weights"] == [1.0, 2.0, 3.0, 4.0]
+    assert r["aggregate"] == "mean" and r["duration_ms"] == pytest.approx(0.2)
+    assert r["search"]["learning_rate"] == 0.05

@@ -112,10 +112,11 @@ def test_killed_run_resumes_with_the_same_result(tmp_path, config, monkeypatch, 
     and no result, resumes after iteration 0 with the continuation states, and ends with exactly
     the history and design of an uninterrupted run; other settings are refused."""
     monkeypatch.setattr(steady, "evaluate", _stand_in)
-    args = list(ARGS)
+    args = ["--estimator", "window", "--corner-margin-mm", "0.04", *ARGS]
     args[args.index("--iterations") + 1] = "2"
     whole, killed = tmp_path / "whole", tmp_path / "killed"
-    assert main(["run", "--config", config, *args, "--no-verify", "--out", str(whole)]) == 0
+    assert main(["run", "--config", config, *args, "--no-verify", "--quiet", "--out", str(whole)]) == 0
+    assert "iter   0" not in capsys.readouterr().out  # --quiet: no per-iteration lines
     r1, j1, x1 = _history(whole)
     assert r1["objective_kind"] == "steady" and r1["status"] == "ok" and r1["resumed_from_iteration"] == -1
     # self-describing (issue 38): version, command line, configuration, settings, seeds, units
@@ -123,6 +124,11 @@ def test_killed_run_resumes_with_the_same_result(tmp_path, config, monkeypatch, 
     assert r1["config"]["bearing"]["num_slices"] == 11 and "config_toml" in r1
     assert r1["seeds"]["search"] == [0, 1] and r1["seeds"]["verification"] == [1000, 1001, 1002, 1003]
     assert r1["optimiser_settings"]["seeds"] == 2 and "units" in r1
+    assert r1["settings"]["estimator"] == "window" and r1["settings"]["corner_margin"] == pytest.approx(
+        0.04e-3
+    )
+    assert (r1["settings"]["seeds"], r1["settings"]["window_revs"], r1["settings"]["settle"]) == (2, 2, 0.5)
+    assert r1["settings"]["gradient_window"] == pytest.approx(0.1e-3) and r1["settings"]["workers"] == 1
     assert j1.shape == (3, 1) and np.all(np.isfinite(j1)) and np.all(j1 > 0)
     assert np.all(np.isfinite(np.asarray(r1["history"]["gradient_per_unit_box"])))
     lo, hi = r1["objective_GPa_m_s"]["ci95_low"], r1["objective_GPa_m_s"]["ci95_high"]
@@ -145,7 +151,8 @@ def test_killed_run_resumes_with_the_same_result(tmp_path, config, monkeypatch, 
     assert (killed / "checkpoint.npz").exists() and not (killed / "result.json").exists()
     monkeypatch.setattr(steady, "evaluate", evaluate)
     assert main(["run", "--config", config, *args, "--no-verify", "--out", str(killed)]) == 0
-    assert "resumed after iteration 0" in capsys.readouterr().out
+    text = capsys.readouterr().out
+    assert "resumed after iteration 0" in text and "iter   1" in text  # without --quiet
     r2, j2, x2 = _history(killed)
     assert r2["resumed_from_iteration"] == 0
     np.testing.assert_array_equal(j2, j1)
@@ -156,17 +163,10 @@ def test_killed_run_resumes_with_the_same_result(tmp_path, config, monkeypatch, 
     assert "checkpoint of a search with other settings" in capsys.readouterr().err
 
 
-def test_verification_uses_unseen_seeds(config, monkeypatch):
-    """`verification` re-measures both designs with the seeds from verify_first_seed on (a
-    stand-in for `steady_design_metrics` records them; the real one is tested in
-    tests/test_steady_design.py) and reports value and CI of mean PV, p95 PV and corner share,
-    whether the mean-PV intervals are disjoint, and corner contacts of the found design."""
+def _metrics_stand_in(calls):
+    """A stand-in for `steady_design_metrics` that records (R_end, seeds, first_seed, window)
+    of each call; mean PV proportional to R_end, corner contacts below R_end 75 mm."""
     import types
-
-    import jaxbearing as jb
-    from optimise import make_problem
-
-    calls = []
 
     def metrics(bearing, op, design, *, seeds, first_seed, window_revs, **kw):
         calls.append((float(design.end_radius), seeds, first_seed, window_revs))
@@ -185,6 +185,35 @@ def test_verification_uses_unseen_seeds(config, monkeypatch):
             settled=True,
             seeds=list(range(first_seed, first_seed + seeds)),
         )
+
+    return metrics
+
+
+def test_verify_seeds_option_reaches_the_verification(tmp_path, config, monkeypatch):
+    """`optimise run --verify-seeds 3`: the verification re-measures the reference and the found
+    design with 3 seeds from 1000 on (stand-ins for the search's ensemble and for
+    `steady_design_metrics`; the real ones are in tests/test_steady_design.py)."""
+    monkeypatch.setattr(steady, "evaluate", _stand_in)
+    calls = []
+    monkeypatch.setattr(steady, "steady_design_metrics", _metrics_stand_in(calls))
+    out = tmp_path / "verified"
+    assert main(["run", "--config", config, *ARGS, "--verify-seeds", "3", "--quiet", "--out", str(out)]) == 0
+    r = json.loads((out / "result.json").read_text())
+    assert r["verification"]["seeds"] == [1000, 1001, 1002]
+    assert [c[1:] for c in calls] == [(3, 1000, 4), (3, 1000, 4)]  # reference, then the optimum
+
+
+def test_verification_uses_unseen_seeds(config, monkeypatch):
+    """`verification` re-measures both designs with the seeds from verify_first_seed on (a
+    stand-in for `steady_design_metrics` records them; the real one is tested in
+    tests/test_steady_design.py) and reports value and CI of mean PV, p95 PV and corner share,
+    whether the mean-PV intervals are disjoint, and corner contacts of the found design."""
+
+    import jaxbearing as jb
+    from optimise import make_problem
+
+    calls = []
+    metrics = _metrics_stand_in(calls)
 
     monkeypatch.setattr(steady, "steady_design_metrics", metrics)
     cfg = jb.load_config(config)

@@ -346,7 +346,18 @@ def test_sweep_process_layout(process_id, tmp_path_factory):
     assert not any(out.iterdir())
 
 
-def test_examples_setting_is_documented():
-    assert EXAMPLES >= 1 and "JAXBEARING_PROPERTY_EXAMPLES=200" in __doc__
+def test_examples_setting_sets_the_examples_per_test():
+    """`JAXBEARING_PROPERTY_EXAMPLES` (read into `EXAMPLES`) is the number of examples a property
+    test of this file runs: a probe under the same `SETTINGS` counts its calls."""
+    assert EXAMPLES == int(os.environ.get("JAXBEARING_PROPERTY_EXAMPLES", "30")) >= 1
+    calls = []
+
+    @SETTINGS
+    @given(st.floats(allow_nan=False, allow_infinity=False))
+    def probe(x):
+        calls.append(x)
+
+    probe()
+    assert len(calls) == EXAMPLES
     assert np.isfinite(EXAMPLE_LIMIT_S)
     assert set(EXPECTED) <= set(SOLVER_ARGUMENTS)

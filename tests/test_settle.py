@@ -50,9 +50,15 @@ def small_config(tmp_path_factory):
     return d, str(cfg)
 
 
-def test_fixed_settle_reports_intervals(small_config, capsys):
+def test_auto_settle_succeeds_and_reports_intervals(small_config, capsys):
+    """A successful `--settle auto` run (11 slices, one seed, tolerance 2e-3): from the skid
+    start the run is declared settled (before the cap) at the first revolution where the verdict
+    (`settling_verdict`: the remaining drift's upper bound, from the revolution means themselves)
+    is within the tolerance, and the window of two revolutions that follows reports every
+    statistic with its confidence interval. (The fixed settling time is run on real output by
+    tests/test_steady_design.py.)"""
     d, cfg = small_config
-    out = d / "fixed"
+    out = d / "auto"
     code = main(
         [
             "simulate",
@@ -61,9 +67,13 @@ def test_fixed_settle_reports_intervals(small_config, capsys):
             "--end",
             "arc",
             "--settle",
-            "2",
+            "auto",
             "--window-revs",
             "2",
+            "--start",
+            "skid",
+            "--settle-tolerance",
+            "2e-3",
             "--out",
             str(out),
         ]
@@ -71,12 +81,31 @@ def test_fixed_settle_reports_intervals(small_config, capsys):
     text = capsys.readouterr().out
     assert code == 0, text
     s = json.loads((out / "summary.json").read_text())
-    assert s["status"] == "ok" and s["settled"] is True and s["settle_mode"] == "fixed"
-    assert s["settle_time_ms"] == pytest.approx(2.0)
-    assert s["seeds"] == [0] and s["window_revs"] == 2
+    assert s["status"] == "ok" and s["settled"] is True and s["settle_mode"] == "auto"
+    (seed,) = s["per_seed"]
+    assert seed["settled"] is True and s["seeds"] == [0] and s["window_revs"] == 2
+    # the verdict, from the revolutions themselves: the settling revolutions are those before
+    # the window (no projective step after a completed pre-start); the verdict holds at the last
+    # of them and at no earlier one, with the run's own slow-mode time constant
+    from jaxbearing.run._settle import settling_verdict
+
+    speeds, ends = seed["revolution_cage_speed_rpm"], seed["revolution_end_ms"]
+    n = len(speeds) - 2
+    assert n >= 4 and s["settle_time_ms"] == pytest.approx(ends[n - 1])
+    assert s["settle_time_ms"] < s["settle_cap_ms"] and seed["projective_steps_rpm"] == []
+    tol = s["settle_tolerance"]
+    assert tol == 2e-3
+    starts = [0.0, *ends[:-1]]
+    centres = [0.5 * (a + b) * 1e-3 for a, b in zip(starts, ends)]
+    tau = seed["slow_mode_time_constant_ms"] * 1e-3
+    verdicts = [settling_verdict(centres[:k], speeds[:k], tol, tau) for k in range(1, n + 1)]
+    assert verdicts[-1].settled and not any(v.settled for v in verdicts[:-1])
+    assert seed["residual_drift_bound_rpm"] == pytest.approx(verdicts[-1].bound_rpm, rel=1e-9)
+    assert seed["residual_drift_bound_rpm"] <= tol * speeds[n - 1]
     # two cage revolutions at the window's cage speed (the skid start: about 8500 rpm)
     assert s["window_ms"] == pytest.approx(2 * 60e3 / s["cage_speed_rpm"]["value"], rel=0.01)
-    assert s["start"] == "skid" and s["per_seed"][0]["start_cage_speed_rpm"] < s["kinematic_cage_speed_rpm"]
+    assert s["window_ms"] == pytest.approx(ends[-1] - ends[n - 1], rel=1e-9)
+    assert s["start"] == "skid" and seed["start_cage_speed_rpm"] < s["kinematic_cage_speed_rpm"]
     for key in EVENT_STATS:
         for stat in ("max", "mean", "median", "p95"):
             est = s[key][stat]
@@ -91,7 +120,10 @@ def test_fixed_settle_reports_intervals(small_config, capsys):
 
 
 def test_auto_settle_hitting_the_cap_is_not_silent(small_config, capsys):
-    _, cfg = small_config
+    """A cap of 1 ms from the quasi-static start (kinematic speeds, no projective steps): the
+    first revolution passes the cap, the run measures unsettled, says so and exits 1."""
+    d, cfg = small_config
+    out = d / "capped"
     code = main(
         [
             "simulate",
@@ -105,11 +137,22 @@ def test_auto_settle_hitting_the_cap_is_not_silent(small_config, capsys):
             "1",
             "--window-revs",
             "2",
+            "--start",
+            "quasi-static",
+            "--out",
+            str(out),
         ]
     )
     text = capsys.readouterr().out
     assert code == 1
     assert "settled false" in text and "NOT SETTLED" in text and "remaining drift" in text
+    s = json.loads((out / "summary.json").read_text())
+    assert s["settled"] is False and s["settle_cap_ms"] == 1.0 and s["start"] == "quasi-static"
+    (seed,) = s["per_seed"]
+    assert len(seed["revolution_cage_speed_rpm"]) == 3  # one revolution past the cap, then the window
+    assert seed["projective_steps_rpm"] == []
+    # the quasi-static start runs the cage at the kinematic speed (pure rolling)
+    assert seed["start_cage_speed_rpm"] == pytest.approx(s["kinematic_cage_speed_rpm"], rel=1e-9)
 
 
 @pytest.mark.slow
@@ -335,3 +378,29 @@ def test_misaligned_run_settles_as_fast_as_the_aligned_one():
     for s in (aligned, tilted):
         assert s["status"] == "ok" and s["settled"], s["per_seed"][0]
     assert tilted["settle_time_ms"] <= 2 * aligned["settle_time_ms"]
+
+
+def test_settled_options_reach_the_run(monkeypatch):
+    """`--seeds`, `--workers`, `--settle-tolerance`, `--settle-cap-ms`, `--window-revs`, `--start`
+    and `--settle` arrive in the settled run `simulate` is asked for (a stand-in records the
+    request and stops the command; the real settled runs are the tests above)."""
+    import jaxbearing.run as run
+
+    seen = []
+
+    def stand_in(bearing, op, **kw):
+        seen.append(kw)
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(run, "simulate", stand_in)
+    args = ["--settle", "auto", "--seeds", "3", "--workers", "2", "--settle-tolerance", "2e-3"]
+    args += ["--settle-cap-ms", "50", "--window-revs", "4", "--start", "quasi-static"]
+    assert main(["simulate", "--end", "arc", *args, "--no-progress"]) == 130
+    (kw,) = seen
+    assert (kw["settle"], kw["seeds"], kw["workers"]) == ("auto", 3, 2)
+    assert (kw["tolerance"], kw["settle_cap_ms"], kw["window_revs"], kw["start"]) == (
+        2e-3,
+        50.0,
+        4,
+        "quasi-static",
+    )

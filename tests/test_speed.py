@@ -313,8 +313,10 @@ def test_a_closed_over_bearing_costs_no_more_than_an_argument():
     """A caller's jit that closes over the bearing makes its arrays constants; XLA specialised
     the quasi-static Newton loops on them (0.21 s per start against 0.036 s) until
     `quasi_static` made them opaque (`jax.lax.optimization_barrier`). The same values to 1e-12
-    (before, the specialised program's rounding differed beyond that too), and a closed-over
-    start within 2x of the argument one (min of 5 calls each; it was 6x)."""
+    (before, the specialised program's rounding differed beyond that too), the barrier in the
+    closed-over program, and a closed-over start within 2x of the argument one (it was 6x): a
+    ratio of the fastest of 7 calls each, the two programs called alternately so that a load on
+    the machine slows both alike (no absolute wall-clock threshold)."""
     import time
 
     from jaxbearing.run import initial_state
@@ -323,21 +325,24 @@ def test_a_closed_over_bearing_costs_no_more_than_an_argument():
     pert = jb.Perturbation(seed=0)
     as_argument = jax.jit(lambda bb: initial_state(bb, op, pert))
     closed_over = jax.jit(lambda _: initial_state(b, op, pert))
+    zero = jnp.zeros(())
+    assert "optimization_barrier" in closed_over.lower(zero).as_text()
 
-    def best(f, x):
-        out = jax.block_until_ready(f(x))
-        times = []
-        for _ in range(5):
-            t = time.perf_counter()
-            jax.block_until_ready(f(x))
-            times.append(time.perf_counter() - t)
-        return min(times), out
-
-    t_arg, y_arg = best(as_argument, b)
-    t_closed, y_closed = best(closed_over, jnp.zeros(()))
+    y_arg = jax.block_until_ready(as_argument(b))
+    y_closed = jax.block_until_ready(closed_over(zero))
     for u, v in zip(jax.tree_util.tree_leaves(y_arg), jax.tree_util.tree_leaves(y_closed)):
         np.testing.assert_allclose(np.asarray(u), np.asarray(v), rtol=1e-12, atol=1e-300)
-    assert t_closed < 2.0 * t_arg + 0.01, (t_closed, t_arg)
+
+    def timed(f, x):
+        t = time.perf_counter()
+        jax.block_until_ready(f(x))
+        return time.perf_counter() - t
+
+    t_arg, t_closed = [], []
+    for _ in range(7):
+        t_arg.append(timed(as_argument, b))
+        t_closed.append(timed(closed_over, zero))
+    assert min(t_closed) < 2.0 * min(t_arg), (t_closed, t_arg)
 
 
 def _toy_problem():

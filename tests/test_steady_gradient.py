@@ -180,7 +180,11 @@ def test_frozen_load_estimator_agrees_with_crn_differences_on_settled_running():
     plateau, tests/test_skid.py), then a common-random-number central difference of the ensemble
     objective (both designs continue from the same states and measure two cage revolutions at
     once; paired over the seeds) against the frozen-load estimate from the same states. The difference must
-    be significant (|FD| > 2 SE) and the estimate agree with it in sign and within 30 %.
+    be significant (|FD| > 2 SE) and the estimate agree with it in sign and within two of the
+    difference's standard errors. That is what 3 seeds can resolve: the difference's standard error
+    is about 37 % of its value here, so agreement within 30 % cannot be told from noise (the check
+    used to read `max(30 %, 2 SE)` and passed, through its 2 SE branch, at 44 %); the 30 % claim is
+    measured at full size by benchmarks/bench_steady_gradient.py.
 
     The settling times are in ms: 0.005 ms from the skid start and 0.0035 ms after the design
     change, i.e. none to speak of. (The comments used to say 5 ms and half a revolution, and the
@@ -191,7 +195,11 @@ def test_frozen_load_estimator_agrees_with_crn_differences_on_settled_running():
     Slow (`make test-slow`; 126-160 s alone, about 3 min of a cold suite). Measured: CRN FD
     -1.737e11 +- 6.4e10 (2.7 standard errors), frozen load -9.69e10 per rad; with 3.53 us
     after the change (the old rev / 2 s passed as ms) -1.358e11 +- 3.9e10. A check this close to
-    its significance bound is fragile: 3 seeds are few. The default
+    its significance bound is fragile: 3 seeds are few. It fails that bound in the session of
+    2026-11-25 (issue 37; same code, this machine): CRN FD -7.53e10 +- 7.8e10 against frozen load
+    -9.70e10, and in a trial with 8 seeds -5.01e10 +- 2.7e10 (1.8 standard errors) against
+    -9.78e10: at this reduced size the difference is not reliably significant, and the frozen-load
+    estimate sat within 2 standard errors of it both times. The default
     suite keeps the estimator's derivative against finite differences of the same functional
     (above); the full-size study is benchmarks/studies/bench_steady_gradient.py."""
     from jaxbearing.run import frozen_load_gradient, steady_design_metrics
@@ -219,4 +227,4 @@ def test_frozen_load_estimator_agrees_with_crn_differences_on_settled_running():
     )
     assert abs(fd) > 2 * se
     assert np.sign(g.gradient[1]) == np.sign(fd)
-    assert abs(g.gradient[1] - fd) <= max(0.3 * abs(fd), 2 * se)
+    assert abs(g.gradient[1] - fd) <= 2 * se

@@ -14,10 +14,10 @@ import pathlib
 import signal
 import subprocess
 import sys
-import time
 
 import numpy as np
 import pytest
+from _figures import assert_png_drawn
 
 from jaxbearing import UserInputError
 from jaxbearing.cli import main as cli_main
@@ -135,14 +135,18 @@ def test_bad_spec_fields():
         loads_sweep_spec('[base.roller]\ndiameter_mm = -1.0\n[axes]\nend = ["arc"]\n')
 
 
-def test_bad_spec_fails_before_computing(tmp_path, capsys):
+def test_bad_spec_fails_before_computing(tmp_path, capsys, monkeypatch):
     """The CLI prints one line naming the axis, exits 2 and creates nothing."""
     spec = tmp_path / "bad.toml"
     spec.write_text('[axes]\n"operating.speed_rpm" = [1e4, 2e4]\n"roller.end_radius_mm" = [1.0]\n')
     out = tmp_path / "out"
-    start = time.perf_counter()
+    import jaxbearing.sweep as sweep
+
+    started = []  # nothing is computed: neither the sweep nor jax.distributed starts (a count)
+    monkeypatch.setattr(sweep, "run_sweep", lambda *a, **k: started.append("run_sweep"))
+    monkeypatch.setattr(sweep, "initialize_distributed", lambda *a: started.append("distributed"))
     assert cli_main(["sweep", str(spec), "--out", str(out)]) == 2
-    assert time.perf_counter() - start < 5  # nothing compiled
+    assert started == []
     err = capsys.readouterr().err.strip().splitlines()
     assert err[-1].startswith("jaxbearing sweep: error: roller.end_radius_mm: ")
     assert "out of range" in err[-1]
@@ -259,40 +263,94 @@ def test_failed_case_is_recorded(tmp_path, reference):
     assert ds.isel(duration_ms=0)["cage_speed_rpm"].values == ref["cage_speed_rpm"].values
 
 
+#: `jaxbearing sweep` in a process that kills itself with SIGKILL right after its first batch
+#: file is written and logged: the kill lands at one known point of the work, not in a race
+#: with it (a kill sent from outside when the file appears may arrive after the next batch)
+_KILLED_AFTER_FIRST_BATCH = """
+import os, signal, sys
+import jaxbearing.sweep._driver as driver
+log = driver.append_log
+def append_then_die(out_dir, record):
+    log(out_dir, record)
+    if record.get("event") == "batch":
+        os.kill(os.getpid(), signal.SIGKILL)
+driver.append_log = append_then_die
+from jaxbearing.cli import main
+sys.exit(main(sys.argv[1:]))
+"""
+
+
 def test_kill_and_resume(tmp_path, reference):
-    """SIGKILL after the first batch file appears; the same command then computes only the
-    missing batch and the dataset equals the uninterrupted run bit for bit."""
+    """SIGKILL after the first batch file is written (one worker: the batches run in order);
+    the same command with --resume then computes only the missing batch and the dataset equals
+    the uninterrupted run bit for bit."""
     out = tmp_path / "sweep"
     env = subprocess_env()
-    cmd = sweep_command(SMALL, out)
+    cmd = sweep_command(SMALL, out, "--workers", "1")
     first = out / "batches" / "batch_00000.npz"
-    proc = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
-    try:
-        deadline = time.monotonic() + 240
-        while not first.exists():
-            assert proc.poll() is None, proc.stdout.read().decode()[-3000:]
-            assert time.monotonic() < deadline, "no batch file within 240 s"
-            time.sleep(0.02)
-        os.kill(proc.pid, signal.SIGKILL)
-    finally:
-        proc.wait()
-    assert proc.returncode == -signal.SIGKILL
+    killed = subprocess.run(
+        [sys.executable, "-c", _KILLED_AFTER_FIRST_BATCH, *cmd[3:]],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert killed.returncode == -signal.SIGKILL, killed.stderr[-3000:]
     assert not (out / "results.nc").exists()
-    done_before = computed_batches(out)
-    assert 0 in done_before
+    assert computed_batches(out) == [0] and first.exists()
     stat = first.stat()
     content = first.read_bytes()
 
-    rerun = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=300)
+    rerun = subprocess.run(cmd + ["--resume"], env=env, capture_output=True, text=True, timeout=300)
     assert rerun.returncode == 0, rerun.stderr[-3000:]
-    log = computed_batches(out)
-    assert log[: len(done_before)] == done_before
-    assert sorted(log[len(done_before) :]) == sorted({0, 1} - set(done_before))
+    assert computed_batches(out) == [0, 1]  # only the missing batch computed
     assert first.stat().st_mtime_ns == stat.st_mtime_ns and first.read_bytes() == content
     from jaxbearing.sweep import open_results
 
     assert_same_results(open_results(out), reference[1])
     assert json.loads((out / "spec.json").read_text())["hash"] == reference[1].attrs["spec_hash"]
+
+
+def test_no_resume_recomputes_every_batch(tmp_path, reference):
+    """`--no-resume` over a finished sweep computes every batch again (same numbers); the
+    default (resume) computes none."""
+    import shutil
+
+    out = tmp_path / "again"
+    shutil.copytree(reference[0], out)
+    before = computed_batches(out)
+    args = ["sweep", str(SMALL), "--out", str(out), "--no-progress", "--workers", "1"]
+    assert cli_main(args) == 0
+    assert computed_batches(out) == before
+    assert cli_main([*args, "--no-resume"]) == 0
+    assert computed_batches(out) == before + [0, 1]
+    from jaxbearing.sweep import open_results
+
+    assert_same_results(open_results(out), reference[1])
+
+
+def test_dry_run_lists_the_axes_and_computes_nothing(tmp_path, capsys):
+    out = tmp_path / "dry"
+    assert cli_main(["sweep", str(SMALL), "--out", str(out), "--dry-run", "--batch-size", "1"]) == 0
+    captured = capsys.readouterr()
+    assert "4 cases" in captured.err and "4 batches of 1" in captured.err
+    assert "operating.speed_rpm [speed_rpm]: 15000.0, 20000.0" in captured.out
+    assert not out.exists()
+
+
+def test_wait_timeout_names_the_missing_batch(tmp_path, capsys, monkeypatch):
+    """Process 0 of 2 (jax.distributed stood in for: this process computes batch 0, the other
+    never runs) waits --wait-timeout-s for batch 1, then says which file is missing, exit 2."""
+    import jaxbearing.sweep as sweep
+
+    monkeypatch.setattr(sweep, "initialize_distributed", lambda *a: (0, 2))
+    out = tmp_path / "half"
+    code = cli_main(["sweep", str(SMALL), "--out", str(out), "--no-progress", "--wait-timeout-s", "0.2"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2
+    assert "1 batch file(s)" in err[-1] and "still missing after 0.2 s" in err[-1]
+    assert "batch_00001.npz" in err[-1]
+    assert computed_batches(out) == [0]
 
 
 def test_resume_refuses_another_sweep(reference):
@@ -325,7 +383,14 @@ def test_plot_draws_every_figure_from_assembled_batches(tmp_path, capsys):
     assert cli_main(["plot", str(tmp_path)]) == 0
     out = capsys.readouterr().out
     assert out.count("drew Figure") == 8 and "could not" not in out
-    assert len(list((tmp_path / "figures").glob("figure*.png"))) == 8
+    figures = sorted((tmp_path / "figures").glob("figure*.png"))
+    assert len(figures) == 8
+    for path in figures:
+        assert_png_drawn(path, min_pixels=100_000)
+    # --out: the same figures, written there instead
+    elsewhere = tmp_path / "elsewhere"
+    assert cli_main(["plot", str(tmp_path), "--out", str(elsewhere)]) == 0
+    assert sorted(p.name for p in elsewhere.glob("figure*.png")) == [p.name for p in figures]
     from jaxbearing.sweep import open_results
 
     ds = open_results(tmp_path)

@@ -4,13 +4,14 @@
   JAX starts, hence a subprocess), one batch sharded over the devices with `jax.shard_map`,
   against the single-device sweep of the same spec run in this process (batches of 2 vmapped
   cases).
-* Two `jax.distributed` processes on 127.0.0.1 (a free port), each taking every second batch
+* Two `jax.distributed` processes on 127.0.0.1 (a free port, held until they end), each taking every second batch
   and writing its batch files into the same directory; process 0 assembles. Each process runs
   the same per-device program as the single-device run, so the numbers are equal bit for bit.
 """
 
 from __future__ import annotations
 
+import contextlib
 import socket
 import subprocess
 
@@ -27,10 +28,16 @@ def reference(tmp_path_factory):
     return run_sweep(load_sweep_spec(SMALL), out, progress=False)
 
 
-def free_port() -> int:
+@contextlib.contextmanager
+def held_port():
+    """A free port on 127.0.0.1, held until the block ends: the socket is bound with
+    SO_REUSEPORT and never listens, so no other program can take the port between choosing it
+    and the coordinator binding it (gRPC servers set SO_REUSEPORT too, so the coordinator's bind
+    succeeds, and connections go to the listening socket only)."""
     with socket.socket() as s:
+        s.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEPORT, 1)
         s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
+        yield s.getsockname()[1]
 
 
 def test_four_devices_match_single_device(tmp_path, reference):
@@ -72,22 +79,26 @@ _STEP_COUNTS = ("num_steps", "num_rejected_steps", "flange_contact_events")
 
 def test_two_processes_match_single_process(tmp_path, reference):
     out = tmp_path / "two"
-    port = free_port()
     env = subprocess_env()
-    cmd = sweep_command(SMALL, out, "--coordinator", f"127.0.0.1:{port}", "--num-processes", "2")
-    procs = [
-        subprocess.Popen(
-            cmd + ["--process-id", str(i)], env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
-        )
-        for i in range(2)
-    ]
-    try:
-        outputs = [p.communicate(timeout=400) for p in procs]
-    finally:
-        for p in procs:
-            if p.poll() is None:
-                p.kill()
-                p.wait()
+    with held_port() as port:
+        cmd = sweep_command(SMALL, out, "--coordinator", f"127.0.0.1:{port}", "--num-processes", "2")
+        procs = [
+            subprocess.Popen(
+                cmd + ["--process-id", str(i)],
+                env=env,
+                stdout=subprocess.PIPE,
+                stderr=subprocess.PIPE,
+                text=True,
+            )
+            for i in range(2)
+        ]
+        try:
+            outputs = [p.communicate(timeout=400) for p in procs]
+        finally:
+            for p in procs:
+                if p.poll() is None:
+                    p.kill()
+                    p.wait()
     for i, (p, (_, err)) in enumerate(zip(procs, outputs)):
         assert p.returncode == 0, f"process {i}:\n{err[-3000:]}"
         assert f"process {i}/2: 1 local device(s)" in err

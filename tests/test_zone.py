@@ -8,6 +8,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
+from _figures import assert_png_drawn
 
 import jaxbearing as jb
 from jaxbearing import UserInputError
@@ -189,10 +190,7 @@ def test_cli_zone_prints_margins_and_writes_maps(tmp_path, capsys):
         assert word in out
     assert out.count(" OK") == 4
     for name in ("zone_height_map.png", "zone_clearance_map.png"):
-        path = tmp_path / "maps" / name
-        data = path.read_bytes()
-        assert data[:8] == b"\x89PNG\r\n\x1a\n"
-        assert len(data) > 20_000  # a real plot, not an empty canvas
+        assert_png_drawn(tmp_path / "maps" / name)  # a real plot, not an empty canvas
 
 
 def test_cli_zone_reports_violations():
