@@ -144,7 +144,7 @@ def test_search_no_worse_than_grid(searched):
     is lower is the rounding of an unloaded contact, not a ranking; what is claimed, and checked,
     is that the search reaches the floor the grid's best point is on. (It used to allow 1e-3
     GPa m/s, 4 000 times the values compared.) The full >= 15 x 15 comparison is
-    benchmarks/bench_optimise_grid.py."""
+    benchmarks/studies/bench_optimise_grid.py."""
     p, res = searched
     grid = opt.grid_search(p, 5, 5, CLEARANCE_MM * 1e-3, batch=GRID_BATCH)
     assert grid["best_design"] is not None and grid["num_model_evaluations"] > 0

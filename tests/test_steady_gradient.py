@@ -184,7 +184,7 @@ def test_frozen_load_estimator_agrees_with_crn_differences_on_settled_running():
     difference's standard errors. That is what 3 seeds can resolve: the difference's standard error
     is about 37 % of its value here, so agreement within 30 % cannot be told from noise (the check
     used to read `max(30 %, 2 SE)` and passed, through its 2 SE branch, at 44 %); the 30 % claim is
-    measured at full size by benchmarks/bench_steady_gradient.py.
+    measured at full size by benchmarks/studies/bench_steady_gradient.py.
 
     The settling times are in ms: 0.005 ms from the skid start and 0.0035 ms after the design
     change, i.e. none to speak of. (The comments used to say 5 ms and half a revolution, and the

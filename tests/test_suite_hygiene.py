@@ -255,6 +255,7 @@ _SETTLED_OPTIONS = "test_settle.py::test_settled_options_reach_the_run"
 _STEADY_CLI = "test_optimise_steady.py::test_killed_run_resumes_with_the_same_result"
 _OPT_FILE = "test_optimise.py::test_cli_settings_from_a_file_and_options_reach_the_problem"
 _TWO_PROCESSES = "test_sweep_distributed.py::test_two_processes_match_single_process"
+_VALIDATE = "test_validate.py::test_validate_writes_the_comparison"
 CLI_CHECKS = {
     ("jaxbearing", "demo", "--window-revs"): [
         "test_cmd_simulate.py::test_demo_settled_passes_its_window_to_the_run"
@@ -264,6 +265,17 @@ CLI_CHECKS = {
     ("jaxbearing", "demo", "--out"): [_DEMO],
     ("jaxbearing", "demo", "--summary-only"): ["test_params.py::test_cli_demo_prints_summary"],
     ("jaxbearing", "config show", "--config"): ["test_config.py::test_config_show_merges_file"],
+    ("jaxbearing", "validate", "--config"): [_VALIDATE],
+    ("jaxbearing", "validate", "--end"): [_VALIDATE],
+    ("jaxbearing", "validate", "--settle"): [_VALIDATE],
+    ("jaxbearing", "validate", "--seeds"): [_VALIDATE],
+    ("jaxbearing", "validate", "--window-revs"): [_VALIDATE],
+    ("jaxbearing", "validate", "--workers"): [_VALIDATE],
+    ("jaxbearing", "validate", "--no-progress"): [_VALIDATE],
+    ("jaxbearing", "validate", "--out"): [
+        _VALIDATE,
+        "test_validate.py::test_an_interrupted_validation_keeps_its_finished_points",
+    ],
     ("jaxbearing", "zone", "--config"): ["test_zone.py::test_cli_zone_reads_a_config"],
     ("jaxbearing", "zone", "--flange-load-N"): ["test_zone.py::test_cli_zone_prints_margins_and_writes_maps"],
     ("jaxbearing", "zone", "--map"): ["test_zone.py::test_cli_zone_prints_margins_and_writes_maps"],
