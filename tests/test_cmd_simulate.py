@@ -243,7 +243,8 @@ def test_demo_transient_writes_both_ends(both_run, tmp_path, capsys):
     assert "a 0.2 ms start-up transient" in text and "peak pressure, max" in text
     assert f"written to {out}/" in text
     doc = json.loads((out / "summary.json").read_text())
-    assert set(doc) == {"arc", "corner"}
+    assert doc["ends"] == ["arc", "corner"] and doc["command"][:3] == ["jaxbearing", "demo", "--transient"]
+    assert doc["config"]["operating"]["speed_rpm"] == 20000.0 and "jaxbearing_version" in doc
     for end in ("arc", "corner"):
         assert doc[end]["status"] == "ok"
         t = np.load(out / f"histories_{end}.npz")["t"]
