@@ -173,35 +173,24 @@ def test_frozen_load_derivative_matches_central_differences(running):
     assert float(value[0]) == pytest.approx(float(direct), rel=1e-9)
 
 
-@pytest.mark.slow
 def test_frozen_load_estimator_agrees_with_crn_differences_on_settled_running():
     """The acceptance check of benchmarks/studies/bench_steady_gradient.py at reduced size (11 slices,
-    3 seeds, theta_f at the reference design): running from the skid start (which lands on the
-    plateau, tests/test_skid.py), then a common-random-number central difference of the ensemble
-    objective (both designs continue from the same states and measure two cage revolutions at
-    once; paired over the seeds) against the frozen-load estimate from the same states. The difference must
-    be significant (|FD| > 2 SE) and the estimate agree with it in sign and within two of the
-    difference's standard errors. That is what 3 seeds can resolve: the difference's standard error
-    is about 37 % of its value here, so agreement within 30 % cannot be told from noise (the check
-    used to read `max(30 %, 2 SE)` and passed, through its 2 SE branch, at 44 %); the 30 % claim is
-    measured at full size by benchmarks/studies/bench_steady_gradient.py.
+    3 seeds, theta_f at the reference design), in the default suite: running from the skid start
+    (which lands on the plateau, tests/test_skid.py), then a common-random-number central
+    difference of the ensemble objective (both designs continue from the same states and measure
+    two cage revolutions at once; paired over the seeds) against the frozen-load estimate from the
+    same states. The difference must be significant (|FD| > 3 SE) and the estimate agree with it
+    in sign and within 30 % of it (no standard-error branch: the old check read
+    `max(30 %, 2 SE)` and passed, through that branch, at 44 %).
 
-    The settling times are in ms: 0.005 ms from the skid start and 0.0035 ms after the design
-    change, i.e. none to speak of. (The comments used to say 5 ms and half a revolution, and the
-    values were seconds passed as ms.) With 5 ms and half a revolution, 3 seeds give
-    -4.6e10 +- 6.8e10, not significant: the pair decorrelates over the extra half revolution, so
-    the study needs benchmarks/studies/bench_steady_gradient.py's 8 seeds and one revolution.
-
-    Slow (`make test-slow`; 126-160 s alone, about 3 min of a cold suite). Measured: CRN FD
-    -1.737e11 +- 6.4e10 (2.7 standard errors), frozen load -9.69e10 per rad; with 3.53 us
-    after the change (the old rev / 2 s passed as ms) -1.358e11 +- 3.9e10. A check this close to
-    its significance bound is fragile: 3 seeds are few. It fails that bound in the session of
-    2026-11-25 (issue 37; same code, this machine): CRN FD -7.53e10 +- 7.8e10 against frozen load
-    -9.70e10, and in a trial with 8 seeds -5.01e10 +- 2.7e10 (1.8 standard errors) against
-    -9.78e10: at this reduced size the difference is not reliably significant, and the frozen-load
-    estimate sat within 2 standard errors of it both times. The default
-    suite keeps the estimator's derivative against finite differences of the same functional
-    (above); the full-size study is benchmarks/studies/bench_steady_gradient.py."""
+    The step is 0.15 deg (15 % of the optimiser's theta_f range): with 0.04 deg the paired
+    difference was not significant with 3 seeds (2026-11-25: -7.53e10 +- 7.8e10 per rad; 8 seeds
+    -5.01e10 +- 2.7e10), since the pairs decorrelate over the two revolutions by about as much
+    whatever the step, and the signal grows with it. Measured with 0.15 deg (2026-11-25, 58 s
+    cold alone on the 2-core machine): CRN FD -1.233e11 +- 2.2e10 per rad (5.6 standard errors),
+    frozen load -9.70e10 +- 2.1e9, 21 % apart. The settling times are in ms: 0.005 ms from the
+    skid start and 0.0035 ms after the design change, i.e. none to speak of. The full-size
+    study is benchmarks/studies/bench_steady_gradient.py."""
     from jaxbearing.run import frozen_load_gradient, steady_design_metrics
 
     b = dataclasses.replace(jb.reference_bearing(), num_slices=11)
@@ -210,7 +199,7 @@ def test_frozen_load_estimator_agrees_with_crn_differences_on_settled_running():
     kw = dict(seeds=3, window_revs=2, workers=1)
     # the skid start lands on the plateau (tests/test_skid.py): measure almost at once (5 us)
     base = steady_design_metrics(b, op, DesignVariables.from_array(x), settle=0.005, **kw)
-    h = 0.04 * np.radians(1.0)  # 4 % of the optimiser's theta_f range (1-2 deg)
+    h = 0.15 * np.radians(1.0)  # 15 % of the optimiser's theta_f range (1-2 deg)
     per_seed = []
     for sign in (1.0, -1.0):
         xs = x.copy()
@@ -225,6 +214,6 @@ def test_frozen_load_estimator_agrees_with_crn_differences_on_settled_running():
     print(
         f"dJ/dtheta_f: CRN FD {fd:.3e} +- {se:.1e}, frozen load {g.gradient[1]:.3e} +- {g.gradient_stderr[1]:.1e}"
     )
-    assert abs(fd) > 2 * se
+    assert abs(fd) > 3 * se
     assert np.sign(g.gradient[1]) == np.sign(fd)
-    assert abs(g.gradient[1] - fd) <= 2 * se
+    assert abs(g.gradient[1] - fd) <= 0.3 * abs(fd)
