@@ -9,12 +9,11 @@ Examples: 30 per test in the default run; the `slow` run has 200 per test
 
 from __future__ import annotations
 
-import contextlib
 import math
-import signal
 
 import pytest
 import tomli_w
+from _timeouts import time_limit
 from hypothesis import HealthCheck, assume, event, given, settings
 from hypothesis import strategies as st
 
@@ -25,8 +24,6 @@ from jaxbearing.sweep import loads_sweep_spec
 from jaxbearing.sweep._spec import _SWEEP_FIELDS
 from optimise._problem import OPTIMISE_TOML_KEYS, load_optimise_toml
 
-EXAMPLE_LIMIT_S = 30
-
 
 def _settings(n: int):
     return settings(
@@ -35,20 +32,6 @@ def _settings(n: int):
         derandomize=n < 200,
         suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
     )
-
-
-@contextlib.contextmanager
-def time_limit(seconds: int = EXAMPLE_LIMIT_S):
-    def expired(signum, frame):
-        raise TimeoutError(f"example ran over {seconds} s (a hang?)")
-
-    old = signal.signal(signal.SIGALRM, expired)
-    signal.alarm(seconds)
-    try:
-        yield
-    finally:
-        signal.alarm(0)
-        signal.signal(signal.SIGALRM, old)
 
 
 SCALAR = st.one_of(

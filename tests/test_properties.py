@@ -21,11 +21,11 @@ import dataclasses
 import io
 import math
 import os
-import signal
 
 import equinox as eqx
 import numpy as np
 import pytest
+from _timeouts import EXAMPLE_LIMIT_S, time_limit
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -35,7 +35,6 @@ from jaxbearing.io import KEYS, SOLVER_ARGUMENTS, Rule, count, real
 from jaxbearing.io._schema import REFERENCE_VALUES
 
 EXAMPLES = int(os.environ.get("JAXBEARING_PROPERTY_EXAMPLES", "30"))
-EXAMPLE_LIMIT_S = 30
 SETTINGS = settings(
     max_examples=EXAMPLES,
     deadline=None,
@@ -53,20 +52,6 @@ def no_solve(monkeypatch):
         raise AssertionError("an invalid input reached the solver")
 
     monkeypatch.setattr(simulate_module, "initial_state", sentinel)
-
-
-@contextlib.contextmanager
-def time_limit(seconds: int = EXAMPLE_LIMIT_S):
-    def expired(signum, frame):
-        raise TimeoutError(f"example ran over {seconds} s (a hang?)")
-
-    old = signal.signal(signal.SIGALRM, expired)
-    signal.alarm(seconds)
-    try:
-        yield
-    finally:
-        signal.alarm(0)
-        signal.signal(signal.SIGALRM, old)
 
 
 def assert_rejected(call, name: str, error=jb.UserInputError):
