@@ -15,6 +15,8 @@ import csv
 import io
 import pathlib
 
+from ._steady import _ci
+
 #: columns of validation.csv (units in the names)
 CSV_COLUMNS = (
     "line",
@@ -121,14 +123,7 @@ def format_table(rows: list[dict]) -> str:
     )
     out = [head, "-" * len(head)]
     for r in rows:
-        m = r["model_cage_speed_rpm"]
-        model = (
-            "-"
-            if m["value"] is None
-            else f"{m['value']:.1f} [{m['ci95_low']:.1f}, {m['ci95_high']:.1f}]"
-            if m["ci95_low"] is not None
-            else f"{m['value']:.1f} (no CI)"
-        )
+        model = _ci(r["model_cage_speed_rpm"], 1.0, ".1f")
         inside = {True: "yes", False: "no", None: "-"}[r["measurement_inside_ci"]]
         out.append(
             f"{r['line']:>5}{r['shaft_speed_rpm']:>11.0f}{r['radial_load_N']:>9.0f}"
