@@ -12,7 +12,10 @@
   intervals: `steady_statistics`, `revolution_statistics`, `confidence_intervals`,
   `batch_means`, `student_t_interval`, `Estimate`;
 - settled running: `simulate_steady` (settling detection over cage revolutions, a window,
-  seeds), `summarise_steady`, `steady_design_metrics` (the steady-running design objective:
+  seeds), `summarise_steady`; the steady-running engine under it, `settle_members` (many
+  `Member`s, each a case and a seed, with `SteadyOptions`: one after another, one process per
+  core, or vmapped on accelerators, `STRATEGIES`; an `EngineRun`) and `window_statistics`
+  (`revolution_statistic_keys`); `steady_design_metrics` (the steady-running design objective:
   mean and p95 PV over contact time, corner share and margin, static margins; continuation from
   given states), `steady_gradient` (its gradient: ensemble of short-window forward-mode
   sensitivities from settled states), `tangent_growth` (finite-time growth of the tangents),
@@ -47,6 +50,7 @@ from ._design import (
     forward_jacobian,
     seated_perturbation,
 )
+from ._engine import STRATEGIES
 from ._ensemble import as_completed_map, available_cpus, parallel_map, shared_workers, simulate_ensemble
 from ._initial import STARTS, Perturbation, SkidStart, initial_state, skid_start
 from ._measured import model_cage_speeds
@@ -63,9 +67,14 @@ from ._result import (
 from ._settle import (
     SETTLE_CAP_MS,
     SETTLE_TOLERANCE,
+    WINDOW_REVS,
+    EngineRun,
+    Member,
     SeedRun,
+    SteadyOptions,
     SteadyResult,
     check_steady_options,
+    settle_members,
     prepare_from,
     simulate,
     simulate_steady,
@@ -78,9 +87,11 @@ from ._statistics import (
     Estimate,
     batch_means,
     confidence_intervals,
+    revolution_statistic_keys,
     revolution_statistics,
     steady_statistics,
     student_t_interval,
+    window_statistics,
 )
 from ._steady_design import CORNER_MARGIN, SteadyDesignMetrics, steady_design_metrics
 from ._steady_gradient import (
@@ -183,4 +194,12 @@ __all__ = [
     "student_t_interval",
     "summarise",
     "summarise_steady",
+    "EngineRun",
+    "Member",
+    "SteadyOptions",
+    "STRATEGIES",
+    "WINDOW_REVS",
+    "settle_members",
+    "revolution_statistic_keys",
+    "window_statistics",
 ]

@@ -64,6 +64,7 @@ from ..dynamics import (
 )
 from ..geometry import Bearing, OperatingPoint, kinematic_cage_speed
 from ._compile_cache import compiled_program
+from ._engine import drive
 
 
 @dataclasses.dataclass(frozen=True)
@@ -216,16 +217,18 @@ def cage_drift(t, cage_speed, since):
     return mean, drift, mean + drift * float(tc[-1])
 
 
-def _pre_start(static: SkidStart, integrate) -> SkidStart:
-    """Bursts of the dynamics from the static skid state with secant steps on the cage speed's
-    drift between them (module docstring); falls back to `static` if a burst fails."""
+def pre_start_steps(static: SkidStart):
+    """The pre-start as a program of integration requests (`_engine`): bursts of the dynamics
+    from the static skid state with secant steps on the cage speed's drift between them (module
+    docstring). Yields `(state, duration)`, is sent `(histories, final state, result code,
+    steps)` and returns the `SkidStart`; falls back to `static` if a burst fails."""
     w0, tau_s = float(static.state.cage.speed), float(static.time_constant)
     rev = 2 * np.pi / abs(w0)
     cap = PRE_START_CAP * abs(w0)
     lo, hi = TIME_CONSTANT_RANGE
     state, tau, elapsed, speeds, drifts = static.state, tau_s, 0.0, [], []
     for k, (skip, measure) in enumerate(zip(PRE_START_SKIP, PRE_START_MEASURE)):
-        hist, end, code, _ = integrate(state, (skip + measure) * rev)
+        hist, end, code, _ = yield state, (skip + measure) * rev
         elapsed += (skip + measure) * rev
         speed = np.asarray(hist["cage_speed"])
         if int(code) != 0 or not np.all(np.isfinite(speed)):
@@ -272,4 +275,4 @@ def skid_start(
     static = _static_skid_start(bearing, op, perturbation)
     if integrate is None:
         return static
-    return _pre_start(static, integrate)
+    return drive(pre_start_steps(static), integrate)

@@ -54,8 +54,17 @@ from ..dynamics import Functionals, Params, Scaling, State, state_scales
 from ..geometry import Bearing, OperatingPoint, kinematic_cage_speed, rad_s_to_rpm
 from ..io import require
 from ._compile_cache import checks_without_host_callbacks, compiled_program
+from ._engine import STRATEGIES, BatchTimes, choose_strategy, drive, drive_batched
 from ._ensemble import parallel_map
-from ._initial import STARTS, Perturbation, along_slow_mode, initial_state, skid_start
+from ._initial import (
+    STARTS,
+    Perturbation,
+    _static_skid_start,
+    along_slow_mode,
+    initial_state,
+    pre_start_steps,
+    skid_start,
+)
 from ._result import result_code
 from ._rosenbrock import DEFAULT_SOLVER, check_solver
 from ._simulate import SolveArgs, _diffeqsolve, _histories, _saved_state
@@ -253,6 +262,15 @@ class SeedRun:
     #: the settling verdict at the end of settling (`settling_verdict`; with `settle` fixed or
     #: "off", the one before the window is not evaluated: nan fields)
     verdict: object = None
+    #: the window's `window_statistics`, when a reducer computed them as the seed finished (the
+    #: window's histories are then dropped: `window` is empty); `extras`: what else it kept
+    per_revolution: dict | None = None
+    extras: dict = dataclasses.field(default_factory=dict)
+
+    @property
+    def measured(self) -> bool:
+        """Whether the run has a window to take statistics from."""
+        return self.status == "ok" and (bool(self.window) or self.per_revolution is not None)
 
 
 def check_steady_options(
@@ -303,27 +321,21 @@ def _as_float(name, value):
         ) from None
 
 
-def _run_seed(
-    params,
+def settle_and_measure_steps(
     start,
     *,
     settle,
     window_revs,
     tolerance,
     cap,
-    rtol,
-    atol,
-    max_steps,
-    saves,
     progress,
     time_constant=None,
     slow_mode=float("nan"),
-    solver=DEFAULT_SOLVER,
 ):
-    """Settle then measure one seed (module docstring); `time_constant` [s] (skid start) turns
-    on the projective steps of the cage speed; `slow_mode` [s]: the running slow mode's time
-    constant the verdict uses (`settling_verdict`)."""
-    compiled = _compiled(params, start, saves, max_steps, solver)
+    """Settle then measure one seed (module docstring), as a program of integration requests
+    (`_engine`: yields `(state, duration)`, is sent `solve_from`'s answer); `time_constant` [s]
+    (skid start) turns on the projective steps of the cage speed; `slow_mode` [s]: the running
+    slow mode's time constant the verdict uses (`settling_verdict`)."""
     state, t, steps = start, 0.0, 0
     speeds, ends, windows, edges, jumps, integrals = [], [], [], [], [], []
     centres = []  # revolution centres [s]
@@ -339,7 +351,7 @@ def _run_seed(
             rev = min(rev, fixed - t)
         if measuring and not windows:
             window_start = state
-        hist, final, code, n = compiled(params, state, jnp.asarray(rev), jnp.asarray(rtol), jnp.asarray(atol))
+        hist, final, code, n = yield state, rev
         hist = {k: np.asarray(v) for k, v in hist.items()}
         steps += int(n)
         if int(code) != 0 or not np.all(np.isfinite(hist["cage_speed"])):
@@ -444,24 +456,184 @@ class SteadyResult:
 
 
 @dataclasses.dataclass(frozen=True)
-class _SteadySeed:
-    """Picklable settled run of one seed (for `parallel_map`)."""
+class Member:
+    """One member of the steady-running engine (`settle_members`): a bearing (with its design),
+    an operating point and one seeded initial scatter. `initial_state` (continuation): a `State`
+    to start from instead of the run's start (e.g. `SeedRun.final_state` of a neighbouring
+    design), settled without projective steps; `rtol`, `atol`: this member's tolerances (None:
+    the run's)."""
 
     bearing: Bearing
-    op: OperatingPoint
-    kwargs: dict
+    operating: OperatingPoint
+    perturbation: Perturbation = Perturbation()
+    initial_state: object = None
+    rtol: float | None = None
+    atol: float | None = None
 
-    def __call__(self, item) -> SteadyResult:
-        perturbation, state = item
-        return simulate_steady(
-            self.bearing,
-            self.op,
-            seeds=1,
-            perturbation=perturbation,
-            workers=1,
-            initial_states=None if state is None else [state],
-            **self.kwargs,
+
+@dataclasses.dataclass(frozen=True)
+class SteadyOptions:
+    """How every member of a settled run settles and measures (`simulate_steady`'s options)."""
+
+    settle: object = "auto"
+    window_revs: int = WINDOW_REVS
+    tolerance: float = SETTLE_TOLERANCE
+    settle_cap_ms: float = SETTLE_CAP_MS
+    start: str = "skid"
+    rtol: float = 1e-3
+    atol: float = 1e-6
+    max_steps: int = 2_000_000
+    saves_per_rev: int = SAVES_PER_REV
+    functionals: Functionals = Functionals()
+    progress: bool = False
+    solver: str = DEFAULT_SOLVER
+
+    def tolerances(self, member: Member) -> tuple[float, float]:
+        return (
+            float(self.rtol if member.rtol is None else member.rtol),
+            float(self.atol if member.atol is None else member.atol),
         )
+
+    def params(self, member: Member) -> Params:
+        return Params(bearing=member.bearing, operating=member.operating, functionals=self.functionals)
+
+
+def member_steps(member: Member, options: SteadyOptions, reduce=None):
+    """The settled run of one member as a program of integration requests (`_engine`): its
+    start (the skid equilibrium and its pre-start, the kinematic start, or the given state),
+    settling and the window (module docstring); returns its `SeedRun`, passed through
+    `reduce(run, member)` if given (e.g. a sweep's statistics, so that the window's histories
+    need not be kept)."""
+    bearing, op, pert, given = member.bearing, member.operating, member.perturbation, member.initial_state
+    skid = None
+    if given is not None:  # continuation from a given state
+        y0, tau = jax.tree_util.tree_map(jnp.asarray, given), None
+    elif options.start == "skid":
+        skid = yield from pre_start_steps(_static_skid_start(bearing, op, pert))
+        # on the plateau after a completed pre-start: no projective steps (their drift, from
+        # two revolution means, is noisier than the pre-start's secant; docs/model.md 16)
+        y0 = skid.state
+        tau = None if skid.pre_start_status == "ok" else float(skid.time_constant)
+    else:
+        y0, tau = initial_state(bearing, op, pert), None
+    slow_mode = float("nan")
+    if options.settle == "auto":
+        slow_mode = running_time_constant(skid, bearing, op, pert)
+    if options.progress:
+        print(
+            f"seed {pert.seed}: settling ({options.settle}), then {options.window_revs} revolutions",
+            flush=True,
+        )
+    *out, verdict = yield from settle_and_measure_steps(
+        y0,
+        settle=options.settle,
+        window_revs=int(options.window_revs),
+        tolerance=options.tolerance,
+        cap=options.settle_cap_ms * 1e-3,
+        progress=options.progress,
+        time_constant=tau,
+        slow_mode=slow_mode,
+    )
+    run = SeedRun(pert.seed, *out, start_cage_speed_rpm=float(rad_s_to_rpm(y0.cage.speed)), verdict=verdict)
+    return run if reduce is None else reduce(run, member)
+
+
+def _run_one(member: Member, options: SteadyOptions, reduce=None) -> tuple[SeedRun, float]:
+    """One member in this process (`drive`, its own compiled `solve_from`): (run, compile time)."""
+    compiled: list = []
+    rtol, atol = options.tolerances(member)
+    integrate = _integrator(
+        options.params(member),
+        int(options.saves_per_rev),
+        int(options.max_steps),
+        rtol,
+        atol,
+        compiled,
+        options.solver,
+    )
+    run = drive(member_steps(member, options, reduce), integrate)
+    return run, sum(compiled)
+
+
+@dataclasses.dataclass(frozen=True)
+class _MemberJob:
+    """Picklable `_run_one` (for `parallel_map`)."""
+
+    options: SteadyOptions
+    reduce: object = None
+
+    def __call__(self, member: Member):
+        return _run_one(member, self.options, self.reduce)
+
+
+@dataclasses.dataclass
+class EngineRun:
+    """What `settle_members` returns: one `SeedRun` per member (in order), the strategy that
+    ran them, the wall time without compilation and the compilation time [s]; `batch_times`
+    for the vmapped strategy (`_engine.BatchTimes`)."""
+
+    runs: list
+    strategy: str
+    wall_time_s: float
+    compile_time_s: float
+    batch_times: BatchTimes | None = None
+
+
+def settle_members(
+    members,
+    options: SteadyOptions = SteadyOptions(),
+    *,
+    strategy: str = "auto",
+    workers: int = 1,
+    devices=None,
+    reduce=None,
+) -> EngineRun:
+    """The steady-running engine: settle and measure every member (`Member`: a case and one
+    seed) with `options`, by `strategy` (`_engine`): "sequential" (one after another in this
+    process), "processes" (one process per core, `workers` of them; started with `spawn`: a
+    script calling this needs the `if __name__ == "__main__":` guard), "vmap" (all members as
+    one vmapped program per round, over `devices`: the local devices by default) or "auto"
+    (`choose_strategy`: vmap on an accelerator, else processes with `workers` > 1, else
+    sequential). Every strategy takes the same decisions for a member; `reduce(run, member)`
+    (picklable for "processes") turns each finished `SeedRun` into what is kept."""
+    members = list(members)
+    if strategy not in STRATEGIES:
+        raise UserInputError(f"strategy = {strategy!r}: must be one of {', '.join(map(repr, STRATEGIES))}")
+    require("workers", workers, lambda v: (v >= 1) & (v == np.round(v)), "an integer >= 1")
+    chosen = choose_strategy(strategy, min(int(workers), len(members)), devices)
+    wall0 = time.perf_counter()
+    if chosen == "vmap":
+        times = BatchTimes()
+        groups: dict = {}
+        for i, m in enumerate(members):  # one batch per parameter structure
+            key = jax.tree_util.tree_structure(options.params(m))
+            groups.setdefault(key, []).append(i)
+        runs: list = [None] * len(members)
+        for idx in groups.values():
+            outs = drive_batched(
+                [member_steps(members[i], dataclasses.replace(options, progress=False), reduce) for i in idx],
+                [options.params(members[i]) for i in idx],
+                [options.tolerances(members[i]) for i in idx],
+                num_saves=int(options.saves_per_rev),
+                max_steps=int(options.max_steps),
+                solver=options.solver,
+                devices=devices,
+                times=times,
+            )
+            for i, out in zip(idx, outs):
+                runs[i] = out
+        wall = time.perf_counter() - wall0 - times.compile_s
+        return EngineRun(runs, chosen, wall, times.compile_s, times)
+    if chosen == "processes" and len(members) > 1:
+        outs = parallel_map(_MemberJob(options, reduce), members, workers=min(int(workers), len(members)))
+        compile_time = max(c for _, c in outs)
+        # the pool's wall time less its longest compilation (the workers compile side by side)
+        return EngineRun(
+            [r for r, _ in outs], chosen, time.perf_counter() - wall0 - compile_time, compile_time
+        )
+    outs = [_run_one(m, options, reduce) for m in members]
+    compile_time = sum(c for _, c in outs)
+    return EngineRun([r for r, _ in outs], chosen, time.perf_counter() - wall0 - compile_time, compile_time)
 
 
 def simulate_steady(
@@ -484,15 +656,18 @@ def simulate_steady(
     workers: int = 1,
     initial_states=None,
     solver: str = DEFAULT_SOLVER,
+    strategy: str = "auto",
 ) -> SteadyResult:
     """Settle (module docstring), then measure `window_revs` cage revolutions, for each of
     `seeds` seeded initial scatters, each from `start`: "skid" (default; the skid equilibrium and
     projective steps of the cage speed while settling) or "quasi-static" (kinematic speeds).
+    The seeds are members of the steady-running engine (`settle_members`).
 
     `workers` > 1 runs the seeds in that many processes (`parallel_map`, started with `spawn`: a
     script calling this needs the `if __name__ == "__main__":` guard); `jaxbearing simulate`
-    uses one per CPU. Default 1: one after another, in this process. `solver`: "tsit5" (default)
-    or "ros34pw2" (`solve`).
+    uses one per CPU. Default 1: one after another, in this process. On an accelerator the
+    seeds run as one vmapped program (`strategy`, `settle_members`). `solver`: "tsit5"
+    (default) or "ros34pw2" (`solve`).
 
     `initial_states` (continuation): one `State` per seed (e.g. `SeedRun.final_state` of a
     neighbouring design's settled run) to start from instead of `start`; settling then runs
@@ -504,16 +679,16 @@ def simulate_steady(
     validate_bearing(bearing, op)
     check_steady_options(settle, window_revs, seeds, tolerance, settle_cap_ms, start=start, workers=workers)
     settle = settle if isinstance(settle, str) and settle in ("auto", "off") else float(settle)
-    kwargs = dict(
+    options = SteadyOptions(
         settle=settle,
-        window_revs=window_revs,
+        window_revs=int(window_revs),
         tolerance=tolerance,
         settle_cap_ms=settle_cap_ms,
         start=start,
         rtol=rtol,
         atol=atol,
-        max_steps=max_steps,
-        saves_per_rev=saves_per_rev,
+        max_steps=int(max_steps),
+        saves_per_rev=int(saves_per_rev),
         functionals=functionals,
         progress=progress,
         solver=solver,
@@ -526,75 +701,17 @@ def simulate_steady(
                 f"initial_states: {len(initial_states)} given, expected one per seed ({int(seeds)})"
             )
     states = initial_states if initial_states is not None else [None] * len(perturbations)
-    workers = min(int(seeds), int(workers))
-    if workers > 1:
-        wall0 = time.perf_counter()
-        outs = parallel_map(
-            _SteadySeed(bearing, op, kwargs), list(zip(perturbations, states)), workers=workers
-        )
-        return dataclasses.replace(
-            outs[0],
-            runs=[o.runs[0] for o in outs],
-            # the pool's wall time less its longest compilation (the workers compile side by side)
-            wall_time_s=time.perf_counter() - wall0 - max(o.compile_time_s for o in outs),
-            compile_time_s=max(o.compile_time_s for o in outs),
-        )
-    params = Params(bearing=bearing, operating=op, functionals=functionals)
-    runs, wall0, compile_time = [], time.perf_counter(), 0.0
-    for pert, given in zip(perturbations, states):
-        if given is not None:  # continuation from a given state
-            y0, tau = jax.tree_util.tree_map(jnp.asarray, given), None
-        elif start == "skid":  # its solve and pre-start count in the wall time, not compilation
-            compiled = []
-            integrate = _integrator(params, int(saves_per_rev), int(max_steps), rtol, atol, compiled, solver)
-            skid = skid_start(bearing, op, pert, integrate=integrate)
-            compile_time += sum(compiled)
-            # on the plateau after a completed pre-start: no projective steps (their drift, from
-            # two revolution means, is noisier than the pre-start's secant; docs/model.md 16)
-            y0 = skid.state
-            tau = None if skid.pre_start_status == "ok" else float(skid.time_constant)
-        else:
-            y0, tau = initial_state(bearing, op, pert), None
-        slow_mode = float("nan")
-        if settle == "auto":
-            slow_mode = running_time_constant(
-                skid if given is None and start == "skid" else None, bearing, op, pert
-            )
-        c0 = time.perf_counter()
-        _compiled(params, y0, int(saves_per_rev), int(max_steps), solver)
-        compile_time += time.perf_counter() - c0
-        if progress:
-            print(f"seed {pert.seed}: settling ({settle}), then {window_revs} revolutions", flush=True)
-        out = _run_seed(
-            params,
-            y0,
-            settle=settle,
-            window_revs=int(window_revs),
-            tolerance=tolerance,
-            cap=settle_cap_ms * 1e-3,
-            rtol=rtol,
-            atol=atol,
-            max_steps=int(max_steps),
-            saves=int(saves_per_rev),
-            progress=progress,
-            time_constant=tau,
-            slow_mode=slow_mode,
-            solver=solver,
-        )
-        *out, verdict = out
-        runs.append(
-            SeedRun(pert.seed, *out, start_cage_speed_rpm=float(rad_s_to_rpm(y0.cage.speed)), verdict=verdict)
-        )
-    wall = time.perf_counter() - wall0 - compile_time
+    members = [Member(bearing, op, p, s) for p, s in zip(perturbations, states)]
+    engine = settle_members(members, options, strategy=strategy, workers=workers)
     return SteadyResult(
-        runs=runs,
+        runs=engine.runs,
         settle=settle,
         window_revs=int(window_revs),
         tolerance=tolerance,
         cap=settle_cap_ms * 1e-3,
         start=start if initial_states is None else "continuation",
-        wall_time_s=wall,
-        compile_time_s=compile_time,
+        wall_time_s=engine.wall_time_s,
+        compile_time_s=engine.compile_time_s,
         bearing=bearing,
         operating=op,
     )
@@ -604,7 +721,7 @@ def summarise_steady(result: SteadyResult, threshold: float = 1.0) -> dict:
     """The summary.json block of a settled run: how it settled, and every statistic of the
     window as {"value", "ci95_low", "ci95_high", "n"} (`_statistics`)."""
     runs = result.runs
-    ok = [r for r in runs if r.status == "ok" and r.window]
+    ok = [r for r in runs if r.measured]
     block = {
         "status": "ok" if result.ok else next(r.status for r in runs if r.status != "ok"),
         "settled": bool(result.settled),
@@ -640,9 +757,15 @@ def summarise_steady(result: SteadyResult, threshold: float = 1.0) -> dict:
         "compile_time_s": result.compile_time_s,
     }
     if ok:
+        given = [r for r in ok if r.per_revolution is not None]  # the reducer's threshold
         block.update(
             steady_statistics(
-                [r.window for r in ok], [r.edges for r in ok], result.bearing, result.operating, threshold
+                [r.window for r in ok if r.per_revolution is None],
+                [r.edges for r in ok if r.per_revolution is None],
+                result.bearing,
+                result.operating,
+                threshold,
+                per_revolution=[r.per_revolution for r in given],
             )
         )
     return block

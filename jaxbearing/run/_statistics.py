@@ -109,6 +109,28 @@ def _window(hist: dict, t0: float, t1: float) -> dict:
     return {k: np.asarray(v)[keep] for k, v in hist.items()}
 
 
+#: per-revolution statistics other than the contact-event reductions (`revolution_statistics`)
+_REVOLUTION_SCALARS = (
+    "cage_speed_rpm",
+    "cage_slip",
+    "roller_skew_rad.mean_abs",
+    "roller_skew_rad.max_abs",
+    "corner_contact_share.time",
+    "corner_contact_share.events",
+    "contact_radius_m.p99",
+    "contact_radius_m.max_in_contact",
+    "flange_contact_events_per_rev",
+    "flange_pv_contact_time_Pa_m_s.mean",
+    "flange_pv_contact_time_Pa_m_s.p95",
+)
+
+
+def revolution_statistic_keys() -> tuple[str, ...]:
+    """The keys of `revolution_statistics`, in its order ("group.reduction" or "name")."""
+    events = tuple(f"{key}.{red}" for key in _EVENT_QUANTITIES for red in EVENT_REDUCTIONS)
+    return events + _REVOLUTION_SCALARS + tuple(FILM_KEYS)
+
+
 def revolution_statistics(
     hist: dict, edges, rho_lim: float, kinematic_speed: float, threshold: float = 1.0
 ) -> dict[str, np.ndarray]:
@@ -127,20 +149,7 @@ def revolution_statistics(
                 if v.size:
                     vals[i] = fn(v)
             out[f"{key}.{red}"] = vals
-    for name in (
-        "cage_speed_rpm",
-        "cage_slip",
-        "roller_skew_rad.mean_abs",
-        "roller_skew_rad.max_abs",
-        "corner_contact_share.time",
-        "corner_contact_share.events",
-        "contact_radius_m.p99",
-        "contact_radius_m.max_in_contact",
-        "flange_contact_events_per_rev",
-        "flange_pv_contact_time_Pa_m_s.mean",
-        "flange_pv_contact_time_Pa_m_s.p95",
-        *FILM_KEYS,
-    ):
+    for name in (*_REVOLUTION_SCALARS, *FILM_KEYS):
         out[name] = np.full(nrev, np.nan)
     kin_rpm = float(rad_s_to_rpm(kinematic_speed))
     for i in range(nrev):
@@ -201,12 +210,24 @@ def confidence_intervals(per_revolution: list[dict[str, np.ndarray]]) -> tuple[d
     return out, method
 
 
-def steady_statistics(windows: list[dict], edges: list, bearing, op, threshold: float = 1.0) -> dict:
-    """The statistics block of a settled run: `windows` are the measurement-window histories of
-    each seed, `edges` their revolution boundaries [s]."""
+def window_statistics(window: dict, edges, bearing, op, threshold: float = 1.0) -> dict[str, np.ndarray]:
+    """`revolution_statistics` of one seed's measurement window `window` with revolution
+    boundaries `edges` [s], for `bearing` at `op`."""
     rho_lim = float(limited_circle_radius(bearing.roller))
     kin = float(kinematic_cage_speed(bearing, op))
-    per_rev = [revolution_statistics(h, e, rho_lim, kin, threshold) for h, e in zip(windows, edges)]
+    return revolution_statistics(window, edges, rho_lim, kin, threshold)
+
+
+def steady_statistics(
+    windows: list[dict], edges: list, bearing, op, threshold: float = 1.0, per_revolution=None
+) -> dict:
+    """The statistics block of a settled run: `windows` are the measurement-window histories of
+    each seed, `edges` their revolution boundaries [s]; or, instead, `per_revolution`: each
+    seed's `window_statistics`, computed as the seed finished."""
+    rho_lim = float(limited_circle_radius(bearing.roller))
+    kin = float(kinematic_cage_speed(bearing, op))
+    per_rev = list(per_revolution) if per_revolution is not None else []
+    per_rev += [revolution_statistics(h, e, rho_lim, kin, threshold) for h, e in zip(windows, edges)]
     est, method = confidence_intervals(per_rev)
     block = _nest(est)
     block["ci_method"] = method

@@ -20,6 +20,7 @@ from ._spec import (
     _STATIC_KEYS,
     _SWEEP_FIELDS,
     MAX_CASES,
+    SETTLED_DEFAULTS,
     Axis,
     SweepSpec,
     SweepSpecError,
@@ -136,9 +137,55 @@ def build_spec(data: Mapping[str, Any], base_dir: str | os.PathLike | None = Non
         batch_size=_positive_int("sweep.batch_size", sweep.get("batch_size", 8), MAX_CASES),
         num_saves=_positive_int("sweep.num_saves", sweep.get("num_saves", 400)),
         max_positions=_positive_int("sweep.max_positions", sweep.get("max_positions", 500)),
+        **_settled_fields(sweep),
     )
     validate_cases(spec)
     return spec
+
+
+def _settled_fields(sweep: Mapping[str, Any]) -> dict[str, Any]:
+    """The settled-running fields of [sweep] (`SETTLED_DEFAULTS`), checked as `jaxbearing
+    simulate` checks its options: a bad value is one line naming the key."""
+    from ..run import check_steady_options
+
+    got = {k: sweep.get(k, v) for k, v in SETTLED_DEFAULTS.items()}
+    for key, value in got.items():
+        kinds = {"settle": (str, numbers.Real), "start": (str,)}.get(key, (numbers.Real,))
+        if isinstance(value, bool) or not isinstance(value, kinds):
+            raise SweepSpecError(f"sweep.{key}", f"{format_value(value)} is not a valid value")
+    settle = got["settle"]
+    if isinstance(settle, str) and settle not in ("auto", "off"):
+        raise SweepSpecError(
+            "sweep.settle", f'{format_value(settle)} must be "auto", "off" or a settling time >= 0 ms'
+        )
+    check_steady_options(
+        settle,
+        got["window_revs"],
+        got["seeds"],
+        got["settle_tolerance"],
+        got["settle_cap_ms"],
+        {k: f"sweep.{v}" for k, v in _STEADY_NAMES.items()},
+        start=got["start"],
+    )
+    return {
+        "settle": settle if isinstance(settle, str) else float(settle),
+        "seeds": int(got["seeds"]),
+        "window_revs": int(got["window_revs"]),
+        "settle_tolerance": float(got["settle_tolerance"]),
+        "settle_cap_ms": float(got["settle_cap_ms"]),
+        "start": got["start"],
+    }
+
+
+#: `check_steady_options`' names of the [sweep] fields
+_STEADY_NAMES = {
+    "settle": "settle",
+    "window_revs": "window_revs",
+    "seeds": "seeds",
+    "tolerance": "settle_tolerance",
+    "cap_ms": "settle_cap_ms",
+    "start": "start",
+}
 
 
 def _sweep_table(sweep) -> Mapping[str, Any]:

@@ -19,6 +19,26 @@ A sweep spec (TOML) names a base configuration and the axes to vary, in engineer
     "roller.end_radius_mm" = { start = 60, stop = 120, num = 4 }   # inclusive linspace
     end = ["arc", "corner"]   # special axis: corner = Bearing.with_flat_ends()
 
+Settled running (the default): every case settles and is measured over a window of whole cage
+revolutions, for `seeds` seeded initial scatters, as members of the steady-running engine
+(`jaxbearing.run.settle_members`; the options of `jaxbearing simulate`):
+
+    [sweep]
+    settle = "auto"           # "auto" (default: until the settling verdict), a settling time
+                              # in ms, or "off": a start-up transient of simulation.duration_ms
+    seeds = 2                 # seeded initial scatters per case (default 1)
+    window_revs = 8           # cage revolutions measured after settling (default 8)
+    settle_tolerance = 1e-3   # relative remaining drift of the cage speed (default 1e-3)
+    settle_cap_ms = 300       # settling gives up here (reported, not settled; default 300)
+    start = "skid"            # "skid" (default) or "quasi-static"
+
+The dataset then holds, for every statistic, its value and 95 % interval (`NAME`,
+`NAME_ci95_low`, `NAME_ci95_high`: batch means over revolutions for one seed, Student-t over
+the seeds for several), and per case `settled`, `settle_time_ms`, `window_ms`, `seeds` and the
+residual drift. With `settle = "off"` the cases are start-up transients of
+`simulation.duration_ms` from the quasi-static start (one `vmap(solve)` per batch, below), and
+the dataset and its figures say so (attribute `running` = "start-up transient").
+
 Every axis key is a dotted configuration key (`jaxbearing config show`) or `end`. Every case is
 built through `Config.replace`, i.e. re-validated, before anything is computed; a bad spec
 raises `SweepSpecError` (a `UserInputError`: one line naming the axis). Keys that change array
@@ -63,8 +83,8 @@ import numpy as np
 from .._errors import UserInputError
 from ..io import Config, format_value
 
-#: format version of the batch files and the dataset
-FORMAT_VERSION = 1
+#: format version of the batch files and the dataset (2: settled running and its options)
+FORMAT_VERSION = 2
 #: spec keys that cannot be axes, and why
 _STATIC_KEYS = {
     "bearing.num_rollers": "it changes array shapes (static); run one sweep per value",
@@ -74,7 +94,29 @@ _STATIC_KEYS = {
     "simulation.progress": "progress is not a model parameter",
     "simulation.end": 'use the special axis "end" = ["arc", "corner"]',
 }
-_SWEEP_FIELDS = ("base", "mode", "zip", "batch_size", "num_saves", "max_positions")
+_SWEEP_FIELDS = (
+    "base",
+    "mode",
+    "zip",
+    "batch_size",
+    "num_saves",
+    "max_positions",
+    "settle",
+    "seeds",
+    "window_revs",
+    "settle_tolerance",
+    "settle_cap_ms",
+    "start",
+)
+#: the settled-running fields of [sweep] and their defaults (those of `jaxbearing simulate`)
+SETTLED_DEFAULTS = {
+    "settle": "auto",
+    "seeds": 1,
+    "window_revs": 8,
+    "settle_tolerance": 1e-3,
+    "settle_cap_ms": 300.0,
+    "start": "skid",
+}
 _RANGE_FIELDS = ("start", "stop", "num")
 
 
@@ -113,6 +155,23 @@ class SweepSpec:
     batch_size: int = 8
     num_saves: int = 400
     max_positions: int = 500
+    #: settled running (`SETTLED_DEFAULTS`; module docstring)
+    settle: object = "auto"
+    seeds: int = 1
+    window_revs: int = 8
+    settle_tolerance: float = 1e-3
+    settle_cap_ms: float = 300.0
+    start: str = "skid"
+
+    @property
+    def settled(self) -> bool:
+        """Whether the cases are settled running (else start-up transients)."""
+        return self.settle != "off"
+
+    @property
+    def running(self) -> str:
+        """What the statistics describe: "settled running" or "start-up transient"."""
+        return "settled running" if self.settled else "start-up transient"
 
     @property
     def num_cases(self) -> int:
@@ -150,6 +209,7 @@ class SweepSpec:
             "batch_size": self.batch_size,
             "num_saves": self.num_saves,
             "max_positions": self.max_positions,
+            **{k: getattr(self, k) for k in SETTLED_DEFAULTS},
         }
 
     @functools.cached_property
@@ -174,6 +234,7 @@ class SweepSpec:
             data["batch_size"],
             data["num_saves"],
             data["max_positions"],
+            **{k: data[k] for k in SETTLED_DEFAULTS},
         )
 
     def with_batch_size(self, batch_size: int) -> SweepSpec:
