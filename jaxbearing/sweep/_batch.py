@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 from collections.abc import Sequence
 from typing import Any
@@ -49,9 +50,37 @@ _ZONE_FIELDS = (
 CONTACT_THRESHOLD = 1.0
 
 
-def variable_names() -> tuple[str, ...]:
+#: per-case float variables of a settled sweep besides the statistics and their intervals
+SETTLED_SCALARS = (
+    "kinematic_cage_speed_rpm",
+    "settled",
+    "settle_time_ms",
+    "window_ms",
+    "seeds",
+    "residual_drift_rpm",
+    "residual_drift_bound_rpm",
+    "num_steps",
+)
+#: the interval variables of a statistic NAME: NAME_ci95_low, NAME_ci95_high
+CI_SUFFIXES = ("_ci95_low", "_ci95_high")
+
+
+def statistic_names() -> tuple[str, ...]:
+    """The settled statistics' dataset names: `run.revolution_statistic_keys` with "." -> "_"
+    ("flange_pv_Pa_m_s.max" -> "flange_pv_Pa_m_s_max": the expected largest PV of a cage
+    revolution)."""
+    from ..run import revolution_statistic_keys
+
+    return tuple(k.replace(".", "_") for k in revolution_statistic_keys())
+
+
+def variable_names(spec: SweepSpec | None = None) -> tuple[str, ...]:
     """Names of the per-case float variables of the dataset (besides status, result_code,
-    contact positions and the design zone)."""
+    contact positions and the design zone): of a start-up transient sweep, or (`spec.settled`)
+    of a settled one, every statistic with its interval."""
+    if spec is not None and spec.settled:
+        stats = statistic_names()
+        return SETTLED_SCALARS + stats + tuple(n + c for n in stats for c in CI_SUFFIXES)
     return _SCALARS + tuple(f"{q}_{s}" for q in _EVENT_STATS for s in _STATS)
 
 
@@ -134,8 +163,12 @@ def padded_size(batch_size: int, num_devices: int) -> int:
 
 
 def solve_batch(spec: SweepSpec, cases: Sequence[int], devices: Sequence | None = None) -> dict:
-    """Solve the cases `cases` as one sharded, vmapped batch; per-case summaries (numpy)."""
+    """Solve the cases `cases`: settled (`settle_batch`) or, with `settle = "off"`, as one
+    sharded, vmapped batch of start-up transients; per-case summaries (numpy)."""
     import jax
+
+    if spec.settled:
+        return settle_batch(spec, cases, devices)
 
     devices = tuple(jax.local_devices() if devices is None else devices)
     size = padded_size(spec.batch_size, len(devices))
@@ -188,4 +221,140 @@ def _summarise_case(spec: SweepSpec, sol, inputs) -> dict:
         points[:count] = pos
     row["contact_position"] = points
     row["contact_position_count"] = np.int32(count)
+    return row
+
+
+# -- settled running -----------------------------------------------------------------------------
+def _positions(window: dict, max_positions: int) -> np.ndarray:
+    """Up to `max_positions` flange contact points on the end face (roller frame y, z [m]),
+    evenly subsampled over the window's contact samples."""
+    if not window or not len(window.get("t", ())):
+        return np.zeros((0, 2))
+    mask = np.asarray(window["flange_force"]) > CONTACT_THRESHOLD  # (T, Z, 4)
+    pos = np.asarray(window["end_face_position"])[mask]
+    if len(pos) > max_positions:
+        pos = pos[np.linspace(0, len(pos) - 1, max_positions).round().astype(int)]
+    return pos
+
+
+@dataclasses.dataclass(frozen=True)
+class _SweepReduce:
+    """What a sweep keeps of a member's settled run (picklable reducer of
+    `run.settle_members`): its `window_statistics` and a sample of contact positions; the
+    window's histories and states are dropped."""
+
+    max_positions: int
+
+    def __call__(self, run, member):
+        from ..run import window_statistics
+
+        if run.status == "ok" and run.window:
+            per_rev = window_statistics(
+                run.window, run.edges, member.bearing, member.operating, CONTACT_THRESHOLD
+            )
+            extras = {"positions": _positions(run.window, self.max_positions)}
+        else:
+            per_rev, extras = None, {"positions": np.zeros((0, 2))}
+        return dataclasses.replace(
+            run, window={}, per_revolution=per_rev, extras=extras, window_start_state=None, final_state=None
+        )
+
+
+def case_members(spec: SweepSpec, case: int) -> list:
+    """The members of case number `case` (`run.Member`): one per seed, with the case's
+    tolerances."""
+    from ..run import Member, Perturbation
+
+    cfg, end = spec.case_config(case)
+    bearing = cfg.bearing()
+    if end == "corner":
+        bearing = bearing.with_flat_ends()
+    op, sim = cfg.operating_point(), cfg.simulation
+    return [
+        Member(bearing, op, Perturbation(seed=k), rtol=sim.rtol, atol=sim.atol) for k in range(spec.seeds)
+    ]
+
+
+def steady_options(spec: SweepSpec):
+    """The `run.SteadyOptions` of a settled sweep."""
+    from ..run import SteadyOptions
+
+    return SteadyOptions(
+        settle=spec.settle,
+        window_revs=spec.window_revs,
+        tolerance=spec.settle_tolerance,
+        settle_cap_ms=spec.settle_cap_ms,
+        start=spec.start,
+        max_steps=spec.base.simulation.max_steps,
+    )
+
+
+def settle_batch(spec: SweepSpec, cases: Sequence[int], devices: Sequence | None = None) -> dict:
+    """Settle and measure the cases `cases` (every seed of each a member of one call of the
+    steady-running engine, `run.settle_members`: vmapped over `devices` on an accelerator, one
+    member after another on a CPU); per-case rows of statistics with their 95 % intervals."""
+    from ..run import settle_members
+
+    members = [m for c in cases for m in case_members(spec, int(c))]
+    engine = settle_members(
+        members, steady_options(spec), devices=devices, reduce=_SweepReduce(spec.max_positions)
+    )
+    rows = []
+    for k, case in enumerate(cases):
+        runs = engine.runs[k * spec.seeds : (k + 1) * spec.seeds]
+        rows.append(_settled_row(spec, runs, members[k * spec.seeds]))
+    out = {"case_index": np.asarray(cases, dtype=np.int64)}
+    for key in rows[0]:
+        out[key] = np.stack([r[key] for r in rows])
+    return out
+
+
+def _settled_row(spec: SweepSpec, runs, member) -> dict:
+    from ..run import SteadyResult, summarise_steady
+
+    result = SteadyResult(
+        runs=list(runs),
+        settle=spec.settle,
+        window_revs=spec.window_revs,
+        tolerance=spec.settle_tolerance,
+        cap=spec.settle_cap_ms * 1e-3,
+        start=spec.start,
+        wall_time_s=float("nan"),
+        compile_time_s=float("nan"),
+        bearing=member.bearing,
+        operating=member.operating,
+    )
+    block = summarise_steady(result, threshold=CONTACT_THRESHOLD)
+
+    def num(v):
+        return np.float64(np.nan if v is None else v)
+
+    row: dict[str, Any] = {
+        "kinematic_cage_speed_rpm": num(block["kinematic_cage_speed_rpm"]),
+        "settled": np.float64(block["settled"]),
+        "settle_time_ms": num(block["settle_time_ms"]),
+        "window_ms": num(block["window_ms"]),
+        "seeds": np.float64(len(runs)),
+        "residual_drift_rpm": num(block.get("residual_drift_rpm")),
+        "residual_drift_bound_rpm": num(block.get("residual_drift_bound_rpm")),
+        "num_steps": np.float64(block["num_steps"]),
+    }
+    from ..run import revolution_statistic_keys
+
+    for key in revolution_statistic_keys():
+        group, _, red = key.partition(".")
+        est = (block.get(group, {}).get(red) if red else block.get(group)) or {}
+        name = key.replace(".", "_")
+        row[name] = num(est.get("value"))
+        row[name + "_ci95_low"] = num(est.get("ci95_low"))
+        row[name + "_ci95_high"] = num(est.get("ci95_high"))
+    row["status"] = np.asarray(block["status"])
+    row["result_code"] = np.int32(0 if block["status"] == "ok" else 1)
+    points = np.full((spec.max_positions, 2), np.nan)
+    pos = np.concatenate([r.extras.get("positions", np.zeros((0, 2))) for r in runs])
+    if len(pos) > spec.max_positions:
+        pos = pos[np.linspace(0, len(pos) - 1, spec.max_positions).round().astype(int)]
+    points[: len(pos)] = pos
+    row["contact_position"] = points
+    row["contact_position_count"] = np.int32(len(pos))
     return row

@@ -12,7 +12,7 @@ import numpy as np
 
 from .._errors import UserInputError
 from ..io import KEY_BY_PATH, atomic_write, optional_import
-from ._batch import _ZONE_FIELDS, case_inputs, variable_names
+from ._batch import _ZONE_FIELDS, CI_SUFFIXES, SETTLED_SCALARS, case_inputs, variable_names
 from ._spec import SweepSpec
 from ._storage import batch_path, load_spec_from_dir, read_batch
 
@@ -44,14 +44,17 @@ def _zone_batch(stacked):
 
 
 def _unit(name: str) -> str:
-    """The unit of a dataset variable from its name (a statistic's suffix `_max`... dropped)."""
+    """The unit of a dataset variable from its name (an interval's and a statistic's suffixes,
+    `_ci95_low`, `_max`, ..., dropped)."""
     from ..io import unit_of
 
-    for stat in ("_max", "_mean", "_median", "_min"):
-        if name.endswith(stat):
-            name = name.removesuffix(stat)
-            break
-    return unit_of(name)
+    for suffix in CI_SUFFIXES:
+        name = name.removesuffix(suffix)
+    while True:  # drop reductions ("_max", "_p95", "_mean_abs", ...) until a unit shows
+        unit = unit_of(name)
+        if unit != "1" or "_" not in name:
+            return unit
+        name = name.rpartition("_")[0]
 
 
 def provenance_attrs(spec: SweepSpec) -> dict:
@@ -69,6 +72,21 @@ def provenance_attrs(spec: SweepSpec) -> dict:
         "seeds": json.dumps(meta["seeds"]),
         "units_convention": "every variable and coordinate has a 'units' attribute ('1': dimensionless)",
     }
+
+
+def _description(spec: SweepSpec, name: str) -> str:
+    """The dataset's description of variable `name`."""
+    if not spec.settled:
+        return f"summarise()['{name}'] of the case, over its start-up transient"
+    for suffix, side in (("_ci95_low", "lower"), ("_ci95_high", "upper")):
+        if name.endswith(suffix):
+            return f"{side} bound of the 95 % confidence interval of {name[: -len(suffix)]}"
+    if name in SETTLED_SCALARS:
+        return f"summarise_steady()['{name}'] of the case (settled running)"
+    return (
+        f"{name}: settled running, per cage revolution, mean over the window "
+        f"({spec.seeds} seed(s); interval: {name}_ci95_low/_ci95_high)"
+    )
 
 
 def assemble(out_dir: str | os.PathLike, spec: SweepSpec | None = None):
@@ -90,9 +108,8 @@ def assemble(out_dir: str | os.PathLike, spec: SweepSpec | None = None):
     shape = spec.shape
     dims = spec.dims
     data_vars: dict[str, Any] = {}
-    for name in variable_names():
-        attrs = {"description": f"summarise()['{name}'] of the case"}
-        data_vars[name] = (dims, cols[name].reshape(shape), attrs)
+    for name in variable_names(spec):
+        data_vars[name] = (dims, cols[name].reshape(shape), {"description": _description(spec, name)})
     data_vars["status"] = (
         dims,
         cols["status"].astype(str).reshape(shape),
@@ -140,7 +157,11 @@ def assemble(out_dir: str | os.PathLike, spec: SweepSpec | None = None):
         spec_hash=spec.hash,
         spec=json.dumps(spec.canonical(), allow_nan=True),
         base_end=spec.base.simulation.end,
-        duration_ms=spec.base.simulation.duration_ms,
+        running=spec.running,
+        settle=str(spec.settle),
+        seeds=spec.seeds,
+        window_revs=spec.window_revs,
+        duration_ms=spec.base.simulation.duration_ms if not spec.settled else np.nan,
         num_saves=spec.num_saves,
         source="jaxbearing sweep",
     )

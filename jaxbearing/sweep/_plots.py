@@ -3,6 +3,8 @@
 * Figures 9-11 of the paper: peak pressure, sliding velocity and PV of the roller-end/flange
   contact versus inner-ring speed, arc and corner ends (needs the axis operating.speed_rpm; the
   `end` axis gives one line per end type). Solid: maximum over contact events; dashed: mean.
+  Of a settled sweep these are the expected largest and mean of a cage revolution, with their
+  95 % intervals as error bars; a start-up transient sweep's figures say so in their title.
 * Figure 12: sliding velocity and PV versus the end radius R_end (roller.end_radius_mm) and
   versus the flange layback angle theta_f (flange.layback_angle_deg), arc ends.
 * Figure 13: contact positions on the roller end face (roller frame, y along the radial
@@ -85,16 +87,33 @@ def _line_figure(ds, key: str, panels, title: str, path: pathlib.Path, arc_only:
             order = np.argsort(part[name].values)
             x = part[name].values[order]
             for stat, style in (("max", "-o"), ("mean", "--s")):
-                y = part[f"{stem}_{stat}"].values[order] * k
-                ax.plot(x, y, style, label=f"{end} {stat}", ms=4)
+                var = f"{stem}_{stat}"
+                y = part[var].values[order] * k
+                if f"{var}_ci95_low" in part:  # settled running: the 95 % intervals
+                    low = part[f"{var}_ci95_low"].values[order] * k
+                    high = part[f"{var}_ci95_high"].values[order] * k
+                    err = np.vstack([np.abs(y - low), np.abs(high - y)])
+                    ax.errorbar(x, y, yerr=err, fmt=style, label=f"{end} {stat}", ms=4, capsize=3)
+                else:
+                    ax.plot(x, y, style, label=f"{end} {stat}", ms=4)
         ax.set_xlabel(_AXIS_LABEL.get(key, name))
         ax.set_ylabel(label)
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
-    fig.suptitle(title + (f"\n({note})" if note else ""), fontsize=10)
+    fig.suptitle(f"{title}, {running_label(ds)}" + (f"\n({note})" if note else ""), fontsize=10)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
+
+
+def running_label(ds) -> str:
+    """What a sweep's statistics describe, as the figures say it: settled running with its
+    intervals, or a start-up transient (also for datasets written before settled sweeps)."""
+    if ds.attrs.get("running") == "settled running":
+        n = int(ds.attrs.get("seeds", 1))
+        how = f"{n} seeds" if n > 1 else "batch means over revolutions"
+        return f"settled running, per cage revolution; bars: 95 % CI ({how})"
+    return "START-UP TRANSIENT (not settled running)"
 
 
 def _base_value(ds, path: str) -> float:
@@ -139,7 +158,8 @@ def _positions_figure(ds, key: str, path: pathlib.Path, max_panels: int = 6):
         ax.set_ylabel("z [mm]")
     axes[0][0].legend(fontsize=7, loc="lower left")
     fig.suptitle(
-        "Contact positions on the roller end face (cf. paper Fig. 13)" + (f"\n({note})" if note else ""),
+        f"Contact positions on the roller end face (cf. paper Fig. 13), {running_label(ds).split(';')[0]}"
+        + (f"\n({note})" if note else ""),
         fontsize=10,
     )
     fig.tight_layout()
