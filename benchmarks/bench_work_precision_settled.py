@@ -280,9 +280,8 @@ def window_solve(
     import diffrax
     import jax.numpy as jnp
 
-    from jaxbearing.run import prepare_from, result_code
-    from jaxbearing.run._compile_cache import checks_without_host_callbacks
-    from jaxbearing.run._simulate import _histories, _saved_state, scaled_diffeqsolve
+    from jaxbearing.run import checks_without_host_callbacks, prepare_from, result_code, scaled_diffeqsolve
+    from jaxbearing.run._simulate import _histories, _saved_state
     from jaxbearing.run._step_control import raceway_normal_norm, step_controller
 
     _, args, y0_scaled, _ = prepare_from(params, start, rtol, atol)

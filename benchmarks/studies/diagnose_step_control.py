@@ -67,9 +67,7 @@ def step_counts(params, start, rtol, loosened: dict, norm: str = "max"):
     norm `norm` (static). jit-able."""
     import diffrax
 
-    from jaxbearing.run import prepare_from, result_code
-    from jaxbearing.run._compile_cache import checks_without_host_callbacks
-    from jaxbearing.run._simulate import scaled_diffeqsolve
+    from jaxbearing.run import checks_without_host_callbacks, prepare_from, result_code, scaled_diffeqsolve
     from jaxbearing.run._step_control import RacewayNormalNorm, step_controller
 
     _, args, y0, _ = prepare_from(params, start, rtol, 1e-6)
