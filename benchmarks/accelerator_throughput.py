@@ -28,7 +28,7 @@ Two parts (`--part sweep`, `--part ensemble`, or both):
    the host CPU for the throughput ratio.
 
 3. **Steady gradient samples** (`--part gradient`). The short-window gradient estimator
-   (`jaxbearing.run.steady_gradient`, `optimise --estimator window`; the search's default is the
+   (`jaxbearing.design.steady_gradient`, `optimise --estimator window`; the search's default is the
    frozen-load estimator, which does not differentiate the trajectory) integrates, from each settled state, a short window
    (`GRADIENT_WINDOW`, 1 ms) with three forward-mode tangents in (R_end, theta_f, Delta_bf)
    (`window_integrals` under `forward_jacobian`, as its per-sample program does), one process
@@ -298,9 +298,9 @@ def gradient_part(members: int) -> dict:
     import numpy as np
 
     import jaxbearing as jb
+    from jaxbearing.design import GRADIENT_WINDOW, forward_jacobian
+    from jaxbearing.design._steady_gradient import _combine, window_integrals
     from jaxbearing.flange import DesignVariables
-    from jaxbearing.run import GRADIENT_WINDOW, forward_jacobian
-    from jaxbearing.run._steady_gradient import _combine, window_integrals
 
     gpu, cpu = accelerator(), jax.devices("cpu")[0]
     bearing, op = jb.reference_bearing(), jb.reference_operating_point()

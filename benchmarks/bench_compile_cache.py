@@ -64,8 +64,8 @@ def _program_gradient() -> float:
     import jax
 
     import jaxbearing as jb
+    from jaxbearing.design import GRADIENT_ATOL, GRADIENT_HORIZON, GRADIENT_RTOL, design_jacobian
     from jaxbearing.flange import DesignVariables
-    from jaxbearing.run import GRADIENT_ATOL, GRADIENT_HORIZON, GRADIENT_RTOL, design_jacobian
 
     bearing, op = jb.reference_bearing(), jb.reference_operating_point()
     design = DesignVariables.of(bearing)

@@ -9,7 +9,7 @@ respect to the three design variables (R_end, theta_f, Delta_bf) on the referenc
 
 each timed relative to one forward solve (compile excluded; compile times reported separately),
 and their agreement (relative to the largest entry). Same horizon and tolerances as the
-acceptance test (`jaxbearing.run.GRADIENT_HORIZON`, `GRADIENT_RTOL`, `GRADIENT_ATOL`).
+acceptance test (`jaxbearing.design.GRADIENT_HORIZON`, `GRADIENT_RTOL`, `GRADIENT_ATOL`).
 
 Writes benchmarks/results/gradients.json and prints a table. Timings: the four methods are run
 round-robin (2 repeats with quick=True, 5 otherwise) and the minimum of each is reported (the
@@ -65,14 +65,9 @@ def main(quick: bool = True, atol: float | None = None) -> dict:
     import jax.numpy as jnp
 
     import jaxbearing as jb
+    from jaxbearing.design import GRADIENT_ATOL, GRADIENT_HORIZON, GRADIENT_RTOL, seated_perturbation
     from jaxbearing.flange import DesignVariables
-    from jaxbearing.run import (
-        GRADIENT_ATOL,
-        GRADIENT_HORIZON,
-        GRADIENT_RTOL,
-        flange_functionals,
-        seated_perturbation,
-    )
+    from jaxbearing.run import flange_functionals
 
     repeats = 2 if quick else 5
     bearing = jb.reference_bearing()

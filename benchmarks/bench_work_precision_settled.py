@@ -280,9 +280,8 @@ def window_solve(
     import diffrax
     import jax.numpy as jnp
 
-    from jaxbearing.run import prepare_from, result_code
-    from jaxbearing.run._compile_cache import checks_without_host_callbacks
-    from jaxbearing.run._simulate import _diffeqsolve, _histories, _saved_state
+    from jaxbearing.run import checks_without_host_callbacks, prepare_from, result_code, scaled_diffeqsolve
+    from jaxbearing.run._simulate import _histories, _saved_state
     from jaxbearing.run._step_control import raceway_normal_norm, step_controller
 
     _, args, y0_scaled, _ = prepare_from(params, start, rtol, atol)
@@ -299,7 +298,7 @@ def window_solve(
     # as the library saves (`solve_from`): the states in the loop, the samples after it
     saveat = diffrax.SaveAt(ts=jnp.linspace(0.0, duration, num_saves), fn=_saved_state)
     with checks_without_host_callbacks():
-        sol = _diffeqsolve(
+        sol = scaled_diffeqsolve(
             y0_scaled, args, duration, saveat, controller, MAX_STEPS, None, False, "tsit5", flat=flat
         )
     hist = {k: v for k, v in _histories(sol.ts, sol.ys, args).items() if k in SAVED}

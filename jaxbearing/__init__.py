@@ -7,7 +7,8 @@ Layers (imports point down only; `docs/architecture.md`):
 
     cli       the `jaxbearing` command line, one module per command
     sweep     sweep specs, batched and sharded execution, storage, dataset, plots
-    run       solve / simulate, statistics, design metrics through the dynamics
+    design    design metrics and their gradients through the dynamics, steady-running objective
+    run       solve / simulate, statistics, settled running, ensembles, plots
     dynamics  state layout, rigid bodies, the vector field, the quasi-static start
     flange    the roller-end/flange model: contact, static design zone, design variables
     forces    the other body pairs: raceway, pocket, cage lands, drag
@@ -24,6 +25,13 @@ import jax
 jax.config.update("jax_enable_x64", True)
 
 from ._errors import ConfigError, UserInputError  # noqa: E402
+from .design import (  # noqa: E402
+    DesignMetrics,
+    design_jacobian,
+    design_metrics,
+    seated_perturbation,
+    steady_design_metrics,
+)
 from .dynamics import Functionals, QuasiStatic, quasi_static  # noqa: E402
 from .flange import (  # noqa: E402
     DesignVariables,
@@ -56,21 +64,16 @@ from .io import (  # noqa: E402
     validate_bearing,
 )
 from .run import (  # noqa: E402
-    DesignMetrics,
     Perturbation,
     SimulationResult,
     Solution,
     SteadyResult,
     contact_events,
-    design_jacobian,
-    design_metrics,
     enable_compilation_cache,
     flange_functionals,
-    seated_perturbation,
     simulate,
     simulate_steady,
     solve,
-    steady_design_metrics,
     summarise,
     summarise_steady,
 )

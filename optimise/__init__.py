@@ -5,7 +5,7 @@ layback angle theta_f and the axial clearance Delta_bf, inside the design zone (
 limit, limited circle, actual axial clearance), robustly over an envelope of speeds and loads.
 The search is a multi-start projected augmented Lagrangian driven by optax (`_search`); the
 objective's gradients come from forward-mode differentiation through the diffrax solve
-(`jaxbearing.run.design_metrics`). Command line: `optimise run --help`.
+(`jaxbearing.design.design_metrics`). Command line: `optimise run --help`.
 """
 
 import jaxbearing  # noqa: F401  (enables 64-bit floats)

@@ -12,7 +12,7 @@ temperature T: J = T log sum_k w_k exp(PV_k / T), w_k normalised; J -> max_k PV_
 
 Horizon (a limitation, measured). The dynamic objective is evaluated over a short horizon
 (`DEFAULT_DURATION`, 0.3 ms from the seated start), because gradients through longer runs pass
-through roller-flange impacts and stop being reliable (`jaxbearing.run.design_metrics`: central
+through roller-flange impacts and stop being reliable (`jaxbearing.design.design_metrics`: central
 differences no longer converge). Over so short a horizon the peak PV measures how hard the
 seated rollers are driven onto their flanges in the first 0.3 ms: about 2 GPa m/s at the
 reference design (R_end 80 mm, theta_f 1.6 deg), but almost zero (1e-7 GPa m/s) for designs such
@@ -43,6 +43,7 @@ import numpy as np
 from jaxtyping import Array, Float
 
 from jaxbearing import Bearing, OperatingPoint, Perturbation, UserInputError, rpm_to_rad_s
+from jaxbearing.design import design_metrics, seated_perturbation
 from jaxbearing.flange import (
     DEFAULT_FLANGE_LOAD,
     DesignVariables,
@@ -50,7 +51,6 @@ from jaxbearing.flange import (
     zone_margins,
 )
 from jaxbearing.io import check_model_inputs, check_solver_arguments, is_concrete, require
-from jaxbearing.run import design_metrics, seated_perturbation
 
 MM = 1e-3
 DEG = math.pi / 180

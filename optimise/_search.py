@@ -22,7 +22,7 @@ Why this method:
   rho, so the limit point does not sit outside the zone by O(1/rho); the small remaining
   violation is absorbed by tightening the constraints (`DesignProblem.tighten`);
 - the constraints are cheap and static, the objective is one dynamic solve per operating point
-  with forward-mode gradients (`jaxbearing.run.design_metrics`: faster than checkpointed reverse mode for
+  with forward-mode gradients (`jaxbearing.design.design_metrics`: faster than checkpointed reverse mode for
   three variables), so every iteration costs one vmapped batch of starts x operating points.
 
 The result is the best *feasible* iterate (every untightened margin > 0) over all starts and
@@ -44,8 +44,8 @@ import numpy as np
 import optax
 
 from jaxbearing import UserInputError
+from jaxbearing.design import forward_jacobian
 from jaxbearing.flange import DesignVariables
-from jaxbearing.run import forward_jacobian
 
 from ._problem import DesignProblem, any_feasible, margins_batch
 

@@ -1,18 +1,18 @@
 """Design search on steady running (issue 13): the default objective of `optimise run`.
 
 Objective. For a design x = (R_end, theta_f, Delta_bf), at every operating point k of the
-envelope, the smooth mean flange PV over contact time of settled running (`jaxbearing.run.
+envelope, the smooth mean flange PV over contact time of settled running (`jaxbearing.design.
 steady_design_metrics`: skid start or continuation, settling, a window of `window_revs` cage
 revolutions, `seeds` seeded scatters; Student-t CI over the seeds), combined over the envelope
 as in `DesignProblem.combine` (smooth max or weighted mean), in GPa m/s.
 
 Gradient (`estimator`). "frozen" (default): the frozen-load estimate of
-`jaxbearing.run.frozen_load_gradient`: from the settled states the objective's runs passed
+`jaxbearing.design.frozen_load_gradient`: from the settled states the objective's runs passed
 through (every seed's state at the start of its window and at its end: 2 x seeds samples of the
 invariant measure), plain trajectories of `gradient_window` seconds; at every saved state the
 flange PV is differentiated in the design at the loads the dynamics gave, through the ratio
 estimator. "window": the short-window forward-mode sensitivities of
-`jaxbearing.run.steady_gradient` over `gradient_window` seconds. benchmarks/studies/bench_steady_gradient
+`jaxbearing.design.steady_gradient` over `gradient_window` seconds. benchmarks/studies/bench_steady_gradient
 measures both against common-random-number central differences (docs/how-to/design-search.md; the study in docs/performance-history.md, Design on steady
 running).
 
@@ -59,17 +59,16 @@ import numpy as np
 import optax
 
 from jaxbearing import UserInputError
-from jaxbearing.flange import MARGIN_NAMES, DesignVariables
-from jaxbearing.io import TreeFileError, check_like, load_tree, require, save_tree
-from jaxbearing.run import (
+from jaxbearing.design import (
     CORNER_MARGIN,
     SteadyGradient,
-    available_cpus,
     frozen_load_gradient,
-    shared_workers,
     steady_design_metrics,
     steady_gradient,
 )
+from jaxbearing.flange import MARGIN_NAMES, DesignVariables
+from jaxbearing.io import TreeFileError, check_like, load_tree, require, save_tree
+from jaxbearing.run import available_cpus, shared_workers
 
 from ._problem import MARGIN_SCALE, PV_SCALE, DesignProblem, any_feasible
 from ._search import _Hyper, start_points

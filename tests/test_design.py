@@ -1,4 +1,4 @@
-"""Differentiable design metrics (jaxbearing.run.design_metrics): AD through the diffrax solve against
+"""Differentiable design metrics (jaxbearing.design.design_metrics): AD through the diffrax solve against
 central finite differences (the acceptance check of issue 5), the contact-height sensitivities
 against the closed form of docs/model.md 5, the static margins against `design_zone`, vmapping over
 designs, and the one-line input errors.
@@ -17,8 +17,7 @@ import pytest
 
 import jaxbearing as jb
 from jaxbearing import UserInputError
-from jaxbearing.flange import DesignVariables, zone_margins
-from jaxbearing.run import (
+from jaxbearing.design import (
     GRADIENT_ATOL,
     GRADIENT_HORIZON,
     GRADIENT_RTOL,
@@ -26,6 +25,7 @@ from jaxbearing.run import (
     design_metrics,
     seated_perturbation,
 )
+from jaxbearing.flange import DesignVariables, zone_margins
 
 REF = jb.reference_bearing()
 OP = jb.reference_operating_point()

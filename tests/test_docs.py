@@ -21,7 +21,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 #: the layers with an API page of their own (docs/reference/api/<name>.md)
-LAYERS = ("geometry", "contact", "io", "flange", "forces", "dynamics", "run", "sweep", "cli")
+LAYERS = ("geometry", "contact", "io", "flange", "forces", "dynamics", "run", "design", "sweep", "cli")
 #: top-level folders whose files other files refer to by their path from the repository root
 TOP = ("benchmarks", "docs", "examples", "notebooks", "jaxbearing", "optimise", "tests")
 #: files written by commands, not kept in git (their mention is not a broken reference)

@@ -13,7 +13,19 @@ ROOT = pathlib.Path(__file__).resolve().parents[1]
 PACKAGE = ROOT / "jaxbearing"
 
 #: bottom to top; a module may import its own layer's modules and any layer below
-LAYERS = ["_errors", "contact", "geometry", "io", "flange", "forces", "dynamics", "run", "sweep", "cli"]
+LAYERS = [
+    "_errors",
+    "contact",
+    "geometry",
+    "io",
+    "flange",
+    "forces",
+    "dynamics",
+    "run",
+    "design",
+    "sweep",
+    "cli",
+]
 #: layers of equal rank may not import each other
 RANK = {name: i for i, name in enumerate(LAYERS)}
 RANK["forces"] = RANK["flange"]

@@ -197,8 +197,8 @@ def test_design_jacobian_with_concrete_values_uses_a_stored_program(monkeypatch)
     """Concrete arguments go through `compiled_program` (its values are those of the traced
     path, which tests/test_design.py checks against central differences); under jit they do not."""
     import jaxbearing as jb
+    from jaxbearing.design import _design
     from jaxbearing.flange import DesignVariables
-    from jaxbearing.run import _design
 
     seen = []
 

@@ -412,7 +412,7 @@ def test_the_flat_state_solves_the_same_problem_as_the_pytree():
 
 
 def test_the_library_solve_hands_diffrax_one_vector():
-    """`_diffeqsolve` flattens the state for the explicit solver only (the Rosenbrock-W
+    """`scaled_diffeqsolve` flattens the state for the explicit solver only (the Rosenbrock-W
     solver's blocks are built from the `State`)."""
     import diffrax
 

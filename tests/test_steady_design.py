@@ -31,7 +31,7 @@ def test_steady_design_metrics_report_intervals_and_margins(small):
     rho_lim = m.summary["limited_circle_radius_m"]
     widest = m.summary["contact_radius_m"]["max_in_contact"]["value"]
     assert widest >= m.summary["contact_radius_m"]["p99"]["value"]
-    assert m.corner_margin["value"] == pytest.approx(rho_lim - jb.run.CORNER_MARGIN - widest)
+    assert m.corner_margin["value"] == pytest.approx(rho_lim - jb.design.CORNER_MARGIN - widest)
     assert set(m.static_margins) == set(MARGIN_NAMES)
     assert m.design["axial_clearance_m"] == pytest.approx(0.15e-3)
 

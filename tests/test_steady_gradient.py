@@ -1,4 +1,4 @@
-"""The gradient estimator of the steady objective (issue 13, item 2; run/_steady_gradient.py).
+"""The gradient estimator of the steady objective (issue 13, item 2; design/_steady_gradient.py).
 
 Fast checks at a reduced size (11 slices per raceway): the ratio estimator's derivative and
 its jackknife against closed forms, and the forward-mode short-window sensitivities against
@@ -15,10 +15,11 @@ import numpy as np
 import pytest
 
 import jaxbearing as jb
+from jaxbearing.design import ratio_gradient, steady_gradient, tangent_growth
+from jaxbearing.design._steady_gradient import STEADY_FUNCTIONALS, trajectory_states, window_integrals
 from jaxbearing.dynamics import contact_loads
 from jaxbearing.flange import DesignVariables
-from jaxbearing.run import ratio_gradient, skid_start, steady_gradient, tangent_growth
-from jaxbearing.run._steady_gradient import STEADY_FUNCTIONALS, trajectory_states, window_integrals
+from jaxbearing.run import skid_start
 
 
 def test_ratio_gradient_is_the_quotient_rule():
@@ -38,7 +39,7 @@ def test_ratio_gradient_is_the_quotient_rule():
 
 def test_jackknife_of_a_mean_is_the_standard_error():
     """With c = 1 the ratio is the mean of a, whose jackknife SE is exactly s / sqrt(K)."""
-    from jaxbearing.run._steady_gradient import _jackknife_stderr
+    from jaxbearing.design._steady_gradient import _jackknife_stderr
 
     rng = np.random.default_rng(1)
     a = rng.normal(size=9)
@@ -146,8 +147,8 @@ def test_frozen_load_derivative_matches_central_differences(running):
     """The frozen-load estimator's derivative (jax.jacfwd through the flange geometry and the
     exact-Hertz radii at the loads the dynamics gave) against central differences of the same
     frozen functional on the same saved states (relative steps 1e-6)."""
+    from jaxbearing.design._steady_gradient import frozen_load_integrands
     from jaxbearing.dynamics import Params
-    from jaxbearing.run._steady_gradient import frozen_load_integrands
 
     b, op, states = running
     x = jnp.asarray(DesignVariables.of(b).as_array())
@@ -191,7 +192,7 @@ def test_frozen_load_estimator_agrees_with_crn_differences_on_settled_running():
     frozen load -9.70e10 +- 2.1e9, 21 % apart. The settling times are in ms: 0.005 ms from the
     skid start and 0.0035 ms after the design change, i.e. none to speak of. The full-size
     study is benchmarks/studies/bench_steady_gradient.py."""
-    from jaxbearing.run import frozen_load_gradient, steady_design_metrics
+    from jaxbearing.design import frozen_load_gradient, steady_design_metrics
 
     b = dataclasses.replace(jb.reference_bearing(), num_slices=11)
     op = jb.reference_operating_point()

@@ -34,7 +34,7 @@ WORKERS = 2
 def _timed(problem, u, chain, repeats: int = 2) -> list[dict]:
     import jax.numpy as jnp
 
-    from jaxbearing.run import frozen_load_gradient, steady_design_metrics
+    from jaxbearing.design import frozen_load_gradient, steady_design_metrics
     from optimise._steady import _operating_point
 
     design = problem.design(jnp.asarray(u))

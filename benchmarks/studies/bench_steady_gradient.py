@@ -2,7 +2,7 @@
 differences (issue 13, item 2): ``python benchmarks/studies/bench_steady_gradient.py [--quick]``.
 
 Objective J(d): the smooth mean flange PV over contact time of settled running
-(`jaxbearing.run.steady_design_metrics(...).objective`), reference bearing, 20,000 rpm, 1000 N.
+(`jaxbearing.design.steady_design_metrics(...).objective`), reference bearing, 20,000 rpm, 1000 N.
 
 At three designs (the reference R_end 80 mm / theta_f 1.6 deg; R_end 70 mm / 1.8 deg; R_end
 100 mm / 1.4 deg; Delta_bf 0.15 mm for all):
@@ -161,8 +161,8 @@ def main(
     "full"); `short_windows=False` leaves out the short-window estimators and the tangent growth;
     `into` writes the result under that key of the existing JSON instead of replacing it."""
     import jaxbearing as jb
+    from jaxbearing.design import frozen_load_gradient, steady_gradient, tangent_growth
     from jaxbearing.flange import DesignVariables
-    from jaxbearing.run import frozen_load_gradient, steady_gradient, tangent_growth
 
     bearing, op = jb.reference_bearing(), jb.reference_operating_point()
     seeds = 2 if quick else SEEDS
@@ -312,8 +312,8 @@ def replicate_clearance(first_seed: int = REPLICATE_FIRST_SEED) -> dict:
     ``clearance_replication_seeds_N_M``); N = 0 repeats the first batch's seeds with today's
     code, whose start-up path (skid pre-start) differs from the one the first batch ran."""
     import jaxbearing as jb
+    from jaxbearing.design import frozen_load_gradient
     from jaxbearing.flange import DesignVariables
-    from jaxbearing.run import frozen_load_gradient
 
     if not (STATE_DIR / f"full_{REPLICATE}_axial_clearance_plus.npz").exists():
         raise SystemExit(f"{STATE_DIR}: the first study's runs are missing; run the full study first")

@@ -77,9 +77,10 @@ def main() -> dict:
     from bench_work_precision_settled import settled_start
 
     import jaxbearing as jb
+    from jaxbearing.design import GRADIENT_ATOL, GRADIENT_HORIZON, GRADIENT_RTOL, seated_perturbation
     from jaxbearing.dynamics import Functionals, Params
     from jaxbearing.flange import DesignVariables
-    from jaxbearing.run import GRADIENT_ATOL, GRADIENT_HORIZON, GRADIENT_RTOL, seated_perturbation, solve
+    from jaxbearing.run import solve
     from jaxbearing.run._settle import solve_from
 
     b, op = jb.reference_bearing(), jb.reference_operating_point()

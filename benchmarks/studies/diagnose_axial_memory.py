@@ -107,8 +107,8 @@ def kept_runs() -> dict:
 
 def main() -> dict:
     import jaxbearing as jb
+    from jaxbearing.design import STEADY_FUNCTIONALS
     from jaxbearing.flange import DesignVariables, with_design
-    from jaxbearing.run import STEADY_FUNCTIONALS
 
     t0 = time.perf_counter()
     bearing, op = jb.reference_bearing(), jb.reference_operating_point()

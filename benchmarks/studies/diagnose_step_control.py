@@ -67,9 +67,7 @@ def step_counts(params, start, rtol, loosened: dict, norm: str = "max"):
     norm `norm` (static). jit-able."""
     import diffrax
 
-    from jaxbearing.run import prepare_from, result_code
-    from jaxbearing.run._compile_cache import checks_without_host_callbacks
-    from jaxbearing.run._simulate import _diffeqsolve
+    from jaxbearing.run import checks_without_host_callbacks, prepare_from, result_code, scaled_diffeqsolve
     from jaxbearing.run._step_control import RacewayNormalNorm, step_controller
 
     _, args, y0, _ = prepare_from(params, start, rtol, 1e-6)
@@ -77,7 +75,7 @@ def step_counts(params, start, rtol, loosened: dict, norm: str = "max"):
     controller = step_controller(rtol, 1e-6, RacewayNormalNorm(weights=w, kind=norm))
     saveat = diffrax.SaveAt(t1=True, fn=lambda t, y, a: a.scaling.unscale(t, y).cage.speed)
     with checks_without_host_callbacks():
-        sol = _diffeqsolve(y0, args, DURATION, saveat, controller, 2_000_000, None, False, "tsit5")
+        sol = scaled_diffeqsolve(y0, args, DURATION, saveat, controller, 2_000_000, None, False, "tsit5")
     return result_code(sol.result), sol.stats["num_steps"], sol.stats["num_rejected_steps"]
 
 

@@ -1,4 +1,4 @@
-"""Runs of the model: the solve, the simulation result, statistics, design metrics, plots.
+"""Runs of the model: the solve, the simulation result, statistics, settled running, plots.
 
 - `solve` (pure, jit/vmap/grad-able diffrax integration of the scaled state), `simulate`
   (compiled, with wall times and a `SimulationResult`), `simulation_result`,
@@ -15,14 +15,10 @@
   seeds), `summarise_steady`; the steady-running engine under it, `settle_members` (many
   `Member`s, each a case and a seed, with `SteadyOptions`: one after another, one process per
   core, or vmapped on accelerators, `STRATEGIES`; an `EngineRun`) and `window_statistics`
-  (`revolution_statistic_keys`); `steady_design_metrics` (the steady-running design objective:
-  mean and p95 PV over contact time, corner share and margin, static margins; continuation from
-  given states), `steady_gradient` (its gradient: ensemble of short-window forward-mode
-  sensitivities from settled states), `tangent_growth` (finite-time growth of the tangents),
-  `solve_from` / `prepare_from` (continue from any state), `check_steady_options` and the
+  (`revolution_statistic_keys`); `solve_from` / `prepare_from` (continue from any state),
+  `scaled_diffeqsolve` (diffrax's integration of the scaled state that `solve` and `solve_from`
+  run, for callers that build their own programs around it), `check_steady_options` and the
   defaults `SETTLE_TOLERANCE`, `SETTLE_CAP_MS`;
-- design metrics through the dynamics: `design_metrics`, `design_jacobian`, `DesignMetrics`,
-  `seated_perturbation`, `forward_jacobian`;
 - `plot_run`: the figures of one run;
 - against measurements: `model_cage_speeds` (a settled run at every measured operating point,
   the relative error with its interval) and its figure `plot_measured`;
@@ -30,25 +26,23 @@
   is `TRANSIENT_ERROR_NORM`), `enable_compilation_cache` (JAX's
   persistent cache in a user directory, `$JAXBEARING_CACHE_DIR`; on at import),
   `compiled_program` (a program compiled once per process and traced once per machine:
-  `jax.export` artefacts in `program_cache_dir`),
+  `jax.export` artefacts in `program_cache_dir`; `checks_without_host_callbacks` traces
+  equinox's run-time checks so that such a program can be stored),
   `parallel_map` / `simulate_ensemble` (independent cases, one process per core),
   `as_completed_map` (the same, each result as it finishes: the sweep's batches),
   `shared_workers` (one pool for every `parallel_map` of a block).
 
+Design metrics and gradients through these runs live one layer up, in `jaxbearing.design`.
+
 May import: `jaxbearing._errors`, `contact`, `geometry`, `io`, `flange`, `forces`, `dynamics`.
 """
 
-from ._compile_cache import CACHE_ENV, compiled_program, enable_compilation_cache, program_cache_dir
-from ._design import (
-    GRADIENT_ATOL,
-    GRADIENT_HORIZON,
-    GRADIENT_MODE_NOTE,
-    GRADIENT_RTOL,
-    DesignMetrics,
-    design_jacobian,
-    design_metrics,
-    forward_jacobian,
-    seated_perturbation,
+from ._compile_cache import (
+    CACHE_ENV,
+    checks_without_host_callbacks,
+    compiled_program,
+    enable_compilation_cache,
+    program_cache_dir,
 )
 from ._engine import STRATEGIES
 from ._ensemble import as_completed_map, available_cpus, parallel_map, shared_workers, simulate_ensemble
@@ -82,7 +76,7 @@ from ._settle import (
     summarise,
     summarise_steady,
 )
-from ._simulate import SolveArgs, flange_functionals, scaled_field, solve
+from ._simulate import SolveArgs, flange_functionals, scaled_diffeqsolve, scaled_field, solve
 from ._statistics import (
     Estimate,
     batch_means,
@@ -92,16 +86,6 @@ from ._statistics import (
     steady_statistics,
     student_t_interval,
     window_statistics,
-)
-from ._steady_design import CORNER_MARGIN, SteadyDesignMetrics, steady_design_metrics
-from ._steady_gradient import (
-    GRADIENT_WINDOW,
-    STEADY_FUNCTIONALS,
-    SteadyGradient,
-    frozen_load_gradient,
-    ratio_gradient,
-    steady_gradient,
-    tangent_growth,
 )
 from ._step_control import (
     DEFAULT_ERROR_NORM,
@@ -119,13 +103,6 @@ from ._summary import FILM_KEYS, contact_events, film_statistics
 __all__ = [
     "SETTLE_CAP_MS",
     "SETTLE_TOLERANCE",
-    "GRADIENT_WINDOW",
-    "STEADY_FUNCTIONALS",
-    "SteadyGradient",
-    "frozen_load_gradient",
-    "ratio_gradient",
-    "steady_gradient",
-    "tangent_growth",
     "prepare_from",
     "as_completed_map",
     "available_cpus",
@@ -144,16 +121,12 @@ __all__ = [
     "RacewayNormalNorm",
     "enable_compilation_cache",
     "compiled_program",
+    "checks_without_host_callbacks",
     "program_cache_dir",
     "parallel_map",
     "shared_workers",
     "raceway_normal_norm",
     "simulate_ensemble",
-    "GRADIENT_ATOL",
-    "GRADIENT_HORIZON",
-    "GRADIENT_MODE_NOTE",
-    "GRADIENT_RTOL",
-    "DesignMetrics",
     "Estimate",
     "Perturbation",
     "SeedRun",
@@ -168,10 +141,7 @@ __all__ = [
     "confidence_intervals",
     "contact_events",
     "film_statistics",
-    "design_jacobian",
-    "design_metrics",
     "flange_functionals",
-    "forward_jacobian",
     "initial_state",
     "skid_start",
     "model_cage_speeds",
@@ -180,12 +150,9 @@ __all__ = [
     "result_code",
     "revolution_statistics",
     "scaled_field",
-    "seated_perturbation",
+    "scaled_diffeqsolve",
     "simulate",
     "simulate_steady",
-    "steady_design_metrics",
-    "SteadyDesignMetrics",
-    "CORNER_MARGIN",
     "simulation_result",
     "smooth_functionals",
     "solve",

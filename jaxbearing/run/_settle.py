@@ -67,7 +67,7 @@ from ._initial import (
 )
 from ._result import result_code
 from ._rosenbrock import DEFAULT_SOLVER, check_solver
-from ._simulate import SolveArgs, _diffeqsolve, _histories, _saved_state
+from ._simulate import SolveArgs, _histories, _saved_state, scaled_diffeqsolve
 from ._simulate import simulate as _simulate_fixed
 from ._statistics import steady_statistics
 from ._step_control import raceway_normal_norm, step_controller
@@ -204,7 +204,9 @@ def solve_from(
     else:
         saveat = diffrax.SaveAt(subs=[last])
     with checks_without_host_callbacks():  # the integrator of `solve`, the error norm of `prepare_from`
-        sol = _diffeqsolve(y0_scaled, args, duration, saveat, controller, max_steps, adjoint, False, solver)
+        sol = scaled_diffeqsolve(
+            y0_scaled, args, duration, saveat, controller, max_steps, adjoint, False, solver
+        )
     if num_saves:
         hist, final = _histories(sol.ts[0], sol.ys[0], args), sol.ys[1]
     else:

@@ -178,7 +178,7 @@ def _save_functionals(t, y_scaled, args: SolveArgs):
     return args.scaling.unscale(t, y_scaled).accumulators
 
 
-def _diffeqsolve(
+def scaled_diffeqsolve(
     y0_scaled,
     args,
     duration,
@@ -297,7 +297,7 @@ def solve(
         norm = error_norm
     controller = step_controller(rtol, atol, norm)
     with checks_without_host_callbacks():  # cacheable program (`_compile_cache`)
-        sol = _diffeqsolve(
+        sol = scaled_diffeqsolve(
             y0_scaled,
             args,
             duration,

@@ -49,12 +49,16 @@ from ..dynamics import Functionals, Params, State, contact_loads
 from ..flange import DesignVariables, with_design
 from ..geometry import Bearing, OperatingPoint
 from ..io import require
-from ._compile_cache import checks_without_host_callbacks, compiled_program
+from ..run import (
+    checks_without_host_callbacks,
+    compiled_program,
+    parallel_map,
+    prepare_from,
+    result_code,
+    scaled_diffeqsolve,
+    solve_from,
+)
 from ._design import forward_jacobian
-from ._ensemble import parallel_map
-from ._result import result_code
-from ._settle import prepare_from, solve_from
-from ._simulate import _diffeqsolve
 
 #: Q_0 of the smooth contact indicator w(Q) = Q / (Q + Q_0) of the steady objective [N]: the
 #: force at which a flange sample counts half (the statistics' hard threshold is 1 N)
@@ -248,7 +252,7 @@ def tangent_growth(
         _, args, y0, controller = prepare_from(params, start, rtol, atol)
         saveat = diffrax.SaveAt(ts=ts, fn=lambda t, y, a: dataclasses.replace(y, accumulators=None))
         with checks_without_host_callbacks():
-            sol = _diffeqsolve(
+            sol = scaled_diffeqsolve(
                 y0, args, duration, saveat, controller, max_steps, diffrax.ForwardMode(), False
             )
         flat = jnp.concatenate(
@@ -284,7 +288,7 @@ def trajectory_states(
     ts = jnp.linspace(0.0, duration, num_saves + 1)[1:]
     saveat = diffrax.SaveAt(ts=ts, fn=lambda t, y, a: a.scaling.unscale(t, y))
     with checks_without_host_callbacks():
-        sol = _diffeqsolve(y0, args, duration, saveat, controller, max_steps, None, False)
+        sol = scaled_diffeqsolve(y0, args, duration, saveat, controller, max_steps, None, False)
     return sol.ys, result_code(sol.result)
 
 

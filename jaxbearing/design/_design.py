@@ -63,9 +63,7 @@ from .._errors import UserInputError
 from ..flange import DEFAULT_FLANGE_LOAD, DesignVariables, check_design, design_zone
 from ..geometry import Bearing, OperatingPoint
 from ..io import SOLVER_ARGUMENTS, check_model_inputs, check_solver_arguments
-from ._compile_cache import compiled_program
-from ._initial import Perturbation
-from ._simulate import flange_functionals
+from ..run import Perturbation, compiled_program, flange_functionals
 
 #: horizon [s] at which AD and central finite differences of the flange functionals agree to 1%
 #: on the reference bearing from `seated_perturbation` (see the module docstring)

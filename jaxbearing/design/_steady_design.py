@@ -3,7 +3,7 @@
 For a design (R_end, theta_f, Delta_bf; `flange.DesignVariables`) at one operating point,
 `steady_design_metrics` runs the bearing from the skid start until settled, measures a window of
 cage revolutions for an ensemble of seeds (`simulate_steady`) and returns, each with its 95 %
-confidence interval (Student-t over the seeds' batch means, `_statistics`):
+confidence interval (Student-t over the seeds' batch means, `jaxbearing.run.student_t_interval`):
 
 - `mean_pv`: the mean flange PV over contact time (every touching flange sample, equally spaced in
   time: the time average wear integrates), per cage revolution;
@@ -33,8 +33,8 @@ of the ensemble average from the states this returns (`final_states`).
 
 Continuation. `initial_states` (one per seed, e.g. a neighbouring design's `final_states`)
 starts every seed from a settled state instead of the skid start, so a design close to the
-previous one settles in the verdict's minimum four revolutions (`_settle.settling_verdict`) instead
-of from the start.
+previous one settles in the settling verdict's minimum four revolutions (`jaxbearing.run.
+simulate_steady`) instead of from the start.
 """
 
 from __future__ import annotations
@@ -53,9 +53,7 @@ from ..flange import (
 )
 from ..geometry import Bearing, OperatingPoint
 from ..io import require
-from ._initial import Perturbation
-from ._settle import simulate_steady, summarise_steady
-from ._statistics import student_t_interval
+from ..run import Perturbation, simulate_steady, student_t_interval, summarise_steady
 from ._steady_gradient import STEADY_FUNCTIONALS
 
 #: default dynamic corner margin [m]: the largest contact radius this far inside the limited circle

@@ -1,0 +1,65 @@
+"""Design: metrics of a roller-end/flange design and their gradients through the dynamics.
+
+- short runs, differentiable (docs/model.md 13 and 14): `design_metrics` (smooth peak flange PV and
+  contact heights of a run, the static design-zone margins), `design_jacobian` (their Jacobian
+  with respect to the design, forward mode by default, `GRADIENT_MODE_NOTE`), `DesignMetrics`,
+  `seated_perturbation` (the initial scatter that starts every roller at zero interference with
+  its flange), `forward_jacobian`, and the gradient check's `GRADIENT_HORIZON`,
+  `GRADIENT_RTOL`, `GRADIENT_ATOL`;
+- settled running (docs/model.md 17): `steady_design_metrics` (the steady-running design
+  objective: mean and p95 PV over contact time, corner share and margin, static margins, with
+  95 % intervals over seeds; continuation from given states), `SteadyDesignMetrics`,
+  `CORNER_MARGIN`;
+- its gradient: `steady_gradient` (an ensemble of short-window forward-mode sensitivities from
+  settled states, `GRADIENT_WINDOW`), `frozen_load_gradient`, `ratio_gradient`,
+  `SteadyGradient`, `tangent_growth` (finite-time growth of the tangents) and the smooth
+  accumulators they differentiate, `STEADY_FUNCTIONALS`.
+
+The `optimise` package searches designs with these.
+
+May import: every layer below (`run` and down); `run` only through its public names.
+"""
+
+from ._design import (
+    GRADIENT_ATOL,
+    GRADIENT_HORIZON,
+    GRADIENT_MODE_NOTE,
+    GRADIENT_RTOL,
+    DesignMetrics,
+    design_jacobian,
+    design_metrics,
+    forward_jacobian,
+    seated_perturbation,
+)
+from ._steady_design import CORNER_MARGIN, SteadyDesignMetrics, steady_design_metrics
+from ._steady_gradient import (
+    GRADIENT_WINDOW,
+    STEADY_FUNCTIONALS,
+    SteadyGradient,
+    frozen_load_gradient,
+    ratio_gradient,
+    steady_gradient,
+    tangent_growth,
+)
+
+__all__ = [
+    "CORNER_MARGIN",
+    "GRADIENT_ATOL",
+    "GRADIENT_HORIZON",
+    "GRADIENT_MODE_NOTE",
+    "GRADIENT_RTOL",
+    "GRADIENT_WINDOW",
+    "STEADY_FUNCTIONALS",
+    "DesignMetrics",
+    "SteadyDesignMetrics",
+    "SteadyGradient",
+    "design_jacobian",
+    "design_metrics",
+    "forward_jacobian",
+    "frozen_load_gradient",
+    "ratio_gradient",
+    "seated_perturbation",
+    "steady_design_metrics",
+    "steady_gradient",
+    "tangent_growth",
+]
