@@ -23,7 +23,7 @@ NAMES = run_all.discover()
 
 
 def test_discovery_finds_this_issues_benchmarks():
-    for name in ("bench_scipy", "bench_cost_per_eval", "bench_scaling"):
+    for name in ("bench_scipy", "bench_cost_per_eval", "bench_steady_engine"):
         assert name in NAMES
 
 

@@ -37,7 +37,7 @@ def both_run(tmp_path_factory):
         "[operating]\nspeed_rpm = 15000.0\nradial_load_N = 500.0\n"
         '[simulation]\nduration_ms = 0.5\nprogress = true\nend = "arc"\n'
     )
-    args = ["--speed-rpm", "20000", "--load-N", "1000", "--duration-ms", "2", "--no-progress"]
+    args = ["--speed-rpm", "20000", "--load-N", "1000", "--transient", "--duration-ms", "2", "--no-progress"]
     text = io.StringIO()
     with contextlib.redirect_stdout(text):
         code = main(["simulate", "--config", str(cfg), "--end", "both", *args, "--out", str(out)])
@@ -49,9 +49,11 @@ def test_both_ends_write_summary_histories_plots(both_run, capsys):
     assert code == 0
     doc = json.loads((out / "summary.json").read_text())
     assert {"arc", "corner"} <= set(doc) and doc["ends"] == ["arc", "corner"]
+    _, _, printed = both_run
+    assert printed.count("START-UP TRANSIENT: 2 ms from the quasi-static start, not settled running") == 1
     for end in ("arc", "corner"):
         block = doc[end]
-        assert block["status"] == "ok"
+        assert block["status"] == "ok" and block["running"] == "start-up transient"
         for key in (
             "cage_speed_rpm",
             "kinematic_cage_speed_rpm",
@@ -150,7 +152,7 @@ def test_progress_of_a_fixed_run_keeps_the_program_cacheable(monkeypatch, capsys
     run_cases(cfg, progress=True)
     assert [kw["progress"] for kw in seen] == [False, False]
     out = capsys.readouterr().out
-    assert "[arc end] simulating 2 ms" in out and "100% of the simulated time" in out
+    assert "[arc end] simulating a 2 ms start-up transient" in out and "100% of the simulated time" in out
     assert "stopped at 25.0% of the simulated time" in out
 
 
@@ -186,7 +188,7 @@ def test_forced_solver_failure_nonzero_exit(tmp_path, capsys):
     table marks the failed run's values, summary.json is strict JSON (issue 16)."""
     cfg = _config(tmp_path, '[simulation]\nduration_ms = 0.6\nmax_steps = 30\nprogress = true\nend = "arc"\n')
     out = tmp_path / "out"
-    assert main(["simulate", "--config", cfg, "--out", str(out)]) == 1
+    assert main(["simulate", "--config", cfg, "--transient", "--out", str(out)]) == 1
     printed = capsys.readouterr().out
     assert "stopped at" in printed and "100%" not in printed
     assert "! [arc] the run failed" in printed
@@ -275,3 +277,39 @@ def test_demo_settled_passes_its_window_to_the_run(tmp_path, capsys, monkeypatch
     capsys.readouterr()
     assert main(["demo", "--window-revs", "2.5", "--out", str(out)]) == 2
     assert "--window-revs" in capsys.readouterr().err and len(seen) == 1
+
+
+def test_simulate_settles_by_default_and_a_transient_is_explicit(monkeypatch, capsys):
+    """`jaxbearing simulate` without options is a settled run (`--settle auto`); a start-up
+    transient takes `--transient` or `--settle off`; `--duration-ms` without it, or `--transient`
+    with a settling mode, is one line naming the option (exit 2), never silently ignored."""
+    import jaxbearing.run as run
+
+    seen = []
+
+    def fake(bearing, op, **kw):
+        seen.append(kw)
+        raise SystemExit(0)
+
+    monkeypatch.setattr(run, "simulate", fake)
+    for args, settle in (
+        ([], "auto"),
+        (["--settle", "5"], "5"),
+        (["--transient"], None),
+        (["--settle", "off"], None),
+    ):
+        seen.clear()
+        with pytest.raises(SystemExit):
+            main(["simulate", "--end", "arc", "--no-progress", *args])
+        assert seen[0].get("settle") == settle, (args, seen[0])
+    capsys.readouterr()
+    for args, words in (
+        (
+            ["--duration-ms", "2"],
+            "--duration-ms = 2: sets the length of a start-up transient; add --transient",
+        ),
+        (["--transient", "--settle", "auto"], "--transient: cannot be combined with --settle auto"),
+    ):
+        assert main(["simulate", "--no-progress", *args]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and words in err[0], err

@@ -251,7 +251,8 @@ def test_table_headers_separate_and_failed_values_marked():
     from jaxbearing.cli import format_table
 
     text = format_table({"arc": _summary("ok", 1e-3), "corner": _summary("failed: step limit", -17.4e-3)})
-    head = text.splitlines()[0]
+    banner, head = text.splitlines()[:2]
+    assert banner.startswith("START-UP TRANSIENT:")  # a transient's table says so first
     assert "meancorner" not in head and "maxarc" not in head
     for label in ("arc max", "arc mean", "arc median", "corner max", "corner mean", "corner median"):
         assert f" {label}" in head

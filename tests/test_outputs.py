@@ -371,7 +371,18 @@ def first_run(tmp_path_factory):
     cfg.write_text(SMALL)
     out = d / "out"
     code = jb_main(
-        ["simulate", "--config", str(cfg), "--end", "arc", "--duration-ms", "1", "--out", str(out)]
+        [
+            "simulate",
+            "--config",
+            str(cfg),
+            "--end",
+            "arc",
+            "--transient",
+            "--duration-ms",
+            "1",
+            "--out",
+            str(out),
+        ]
     )
     return code, json.loads((out / "summary.json").read_text())
 
@@ -397,12 +408,13 @@ def test_summary_json_describes_itself(first_run):
 
 
 def test_recorded_configuration_reproduces_the_statistics(first_run, tmp_path):
-    """summary.json's configuration fed back (no options) gives the same statistics."""
+    """summary.json's configuration fed back (only --transient, the running it records) gives
+    the same statistics."""
     _, doc = first_run
     cfg = tmp_path / "recorded.toml"
     cfg.write_text(doc["config_toml"])
     out = tmp_path / "again"
-    assert jb_main(["simulate", "--config", str(cfg), "--out", str(out)]) == 0
+    assert jb_main(["simulate", "--config", str(cfg), "--transient", "--out", str(out)]) == 0
     again = json.loads((out / "summary.json").read_text())
     assert again["config"] == doc["config"]
     assert _statistics(again) == _statistics(doc)
@@ -428,7 +440,10 @@ def test_write_failure_after_the_solve_keeps_the_results(first_run, tmp_path, mo
 
     monkeypatch.setattr(sim, "write_outputs", failing)
     capsys.readouterr()
-    assert jb_main(["simulate", "--config", str(cfg), "--out", str(out)]) == EXIT_RESULTS_ELSEWHERE
+    assert (
+        jb_main(["simulate", "--config", str(cfg), "--transient", "--out", str(out)])
+        == EXIT_RESULTS_ELSEWHERE
+    )
     line = _err_line(capsys)
     kept = pathlib.Path(line.rsplit("they are kept in ", 1)[1])
     assert "injected" in line and kept.is_relative_to(tmp_path / "cache")

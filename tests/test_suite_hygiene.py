@@ -249,6 +249,7 @@ def test_no_short_wall_clock_threshold(path):
 #: name it uses (`ARGS`, `_cli_args`)
 _OVERRIDES = "test_cmd_simulate.py::test_command_line_overrides_win_over_the_file"
 _DEMO = "test_cmd_simulate.py::test_demo_transient_writes_both_ends"
+_DEFAULT_SETTLED = "test_cmd_simulate.py::test_simulate_settles_by_default_and_a_transient_is_explicit"
 _AUTO = "test_settle.py::test_auto_settle_succeeds_and_reports_intervals"
 _CAP = "test_settle.py::test_auto_settle_hitting_the_cap_is_not_silent"
 _SETTLED_OPTIONS = "test_settle.py::test_settled_options_reach_the_run"
@@ -288,7 +289,8 @@ CLI_CHECKS = {
     ("jaxbearing", "simulate", "--out"): [_OVERRIDES, _AUTO],
     ("jaxbearing", "simulate", "--no-progress"): [_OVERRIDES],
     ("jaxbearing", "simulate", "--solver"): ["test_cmd_simulate.py::test_solver_reaches_the_run"],
-    ("jaxbearing", "simulate", "--settle"): [_AUTO, _CAP],
+    ("jaxbearing", "simulate", "--settle"): [_AUTO, _CAP, _DEFAULT_SETTLED],
+    ("jaxbearing", "simulate", "--transient"): [_OVERRIDES, _DEFAULT_SETTLED],
     ("jaxbearing", "simulate", "--window-revs"): [_AUTO],
     ("jaxbearing", "simulate", "--seeds"): [_SETTLED_OPTIONS],
     ("jaxbearing", "simulate", "--settle-tolerance"): [_AUTO],

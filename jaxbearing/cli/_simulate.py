@@ -24,9 +24,9 @@ def register(sub) -> None:
         "simulate",
         help="integrate the bearing dynamics and report roller-end/flange contacts",
         description="Integrate the whole-bearing dynamics and report the roller-end/flange contact "
-        "statistics (paper Figure 7 quantities), cage speed and slip: with --settle, from the skid "
-        "start until settled, then over a window of cage revolutions with 95 % confidence intervals; "
-        "without it, one fixed-duration run from the quasi-static start.",
+        "statistics (paper Figure 7 quantities), cage speed and slip of settled running: from the skid "
+        "start until settled, then over a window of cage revolutions with 95 % confidence intervals. "
+        "--transient: one fixed-duration run from the quasi-static start instead (a start-up transient).",
     )
     p.add_argument("--config", help="TOML configuration (default: the embedded reference bearing)")
     p.add_argument(
@@ -46,7 +46,8 @@ def register(sub) -> None:
     p.add_argument(
         "--duration-ms",
         type=float,
-        help="simulated time [ms] of a fixed-duration run " + _from_config("simulation.duration_ms"),
+        help="with --transient: simulated time [ms] of the start-up transient "
+        + _from_config("simulation.duration_ms"),
     )
     p.add_argument(
         "--out",
@@ -151,7 +152,7 @@ def run_cases(cfg, progress: bool = True, steady: dict | None = None) -> dict:
     for end in ends:
         b = bearing.with_flat_ends() if end == "corner" else bearing
         if progress:
-            what = "until settled" if steady else f"{sim.duration_ms:g} ms"
+            what = "until settled" if steady else f"a {sim.duration_ms:g} ms start-up transient"
             print(f"[{end} end] simulating {what} ...", flush=True)
         # a fixed-duration run shows the host-side meter (`HostProgress`): the solve's own meter
         # is a host callback, which would make the program uncacheable (compiled in every process)
@@ -194,7 +195,13 @@ def format_table(summaries: dict) -> str:
     head = f"{'quantity':<22}{'unit':>9}" + "".join(
         f"{e + ' ' + st:>{widths[e]}}" for e in ends for st in stats
     )
-    lines = [head, "-" * len(head)]
+    span = max((summaries[e].get("simulated_time_s") or 0.0) for e in ends) * 1e3
+    lines = [
+        f"START-UP TRANSIENT: {span:g} ms from the quasi-static start, not settled running; statistics "
+        "over the whole run, no confidence intervals (drop --transient for settled running)",
+        head,
+        "-" * len(head),
+    ]
     for key, label, unit, k in _TABLE_ROWS:
         row = f"{label:<22}{unit:>9}"
         for e in ends:

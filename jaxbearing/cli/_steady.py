@@ -1,6 +1,8 @@
 """Settled runs on the command line: the `--settle` options of `simulate` and their table.
 
-`--settle auto|off|MS` turns `simulate` into a settled run (`jaxbearing.run.simulate_steady`):
+`jaxbearing simulate` settles by default (`--settle auto`; a settling time MS in ms is the
+other choice); a start-up transient is the explicit `--transient` (or `--settle off`), and its
+table, summary.json (`running`) and plots say so. A settled run (`jaxbearing.run.simulate_steady`):
 skid start (`--start skid`, default: the speeds of steady running, then projective steps of the
 cage speed while settling; `--start quasi-static`: kinematic speeds), settling (`auto`: until
 the remaining drift of the cage speed, the trend of the last 4-8 revolution means times the slow
@@ -28,8 +30,14 @@ def add_arguments(p) -> None:
     g = p.add_argument_group("settled running (statistics with 95 % confidence intervals)")
     g.add_argument(
         "--settle",
-        help='"auto" (detect settling), "off" (measure from the start) or a '
-        "settling time in ms (default: none: one fixed-duration run from the quasi-static start)",
+        help='"auto" (until the settling verdict), a settling time in ms, or "off" (the same as '
+        "--transient) (default: auto)",
+    )
+    g.add_argument(
+        "--transient",
+        action="store_true",
+        help="instead: a start-up transient, one fixed-duration run of --duration-ms from the "
+        "quasi-static start, labelled as such (default: settled running)",
     )
     g.add_argument(
         "--window-revs",
@@ -67,9 +75,24 @@ def add_arguments(p) -> None:
 
 
 def options(args) -> dict | None:
-    """Keyword arguments of `simulate` for a settled run, checked; None without `--settle`."""
-    if args.settle is None:
+    """Keyword arguments of `simulate` for a settled run (the default), checked; None for a
+    start-up transient (`--transient` or `--settle off`). `--duration-ms` belongs to a
+    transient: given for a settled run, it is an error (one line), not silently ignored."""
+    from .._errors import UserInputError
+
+    transient = args.transient or args.settle == "off"
+    if args.transient and args.settle not in (None, "off"):
+        raise UserInputError(
+            f"--transient: cannot be combined with --settle {args.settle} (a transient is not settled)"
+        )
+    if transient:
         return None
+    if getattr(args, "duration_ms", None) is not None:
+        raise UserInputError(
+            f"--duration-ms = {args.duration_ms:g}: sets the length of a start-up transient; add "
+            "--transient (a settled run lasts until settled, then --window-revs revolutions)"
+        )
+    args.settle = "auto" if args.settle is None else args.settle
     from ..run import check_steady_options
 
     names = {

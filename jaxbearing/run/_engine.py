@@ -86,11 +86,13 @@ class BatchTimes:
     rounds: int = 0
 
 
-def batched_program(params, state, num_saves: int, max_steps: int, solver: str, devices: Sequence):
+def batched_program(
+    solve_from: Callable, params, state, num_saves: int, max_steps: int, solver: str, devices: Sequence
+):
     """`vmap(solve_from)` over stacked (params, state, duration, rtol, atol) with leading axis a
     multiple of len(devices), compiled: on one device the plain vmap (`compiled_program`: traced
-    once per machine), on several `jax.shard_map` over the mesh axis "members"."""
-    from ._settle import solve_from  # the same integrator as one member at a time
+    once per machine), on several `jax.shard_map` over the mesh axis "members". `solve_from`:
+    the integrator one member at a time uses (`_settle.solve_from`)."""
 
     def one(p, s, d, r, a):
         return solve_from(p, s, d, num_saves=num_saves, rtol=r, atol=a, max_steps=max_steps, solver=solver)
@@ -113,6 +115,7 @@ def drive_batched(
     params: Sequence,
     tolerances: Sequence[tuple[float, float]],
     *,
+    solve_from: Callable,
     num_saves: int,
     max_steps: int,
     solver: str,
@@ -121,7 +124,7 @@ def drive_batched(
 ) -> list:
     """Run the request programs `programs` together (module docstring): member i integrates
     with `params[i]` (a `dynamics.Params`; all of one structure) and `tolerances[i]` = (rtol,
-    atol). Returns the programs' return values, in order."""
+    atol), answered by `solve_from` vmapped. Returns the programs' return values, in order."""
     times = times if times is not None else BatchTimes()
     devices = tuple(jax.local_devices() if devices is None else devices)
     n = len(programs)
@@ -155,7 +158,7 @@ def drive_batched(
         times.host_s += time.perf_counter() - h0
         if run is None:
             c0 = time.perf_counter()
-            run = batched_program(stacked_params, stacked, num_saves, max_steps, solver, devices)
+            run = batched_program(solve_from, stacked_params, stacked, num_saves, max_steps, solver, devices)
             times.compile_s += time.perf_counter() - c0
         s0 = time.perf_counter()
         out = jax.device_get(run(stacked_params, stacked, np.asarray(durations), rtol, atol))

@@ -14,6 +14,7 @@ import pathlib
 import numpy as np
 
 from ..io import pyplot as _plt
+from ._summary import SETTLED_LABEL, TRANSIENT_LABEL
 
 
 def plot_run(out_dir: pathlib.Path, results: dict) -> list[pathlib.Path]:
@@ -24,6 +25,7 @@ def plot_run(out_dir: pathlib.Path, results: dict) -> list[pathlib.Path]:
     out_dir = pathlib.Path(out_dir)
     files = []
     events = {end: contact_events(res.histories) for end, (res, _) in results.items()}
+    label = _running_label(results)
 
     fig, axes = plt.subplots(1, 4, figsize=(14, 3.6))
     panels = (
@@ -40,7 +42,7 @@ def plot_run(out_dir: pathlib.Path, results: dict) -> list[pathlib.Path]:
         else:
             ax.text(0.5, 0.5, "no contact events", ha="center", transform=ax.transAxes)
         ax.set_ylabel(label)
-    fig.suptitle("Roller end / flange contact events (cf. paper Fig. 7)")
+    fig.suptitle(f"Roller end / flange contact events (cf. paper Fig. 7), {label}")
     fig.tight_layout()
     files.append(out_dir / "flange_boxplots.png")
     fig.savefig(files[-1], dpi=110)
@@ -59,7 +61,7 @@ def plot_run(out_dir: pathlib.Path, results: dict) -> list[pathlib.Path]:
         ax.set_aspect("equal")
         ax.set_xlabel("y on end face [mm]")
         ax.set_ylabel("z on end face [mm]")
-        ax.set_title(f"{end} end (cf. paper Fig. 8)")
+        ax.set_title(f"{end} end (cf. paper Fig. 8)\n{label}", fontsize=9)
         ax.legend(loc="upper right", fontsize=7)
     fig.tight_layout()
     files.append(out_dir / "contact_positions.png")
@@ -79,12 +81,24 @@ def plot_run(out_dir: pathlib.Path, results: dict) -> list[pathlib.Path]:
     )
     ax.set_xlabel("time [ms]")
     ax.set_ylabel("cage speed [rpm]")
+    ax.set_title(f"cage speed, {label}", fontsize=9)
     ax.legend()
     fig.tight_layout()
     files.append(out_dir / "cage_speed.png")
     fig.savefig(files[-1], dpi=110)
     plt.close(fig)
     return files
+
+
+def _running_label(results: dict) -> str:
+    """What the runs' figures show: "START-UP TRANSIENT" (a fixed-duration run), the settled
+    window, or a window that did not settle (`summarise`'s "running")."""
+    running = {s.get("running", TRANSIENT_LABEL) for _, s in results.values()}
+    if TRANSIENT_LABEL in running:
+        return "START-UP TRANSIENT (not settled running)"
+    if running == {SETTLED_LABEL}:
+        return "settled running (measurement window)"
+    return "window NOT SETTLED"
 
 
 def plot_measured(path, rows: list[dict], title: str = "") -> pathlib.Path:

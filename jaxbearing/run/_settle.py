@@ -71,6 +71,7 @@ from ._simulate import SolveArgs, _histories, _saved_state, scaled_diffeqsolve
 from ._simulate import simulate as _simulate_fixed
 from ._statistics import steady_statistics
 from ._step_control import raceway_normal_norm, step_controller
+from ._summary import SETTLED_LABEL, UNSETTLED_LABEL
 from ._summary import summarise as _summarise_fixed
 
 #: defaults of the settled run
@@ -616,6 +617,7 @@ def settle_members(
                 [member_steps(members[i], dataclasses.replace(options, progress=False), reduce) for i in idx],
                 [options.params(members[i]) for i in idx],
                 [options.tolerances(members[i]) for i in idx],
+                solve_from=solve_from,
                 num_saves=int(options.saves_per_rev),
                 max_steps=int(options.max_steps),
                 solver=options.solver,
@@ -725,6 +727,7 @@ def summarise_steady(result: SteadyResult, threshold: float = 1.0) -> dict:
     runs = result.runs
     ok = [r for r in runs if r.measured]
     block = {
+        "running": SETTLED_LABEL if result.settled else UNSETTLED_LABEL,
         "status": "ok" if result.ok else next(r.status for r in runs if r.status != "ok"),
         "settled": bool(result.settled),
         "settle_mode": result.settle if isinstance(result.settle, str) else "fixed",

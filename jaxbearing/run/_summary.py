@@ -125,6 +125,13 @@ def _stats(values: np.ndarray) -> dict:
     }
 
 
+#: what a fixed-duration run's statistics describe (summary key "running"; tables and plots)
+TRANSIENT_LABEL = "start-up transient"
+#: ... and a settled run's, when the settling verdict passed (else `UNSETTLED_LABEL`)
+SETTLED_LABEL = "settled running"
+UNSETTLED_LABEL = "not settled (see settled and residual_drift_rpm)"
+
+
 def summarise(result, threshold: float = 1.0) -> dict:
     """The summary.json block of one run (keys documented in the `simulate` command)."""
     h = result.histories
@@ -134,6 +141,7 @@ def summarise(result, threshold: float = 1.0) -> dict:
     # cage speed averaged over the second half of the run (after the start transient)
     cage_rpm = float(rad_s_to_rpm(np.mean(cage[len(cage) // 2 :]))) if cage.size else float("nan")
     block = {
+        "running": TRANSIENT_LABEL,
         "status": result.status,
         "cage_speed_rpm": cage_rpm,
         "kinematic_cage_speed_rpm": kin,

@@ -60,10 +60,11 @@ def _unit(name: str) -> str:
 def provenance_attrs(spec: SweepSpec) -> dict:
     """netCDF attributes (strings and numbers only) saying what produced the dataset: the package
     version, the command line, the base configuration in engineering units (JSON and TOML; the
-    swept keys vary along the axes), the seeds (every case starts from `Perturbation(seed=0)`)."""
+    swept keys vary along the axes), the seeds (every case runs `Perturbation(seed=k)` for k in
+    0 .. seeds-1; a transient sweep seed 0)."""
     from ..io import dumps_strict, provenance
 
-    meta = provenance(spec.base, seeds=[0])
+    meta = provenance(spec.base, seeds=list(range(spec.seeds if spec.settled else 1)))
     return {
         "jaxbearing_version": str(meta["jaxbearing_version"]),
         "command": json.dumps(meta["command"]),
@@ -159,7 +160,6 @@ def assemble(out_dir: str | os.PathLike, spec: SweepSpec | None = None):
         base_end=spec.base.simulation.end,
         running=spec.running,
         settle=str(spec.settle),
-        seeds=spec.seeds,
         window_revs=spec.window_revs,
         duration_ms=spec.base.simulation.duration_ms if not spec.settled else np.nan,
         num_saves=spec.num_saves,

@@ -110,7 +110,7 @@ def running_label(ds) -> str:
     """What a sweep's statistics describe, as the figures say it: settled running with its
     intervals, or a start-up transient (also for datasets written before settled sweeps)."""
     if ds.attrs.get("running") == "settled running":
-        n = int(ds.attrs.get("seeds", 1))
+        n = len(json.loads(ds.attrs.get("seeds", "[0]")))
         how = f"{n} seeds" if n > 1 else "batch means over revolutions"
         return f"settled running, per cage revolution; bars: 95 % CI ({how})"
     return "START-UP TRANSIENT (not settled running)"
