@@ -23,6 +23,7 @@ from ._problem import (
     operating_envelope,
 )
 from ._search import SearchResult, grid_search, search, start_points
+from ._steady import near_optimal_set
 
 __all__ = [
     "MARGIN_NAMES",
@@ -35,6 +36,7 @@ __all__ = [
     "grid_search",
     "load_optimise_toml",
     "make_problem",
+    "near_optimal_set",
     "operating_envelope",
     "plot_search",
     "search",

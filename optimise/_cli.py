@@ -565,6 +565,15 @@ def run_steady(args, problem, options, settings, out, meta=None) -> int:
         f"final design: {_design_text(res.design)}  (start {res.best_start}, iteration {res.best_iteration})"
     )
     print(f"  steady mean PV {res.objective:.4f} [{lo:.4f}, {hi:.4f}] GPa m/s (search seeds)")
+    from ._steady import near_optimal_set
+
+    near = near_optimal_set(res)
+    if near:
+        binds = sorted({d["binding_margin"] for d in near})
+        print(
+            f"  near-optimal set: {len(near)} evaluated design(s) within the best's 95 % interval, "
+            f"binding margin {', '.join(binds)} (result.json near_optimal; drawn on {plot_path.name})"
+        )
     v = res.verification
     if v:
         for name in ("reference", "optimum"):
@@ -596,7 +605,7 @@ def _steady_result_json(problem, options, settings, res) -> dict:
 
     import numpy as np
 
-    from ._steady import CONSTRAINT_NAMES
+    from ._steady import CONSTRAINT_NAMES, near_optimal_set
 
     h = res.history
     x = np.asarray(h["x"]) if len(h["x"]) else np.zeros((0, 0, 3))
@@ -613,6 +622,25 @@ def _steady_result_json(problem, options, settings, res) -> dict:
         },
         "start_design": _engineering(res.start_design),
         "verification": res.verification,
+        "near_optimal": [
+            {
+                **_engineering(d["design"]),
+                "objective_GPa_m_s": {
+                    "value": d["objective"],
+                    "ci95_low": d["ci95"][0],
+                    "ci95_high": d["ci95"][1],
+                },
+                "iteration": d["iteration"],
+                "start": d["start"],
+                "binding_margin": d["binding_margin"],
+                "binding_margin_mm": d["binding_margin_m"] * 1e3,
+            }
+            for d in near_optimal_set(res)
+        ],
+        "near_optimal_rule": (
+            "every feasible design the search evaluated whose objective lies within the best design's "
+            "95 % interval (search seeds), best first; binding_margin: its smallest margin"
+        ),
         "bounds": problem.bounds.engineering(),
         "operating_points": [
             {"speed_rpm": float(w) * 60 / (2 * math.pi), "load_N": float(f)}

@@ -12,7 +12,8 @@ def plot_search(problem, result, path) -> pathlib.Path:
     """Write a PNG of every start's path in (R_end, theta_f) over the feasibility map of the
     design zone (`jaxbearing.design_zone_grid`, at the final Delta_bf, or the start's when no
     feasible design was found): feasible region shaded, zero lines of each margin, starts as
-    circles, the final design as a star. For a steady search (five margins per iterate), the
+    circles, the final design as a star, the near-optimal designs (`_steady.near_optimal_set`)
+    as open diamonds. For a steady search (five margins per iterate), the
     dynamic corner margin's zero line too, dashed (`_steady`: the limited-circle margin equal to
     the skew excursion measured at the final design plus the corner margin)."""
     from jaxbearing.io import pyplot
@@ -54,6 +55,19 @@ def plot_search(problem, result, path) -> pathlib.Path:
         for s in range(xs.shape[1]):
             (line,) = ax.plot(xs[:, s, 0] * 1e3, np.degrees(xs[:, s, 1]), "-", lw=1, marker=".", ms=3)
             ax.plot(xs[0, s, 0] * 1e3, math.degrees(xs[0, s, 1]), "o", color=line.get_color(), mfc="none")
+    near = _near_optimal(result)
+    if near:
+        pts = np.asarray([d["design"] for d in near])
+        ax.plot(
+            pts[:, 0] * 1e3,
+            np.degrees(pts[:, 1]),
+            "D",
+            mfc="none",
+            mec="k",
+            ms=7,
+            ls="none",
+            label=f"near-optimal: within the best's 95 % interval ({len(near)})",
+        )
     if result.design is not None:
         ax.plot(
             result.design[0] * 1e3,
@@ -78,3 +92,14 @@ def plot_search(problem, result, path) -> pathlib.Path:
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
+
+
+def _near_optimal(result) -> list:
+    """The steady search's near-optimal set (`_steady.near_optimal_set`); none for the startup
+    search."""
+    margins = np.asarray(result.history.get("margins", [])) if result.history else np.zeros(0)
+    if margins.ndim != 3 or margins.shape[-1] != 5:
+        return []
+    from ._steady import near_optimal_set
+
+    return near_optimal_set(result)

@@ -467,6 +467,38 @@ def steady_search(
     return result
 
 
+def near_optimal_set(result: SteadySearchResult) -> list[dict]:
+    """The feasible designs the search evaluated whose objective lies within the best design's
+    95 % interval (issue 35, item 7: the optimum is a ridge along a binding margin, not a
+    point; a designer chooses among these by other criteria), best first. Each: the design
+    (R_end, theta_f, Delta_bf in SI), its objective and interval, where it was evaluated
+    (iteration, start), and its binding margin: the smallest of its static and dynamic margins
+    (`CONSTRAINT_NAMES`) with its value [m]. Empty without a feasible design."""
+    if result.design is None or result.objective_ci is None or not len(result.history.get("x", ())):
+        return []
+    h = result.history
+    x, objective = np.asarray(h["x"]), np.asarray(h["objective"], float)  # (I, S, 3), (I, S)
+    ci, margins = np.asarray(h["ci"], float), np.asarray(h["margins"], float)  # (I, S, 2), (I, S, 5)
+    high = float(result.objective_ci[1])
+    feasible = np.all(margins > 0, axis=-1) & np.isfinite(objective)
+    near = feasible & (objective <= high)
+    out = []
+    for it, s in zip(*np.nonzero(near)):
+        k = int(np.argmin(margins[it, s]))
+        out.append(
+            {
+                "design": x[it, s].tolist(),
+                "objective": float(objective[it, s]),
+                "ci95": [float(ci[it, s, 0]), float(ci[it, s, 1])],
+                "iteration": int(it),
+                "start": int(s),
+                "binding_margin": CONSTRAINT_NAMES[k],
+                "binding_margin_m": float(margins[it, s, k]),
+            }
+        )
+    return sorted(out, key=lambda d: d["objective"])
+
+
 def _save_checkpoint(path: pathlib.Path, key: str, state: dict) -> None:
     """The search state, data only (`jaxbearing.io.save_tree`: `.npz` and JSON), atomically."""
     save_tree(path, {"fingerprint": key, "state": jax.tree_util.tree_map(np.asarray, state)})
