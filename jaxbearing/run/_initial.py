@@ -176,6 +176,29 @@ def _static_skid_start(bearing: Bearing, op: OperatingPoint, perturbation: Pertu
     )
 
 
+def static_skid_starts(members, devices=None) -> list[SkidStart]:
+    """`_static_skid_start` of every (bearing, operating point, perturbation) in `members`
+    (all of one parameter structure) as one vmapped program: the accelerator path of the
+    steady-running engine, where thousands of members would otherwise each solve their skid
+    equilibrium on the host one after another (3.6 s each at 11 slices on the 2-core CPU)."""
+    import numpy as np
+
+    dyn = [(b, op, traced_scatter(p)) for b, op, p in members]
+    stacked = jax.tree_util.tree_map(lambda *xs: np.stack([np.asarray(x) for x in xs]), *dyn)
+    out = jax.device_get(compiled_program("skid_start_members", jax.vmap(_skid), stacked)(*stacked))
+    starts = []
+    for i in range(len(members)):
+        one = jax.tree_util.tree_map(lambda a: a[i], out)
+        starts.append(
+            dataclasses.replace(
+                one,
+                plateau_speed=float(one.equilibrium.cage_speed),
+                static_time_constant=float(one.time_constant),
+            )
+        )
+    return starts
+
+
 #: the pre-start's bursts, in revolutions at the static skid speed: each skips `PRE_START_SKIP`
 #: (the first: the rollers skew and reach the flanges; the later ones: the rollers' spins and
 #: pocket contacts readjust to the stepped cage speed), then measures the cage speed's drift over

@@ -64,6 +64,7 @@ from ._initial import (
     initial_state,
     pre_start_steps,
     skid_start,
+    static_skid_starts,
 )
 from ._result import result_code
 from ._rosenbrock import DEFAULT_SOLVER, check_solver
@@ -501,18 +502,21 @@ class SteadyOptions:
         return Params(bearing=member.bearing, operating=member.operating, functionals=self.functionals)
 
 
-def member_steps(member: Member, options: SteadyOptions, reduce=None):
+def member_steps(member: Member, options: SteadyOptions, reduce=None, static=None):
     """The settled run of one member as a program of integration requests (`_engine`): its
     start (the skid equilibrium and its pre-start, the kinematic start, or the given state),
     settling and the window (module docstring); returns its `SeedRun`, passed through
     `reduce(run, member)` if given (e.g. a sweep's statistics, so that the window's histories
-    need not be kept)."""
+    need not be kept). `static`: the member's static skid equilibrium if already solved
+    (`static_skid_starts`, the vmapped path), else it is solved here when needed."""
     bearing, op, pert, given = member.bearing, member.operating, member.perturbation, member.initial_state
     skid = None
     if given is not None:  # continuation from a given state
         y0, tau = jax.tree_util.tree_map(jnp.asarray, given), None
     elif options.start == "skid":
-        skid = yield from pre_start_steps(_static_skid_start(bearing, op, pert))
+        skid = yield from pre_start_steps(
+            static if static is not None else _static_skid_start(bearing, op, pert)
+        )
         # on the plateau after a completed pre-start: no projective steps (their drift, from
         # two revolution means, is noisier than the pre-start's secant; docs/model.md 16)
         y0 = skid.state
@@ -521,7 +525,7 @@ def member_steps(member: Member, options: SteadyOptions, reduce=None):
         y0, tau = initial_state(bearing, op, pert), None
     slow_mode = float("nan")
     if options.settle == "auto":
-        slow_mode = running_time_constant(skid, bearing, op, pert)
+        slow_mode = running_time_constant(skid if skid is not None else static, bearing, op, pert)
     if options.progress:
         print(
             f"seed {pert.seed}: settling ({options.settle}), then {options.window_revs} revolutions",
@@ -612,9 +616,28 @@ def settle_members(
             key = jax.tree_util.tree_structure(options.params(m))
             groups.setdefault(key, []).append(i)
         runs: list = [None] * len(members)
+        quiet = dataclasses.replace(options, progress=False)
         for idx in groups.values():
+            # the static skid equilibria of the group in one vmapped program, not one by one
+            needs = [
+                i
+                for i in idx
+                if members[i].initial_state is None and (options.start == "skid" or options.settle == "auto")
+            ]
+            h0 = time.perf_counter()
+            statics = dict(
+                zip(
+                    needs,
+                    static_skid_starts(
+                        [(members[i].bearing, members[i].operating, members[i].perturbation) for i in needs]
+                    )
+                    if needs
+                    else [],
+                )
+            )
+            times.host_s += time.perf_counter() - h0
             outs = drive_batched(
-                [member_steps(members[i], dataclasses.replace(options, progress=False), reduce) for i in idx],
+                [member_steps(members[i], quiet, reduce, statics.get(i)) for i in idx],
                 [options.params(members[i]) for i in idx],
                 [options.tolerances(members[i]) for i in idx],
                 solve_from=solve_from,
