@@ -605,7 +605,7 @@ def _steady_result_json(problem, options, settings, res) -> dict:
 
     import numpy as np
 
-    from ._steady import CONSTRAINT_NAMES, near_optimal_set
+    from ._steady import CLEARANCE_EFFECT, CONSTRAINT_NAMES, near_optimal_set
 
     h = res.history
     x = np.asarray(h["x"]) if len(h["x"]) else np.zeros((0, 0, 3))
@@ -637,6 +637,12 @@ def _steady_result_json(problem, options, settings, res) -> dict:
             }
             for d in near_optimal_set(res)
         ],
+        "axial_clearance_effect": {
+            **CLEARANCE_EFFECT,
+            "moved": bool(
+                res.design is not None and abs(float(res.design[2]) - float(res.start_design[2])) > 1e-12
+            ),
+        },
         "near_optimal_rule": (
             "every feasible design the search evaluated whose objective lies within the best design's "
             "95 % interval (search seeds), best first; binding_margin: its smallest margin"

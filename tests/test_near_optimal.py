@@ -73,6 +73,10 @@ def test_result_json_and_figure_carry_the_near_optimal_set(tmp_path, monkeypatch
     doc = _steady_result_json(problem, {}, SteadySettings(), res)
     assert [d["end_radius_mm"] for d in doc["near_optimal"]] == [106.0, 94.0, 105.0]
     assert doc["near_optimal"][0]["binding_margin"] == "dynamic_corner"
+    # the clearance: not seen by the estimator, said with the measured bound, not silently kept
+    effect = doc["axial_clearance_effect"]
+    assert effect["estimator_sees_it"] is False and effect["moved"] is False
+    assert "[-0.13e12, +3.79e12]" in effect["measured"] and "not significant" in effect["measured"]
     assert abs(doc["near_optimal"][1]["binding_margin_mm"] - 2e-3) < 1e-12
     labels = []
     real = matplotlib.axes.Axes.plot
