@@ -334,6 +334,7 @@ def test_dry_run_lists_the_axes_and_computes_nothing(tmp_path, capsys):
     assert cli_main(["sweep", str(SMALL), "--out", str(out), "--dry-run", "--batch-size", "1"]) == 0
     captured = capsys.readouterr()
     assert "4 cases" in captured.err and "4 batches of 1" in captured.err
+    assert 'START-UP TRANSIENTS (settle = "off"): 0.2 ms' in captured.err  # what every case computes
     assert "operating.speed_rpm [speed_rpm]: 15000.0, 20000.0" in captured.out
     assert not out.exists()
 

@@ -117,6 +117,7 @@ def run(args) -> int:
         f"{spec.num_batches} batches of {spec.batch_size}; spec hash {spec.hash}",
         file=sys.stderr,
     )
+    print(f"  {_running(spec)}", file=sys.stderr)
     if args.dry_run:
         for a in spec.axes:
             print(f"  {a.key} [{a.dim}]: {', '.join(map(str, a.values))}")
@@ -156,3 +157,18 @@ def run(args) -> int:
         first = next(str(s) for s in ds["status"].values.ravel() if s != "ok")
         print(f"first failure: {first}", file=sys.stderr)
     return 0
+
+
+def _running(spec) -> str:
+    """What every case of `spec` computes, in one line."""
+    if not spec.settled:
+        return (
+            f'START-UP TRANSIENTS (settle = "off"): {spec.base.simulation.duration_ms:g} ms from the '
+            "quasi-static start, no intervals"
+        )
+    settle = "until the settling verdict" if spec.settle == "auto" else f"a fixed {spec.settle:g} ms"
+    return (
+        f"settled running: {spec.seeds} seed(s) per case from the {spec.start} start, {settle} "
+        f"(tolerance {spec.settle_tolerance:g}, cap {spec.settle_cap_ms:g} ms), then {spec.window_revs} "
+        "cage revolutions; every statistic with its 95 % interval"
+    )
