@@ -200,3 +200,24 @@ def test_a_settled_sweep_missing_a_batch_resumes_exactly(settled_sweep, tmp_path
     assert sum('"batch": 1' in line for line in log) == 2 and sum('"batch": 0' in line for line in log) == 1
     for name in ("cage_speed_rpm", "flange_pv_Pa_m_s_max_ci95_high", "settle_time_ms", "contact_position"):
         np.testing.assert_array_equal(resumed[name].values, ds[name].values)
+
+
+def test_several_operating_points_in_one_engine_call_equal_their_single_runs():
+    """`simulate_steady_points` (a design's envelope, e.g. the design search's speeds, as members
+    of one engine call) gives each point exactly its own `simulate_steady` (one member at a
+    time: the same decisions, the same numbers). A short run: 2 revolutions measured from the
+    kinematic start."""
+    from jaxbearing.run import simulate_steady, simulate_steady_points
+
+    bearing, op = _small()
+    other = dataclasses.replace(op, inner_speed=op.inner_speed * 0.75)
+    kw = dict(settle="off", window_revs=2, start="quasi-static")
+    both = simulate_steady_points(bearing, [op, other], **kw)
+    alone = simulate_steady(bearing, other, **kw)
+    assert [r.operating is o for r, o in zip(both, (op, other))] == [True, True]
+    assert both[1].runs[0].revolution_speeds_rpm == alone.runs[0].revolution_speeds_rpm
+    assert both[0].runs[0].revolution_speeds_rpm[-1] > both[1].runs[0].revolution_speeds_rpm[-1]
+    with pytest.raises(
+        jb.UserInputError, match=r"^initial_states: 1 given, expected one list per operating point"
+    ):
+        simulate_steady_points(bearing, [op, other], initial_states=[None], **kw)

@@ -6,7 +6,8 @@
   `seated_perturbation` (the initial scatter that starts every roller at zero interference with
   its flange), `forward_jacobian`, and the gradient check's `GRADIENT_HORIZON`,
   `GRADIENT_RTOL`, `GRADIENT_ATOL`;
-- settled running (docs/model.md 17): `steady_design_metrics` (the steady-running design
+- settled running (docs/model.md 17): `steady_design_metrics` (and `steady_design_metrics_points`,
+  a whole envelope in one engine call; the steady-running design
   objective: mean and p95 PV over contact time, corner share and margin, static margins, with
   95 % intervals over seeds; continuation from given states), `SteadyDesignMetrics`,
   `CORNER_MARGIN`;
@@ -31,7 +32,12 @@ from ._design import (
     forward_jacobian,
     seated_perturbation,
 )
-from ._steady_design import CORNER_MARGIN, SteadyDesignMetrics, steady_design_metrics
+from ._steady_design import (
+    CORNER_MARGIN,
+    SteadyDesignMetrics,
+    steady_design_metrics,
+    steady_design_metrics_points,
+)
 from ._steady_gradient import (
     GRADIENT_WINDOW,
     STEADY_FUNCTIONALS,
@@ -60,6 +66,7 @@ __all__ = [
     "ratio_gradient",
     "seated_perturbation",
     "steady_design_metrics",
+    "steady_design_metrics_points",
     "steady_gradient",
     "tangent_growth",
 ]

@@ -53,7 +53,7 @@ from ..flange import (
 )
 from ..geometry import Bearing, OperatingPoint
 from ..io import require
-from ..run import Perturbation, simulate_steady, student_t_interval, summarise_steady
+from ..run import Perturbation, simulate_steady_points, student_t_interval, summarise_steady
 from ._steady_gradient import STEADY_FUNCTIONALS
 
 #: default dynamic corner margin [m]: the largest contact radius this far inside the limited circle
@@ -108,6 +108,40 @@ def steady_design_metrics(
     keyword arguments go to `simulate_steady` (`workers`, `rtol`, `tolerance`, ...).
     `first_seed` selects the seeds (first_seed .. first_seed + seeds - 1): a verification uses
     seeds a search never saw. `initial_states`: continuation (module docstring)."""
+    (metrics,) = steady_design_metrics_points(
+        bearing,
+        [op],
+        design,
+        seeds=seeds,
+        window_revs=window_revs,
+        settle=settle,
+        corner_margin=corner_margin,
+        flange_load=flange_load,
+        first_seed=first_seed,
+        initial_states=None if initial_states is None else [initial_states],
+        **steady_kwargs,
+    )
+    return metrics
+
+
+def steady_design_metrics_points(
+    bearing: Bearing,
+    ops,
+    design: DesignVariables,
+    *,
+    seeds: int = 4,
+    window_revs: int = 4,
+    settle="auto",
+    corner_margin: float = CORNER_MARGIN,
+    flange_load: float = DEFAULT_FLANGE_LOAD,
+    first_seed: int = 0,
+    initial_states=None,
+    **steady_kwargs,
+) -> list[SteadyDesignMetrics]:
+    """`steady_design_metrics` at every operating point of `ops`, every point's seeds members of
+    one call of the steady-running engine (`run.simulate_steady_points`: a design's whole
+    envelope in one process pool, or one vmapped program on an accelerator). `initial_states`:
+    None, or per point None or one state per seed."""
     check_design(bearing, design)
     require("corner_margin", corner_margin, lambda v: np.isfinite(v) & (v >= 0), ">= 0 m")
     require("first_seed", first_seed, lambda v: (v >= 0) & (v == np.round(v)), "an integer >= 0")
@@ -115,9 +149,9 @@ def steady_design_metrics(
     pert = steady_kwargs.pop("perturbation", Perturbation())
     pert = dataclasses.replace(pert, seed=int(first_seed))
     steady_kwargs.setdefault("functionals", STEADY_FUNCTIONALS)
-    result = simulate_steady(
+    results = simulate_steady_points(
         b,
-        op,
+        list(ops),
         settle=settle,
         window_revs=window_revs,
         seeds=seeds,
@@ -125,6 +159,15 @@ def steady_design_metrics(
         initial_states=initial_states,
         **steady_kwargs,
     )
+    margins = np.asarray(zone_margins(b, design, flange_load=flange_load))
+    pv_ref = float(steady_kwargs["functionals"].pv_reference)
+    return [_metrics(result, design, margins, corner_margin, pv_ref) for result in results]
+
+
+def _metrics(
+    result, design: DesignVariables, margins, corner_margin: float, pv_ref: float
+) -> SteadyDesignMetrics:
+    """The design metrics of one operating point's settled run (module docstring)."""
     s = summarise_steady(result)
     none = {"value": None, "ci95_low": None, "ci95_high": None, "n": 0}
     pv = s.get("flange_pv_contact_time_Pa_m_s", {})
@@ -143,14 +186,12 @@ def steady_design_metrics(
             "n": est.get("n", 0),
         }
 
-    pv_ref = float(steady_kwargs["functionals"].pv_reference)
     per_seed = [
         pv_ref * sum(a for a, _ in r.window_integrals) / sum(c for _, c in r.window_integrals)
         if r.status == "ok" and r.window_integrals and sum(c for _, c in r.window_integrals) > 0
         else np.nan
         for r in result.runs
     ]
-    margins = np.asarray(zone_margins(b, design, flange_load=flange_load))
     return SteadyDesignMetrics(
         design={
             "end_radius_m": float(design.end_radius),

@@ -12,7 +12,8 @@
   intervals: `steady_statistics`, `revolution_statistics`, `confidence_intervals`,
   `batch_means`, `student_t_interval`, `Estimate`;
 - settled running: `simulate_steady` (settling detection over cage revolutions, a window,
-  seeds), `summarise_steady`; the steady-running engine under it, `settle_members` (many
+  seeds), `simulate_steady_points` (the same at several operating points, one engine call),
+  `summarise_steady`; the steady-running engine under it, `settle_members` (many
   `Member`s, each a case and a seed, with `SteadyOptions`: one after another, one process per
   core, or vmapped on accelerators, `STRATEGIES`; an `EngineRun`) and `window_statistics`
   (`revolution_statistic_keys`); `solve_from` / `prepare_from` (continue from any state),
@@ -72,6 +73,7 @@ from ._settle import (
     settle_members,
     simulate,
     simulate_steady,
+    simulate_steady_points,
     solve_from,
     summarise,
     summarise_steady,
@@ -167,6 +169,7 @@ __all__ = [
     "STRATEGIES",
     "WINDOW_REVS",
     "settle_members",
+    "simulate_steady_points",
     "revolution_statistic_keys",
     "window_statistics",
 ]

@@ -700,10 +700,63 @@ def simulate_steady(
     neighbouring design's settled run) to start from instead of `start`; settling then runs
     without projective steps (the state is already near its plateau) and `start` is reported
     as "continuation"."""
+    (result,) = simulate_steady_points(
+        bearing,
+        [op],
+        settle=settle,
+        window_revs=window_revs,
+        seeds=seeds,
+        tolerance=tolerance,
+        settle_cap_ms=settle_cap_ms,
+        start=start,
+        rtol=rtol,
+        atol=atol,
+        max_steps=max_steps,
+        saves_per_rev=saves_per_rev,
+        perturbation=perturbation,
+        functionals=functionals,
+        progress=progress,
+        workers=workers,
+        initial_states=None if initial_states is None else [initial_states],
+        solver=solver,
+        strategy=strategy,
+    )
+    return result
+
+
+def simulate_steady_points(
+    bearing: Bearing,
+    ops,
+    *,
+    settle="auto",
+    window_revs: int = WINDOW_REVS,
+    seeds: int = 1,
+    tolerance: float = SETTLE_TOLERANCE,
+    settle_cap_ms: float = SETTLE_CAP_MS,
+    start: str = "skid",
+    rtol: float = 1e-3,
+    atol: float = 1e-6,
+    max_steps: int = 2_000_000,
+    saves_per_rev: int = SAVES_PER_REV,
+    perturbation: Perturbation = Perturbation(),
+    functionals: Functionals = Functionals(),
+    progress: bool = False,
+    workers: int = 1,
+    initial_states=None,
+    solver: str = DEFAULT_SOLVER,
+    strategy: str = "auto",
+) -> list[SteadyResult]:
+    """`simulate_steady` at every operating point of `ops` (a sequence), every point's seeds
+    members of one call of the steady-running engine (`settle_members`: one process pool or one
+    vmapped program for all of them, e.g. a design's whole speed envelope); one `SteadyResult`
+    per point, in order. `initial_states`: None, or per point None or one state per seed. The
+    wall and compilation times of each result are those of the whole call."""
     from ..io import validate_bearing
 
+    ops = list(ops)
     check_solver(solver)
-    validate_bearing(bearing, op)
+    for op in ops:
+        validate_bearing(bearing, op)
     check_steady_options(settle, window_revs, seeds, tolerance, settle_cap_ms, start=start, workers=workers)
     settle = settle if isinstance(settle, str) and settle in ("auto", "off") else float(settle)
     options = SteadyOptions(
@@ -720,28 +773,36 @@ def simulate_steady(
         progress=progress,
         solver=solver,
     )
-    perturbations = [dataclasses.replace(perturbation, seed=perturbation.seed + k) for k in range(int(seeds))]
-    if initial_states is not None:
-        initial_states = list(initial_states)
-        if len(initial_states) != int(seeds):
-            raise UserInputError(
-                f"initial_states: {len(initial_states)} given, expected one per seed ({int(seeds)})"
-            )
-    states = initial_states if initial_states is not None else [None] * len(perturbations)
-    members = [Member(bearing, op, p, s) for p, s in zip(perturbations, states)]
+    n = int(seeds)
+    perturbations = [dataclasses.replace(perturbation, seed=perturbation.seed + k) for k in range(n)]
+    given = list(initial_states) if initial_states is not None else [None] * len(ops)
+    if len(given) != len(ops):
+        raise UserInputError(
+            f"initial_states: {len(given)} given, expected one list per operating point ({len(ops)})"
+        )
+    members = []
+    for op, states in zip(ops, given):
+        if states is not None:
+            states = list(states)
+            if len(states) != n:
+                raise UserInputError(f"initial_states: {len(states)} given, expected one per seed ({n})")
+        members += [Member(bearing, op, p, s) for p, s in zip(perturbations, states or [None] * n)]
     engine = settle_members(members, options, strategy=strategy, workers=workers)
-    return SteadyResult(
-        runs=engine.runs,
-        settle=settle,
-        window_revs=int(window_revs),
-        tolerance=tolerance,
-        cap=settle_cap_ms * 1e-3,
-        start=start if initial_states is None else "continuation",
-        wall_time_s=engine.wall_time_s,
-        compile_time_s=engine.compile_time_s,
-        bearing=bearing,
-        operating=op,
-    )
+    return [
+        SteadyResult(
+            runs=engine.runs[k * n : (k + 1) * n],
+            settle=settle,
+            window_revs=int(window_revs),
+            tolerance=tolerance,
+            cap=settle_cap_ms * 1e-3,
+            start=start if given[k] is None else "continuation",
+            wall_time_s=engine.wall_time_s,
+            compile_time_s=engine.compile_time_s,
+            bearing=bearing,
+            operating=op,
+        )
+        for k, op in enumerate(ops)
+    ]
 
 
 def summarise_steady(result: SteadyResult, threshold: float = 1.0) -> dict:
