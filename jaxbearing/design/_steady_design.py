@@ -108,19 +108,11 @@ def steady_design_metrics(
     keyword arguments go to `simulate_steady` (`workers`, `rtol`, `tolerance`, ...).
     `first_seed` selects the seeds (first_seed .. first_seed + seeds - 1): a verification uses
     seeds a search never saw. `initial_states`: continuation (module docstring)."""
-    (metrics,) = steady_design_metrics_points(
-        bearing,
-        [op],
-        design,
-        seeds=seeds,
-        window_revs=window_revs,
-        settle=settle,
-        corner_margin=corner_margin,
-        flange_load=flange_load,
-        first_seed=first_seed,
-        initial_states=None if initial_states is None else [initial_states],
-        **steady_kwargs,
-    )
+    forwarded = {
+        k: v for k, v in locals().items() if k not in ("bearing", "op", "initial_states", "steady_kwargs")
+    }
+    one = None if initial_states is None else [initial_states]
+    (metrics,) = steady_design_metrics_points(bearing, [op], initial_states=one, **forwarded, **steady_kwargs)
     return metrics
 
 

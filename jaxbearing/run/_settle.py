@@ -700,27 +700,9 @@ def simulate_steady(
     neighbouring design's settled run) to start from instead of `start`; settling then runs
     without projective steps (the state is already near its plateau) and `start` is reported
     as "continuation"."""
-    (result,) = simulate_steady_points(
-        bearing,
-        [op],
-        settle=settle,
-        window_revs=window_revs,
-        seeds=seeds,
-        tolerance=tolerance,
-        settle_cap_ms=settle_cap_ms,
-        start=start,
-        rtol=rtol,
-        atol=atol,
-        max_steps=max_steps,
-        saves_per_rev=saves_per_rev,
-        perturbation=perturbation,
-        functionals=functionals,
-        progress=progress,
-        workers=workers,
-        initial_states=None if initial_states is None else [initial_states],
-        solver=solver,
-        strategy=strategy,
-    )
+    forwarded = {k: v for k, v in locals().items() if k not in ("bearing", "op", "initial_states")}
+    one = None if initial_states is None else [initial_states]
+    (result,) = simulate_steady_points(bearing, [op], initial_states=one, **forwarded)
     return result
 
 
