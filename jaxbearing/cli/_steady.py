@@ -7,7 +7,7 @@ skid start (`--start skid`, default: the speeds of steady running, then projecti
 cage speed while settling; `--start quasi-static`: kinematic speeds), settling (`auto`: until
 the remaining drift of the cage speed, the trend of the last 4-8 revolution means times the slow
 mode's time constant, is below `--settle-tolerance`, at most `--settle-cap-ms`; docs/model.md
-16; MS: a fixed settling time; `off`: none), then a window of `--window-revs` revolutions for each of
+16; MS: a fixed settling time), then a window of `--window-revs` revolutions for each of
 `--seeds` seeds. Every statistic is printed with its 95 % confidence interval.
 """
 
