@@ -45,12 +45,15 @@ def test_vector_field_finite_at_unphysical_states():
     for state in (y0, bad):
         rates = f(state)
         assert all(bool(jnp.all(jnp.isfinite(x))) for x in jax.tree_util.tree_leaves(rates))
-    # and its derivative with respect to the state
-    jac = jax.jacfwd(
-        lambda r: (
-            physical_rates(
-                0.0, eqx.tree_at(lambda s: s.rollers.radial, bad, r), params
-            ).rollers.radial_velocity
+    # and its derivative with respect to the state (compiled: op by op it dispatches thousands
+    # of small programs)
+    jac = jax.jit(
+        jax.jacfwd(
+            lambda r: (
+                physical_rates(
+                    0.0, eqx.tree_at(lambda s: s.rollers.radial, bad, r), params
+                ).rollers.radial_velocity
+            )
         )
     )(bad.rollers.radial)
     assert bool(jnp.all(jnp.isfinite(jac)))

@@ -40,7 +40,9 @@ def test_no_drag_no_land_film_gives_pure_rolling(reference):
     b, op = reference
     b = eqx.tree_at(lambda b: b.lubricant.oil_fraction, b, 0.0)
     op = eqx.tree_at(lambda o: o.gravity, op, 0.0)
-    skid = skid_start(b, op, None)
+    # no scatter, as a zero-amplitude perturbation: the skid-start program every other skid start
+    # in the suite uses (None is a program of its own, 18 s cold)
+    skid = skid_start(b, op, Perturbation(axial=0.0, skew=0.0))
     w_kin = float(kinematic_cage_speed(b, op))
     assert float(skid.equilibrium.cage_speed) == pytest.approx(w_kin, rel=1e-3)
     spin = np.asarray(skid.state.rollers.angular_velocity[:, 0])

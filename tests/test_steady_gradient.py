@@ -1,10 +1,13 @@
 """The gradient estimator of the steady objective (issue 13, item 2; design/_steady_gradient.py).
 
 Fast checks at a reduced size (11 slices per raceway): the ratio estimator's derivative and
-its jackknife against closed forms, and the forward-mode short-window sensitivities against
-central differences of the same window integrals from the same settled-running states (common
-random numbers: the estimator differentiates exactly this). The bias of the estimator against
-the derivative of the settled mean is measured in benchmarks/studies/bench_steady_gradient.py."""
+its jackknife against closed forms, the frozen-load estimator (the default) against central
+differences of its own functional and against common-random-number differences of the settled
+objective. Slow (`make test-slow`): the forward-mode short-window sensitivities against central
+differences of the same window integrals from the same states, and the tangent growth, the
+studied alternatives to the frozen-load estimator (notebook 05 runs `tangent_growth` and
+asserts the same of it in the default suite). The bias of the estimators against the
+derivative of the settled mean is measured in benchmarks/studies/bench_steady_gradient.py."""
 
 import dataclasses
 
@@ -94,8 +97,11 @@ def running():
     return b, op, states
 
 
+@pytest.mark.slow
 def test_short_window_sensitivities_match_central_differences(running):
-    """Forward mode through the window solve against central differences of the same
+    """Slow: the short-window forward mode is a studied alternative, not the default estimator.
+
+    Forward mode through the window solve against central differences of the same
     integrals from the same states (tight tolerances: the FD needs them), to 1 % at one of the
     relative steps `FD_STEPS`. No one step serves every trajectory: the FD of an adaptive solve
     carries the noise of a second compiled program's steps, which grows as the step shrinks,
@@ -136,25 +142,54 @@ def test_short_window_sensitivities_match_central_differences(running):
             )
 
 
+@pytest.mark.slow
 def test_tangent_growth_is_finite_and_starts_at_zero(running):
+    """Slow: a studied alternative's diagnostic; notebook 05 (default suite) asserts the same."""
     b, op, states = running
     ts, norms = tangent_growth(b, op, DesignVariables.of(b), states[0], 0.2e-3, num_saves=5)
     assert norms.shape == (3, 5) and np.all(np.isfinite(norms))
     assert np.all(norms[:, 0] == 0.0) and np.all(norms[:, -1] > 0)
 
 
-def test_frozen_load_derivative_matches_central_differences(running):
+@pytest.fixture(scope="module")
+def settled():
+    """The reduced-size settled ensemble of the CRN check (11 slices, 3 seeds, 2-revolution
+    windows, measured 5 us after the skid start, which lands on the plateau)."""
+    from jaxbearing.design import steady_design_metrics
+
+    b = dataclasses.replace(jb.reference_bearing(), num_slices=11)
+    op = jb.reference_operating_point()
+    x = np.asarray(DesignVariables.of(b).as_array())
+    base = steady_design_metrics(
+        b, op, DesignVariables.from_array(x), settle=0.005, seeds=3, window_revs=2, workers=1
+    )
+    return b, op, x, base
+
+
+def _frozen_window_states(b, op, state, window=1e-3, num_saves=200):
+    """The saved states of `frozen_load_gradient`'s window from `state` (its default 1 ms, 200
+    saves: the very program it compiles, `trajectory_states`) and the solve's result code."""
+    from jaxbearing.run import compiled_program
+
+    args = (b, op, jax.tree_util.tree_map(jnp.asarray, state), jnp.asarray(window), jnp.asarray(1e-3))
+    run = lambda b_, o, s, d, r: trajectory_states(b_, o, s, d, num_saves, rtol=r)  # noqa: E731
+    return compiled_program("trajectory_states", run, args, num_saves)(*args)
+
+
+def test_frozen_load_derivative_matches_central_differences(settled):
     """The frozen-load estimator's derivative (jax.jacfwd through the flange geometry and the
     exact-Hertz radii at the loads the dynamics gave) against central differences of the same
-    frozen functional on the same saved states (relative steps 1e-6)."""
+    frozen functional on the same saved states (relative steps 1e-6): the states of the
+    estimator's own 1 ms window from a settled state."""
     from jaxbearing.design._steady_gradient import frozen_load_integrands
     from jaxbearing.dynamics import Params
 
-    b, op, states = running
+    b, op, _, base = settled
     x = jnp.asarray(DesignVariables.of(b).as_array())
-    saved, code, q0 = _window_flange_forces(b, op, states[0])
+    saved, code = _frozen_window_states(b, op, base.sample_states[0])
     assert int(code) == 0
     params = Params(bearing=b, operating=op, functionals=STEADY_FUNCTIONALS)
+    q0 = jax.jit(jax.vmap(lambda s: contact_loads(s, params).flange.normal_force))(saved)
     assert float(jnp.sum(q0 > 1.0)) > 0  # some flange contact among the saved states
 
     @jax.jit
@@ -174,7 +209,7 @@ def test_frozen_load_derivative_matches_central_differences(running):
     assert float(value[0]) == pytest.approx(float(direct), rel=1e-9)
 
 
-def test_frozen_load_estimator_agrees_with_crn_differences_on_settled_running():
+def test_frozen_load_estimator_agrees_with_crn_differences_on_settled_running(settled):
     """The acceptance check of benchmarks/studies/bench_steady_gradient.py at reduced size (11 slices,
     3 seeds, theta_f at the reference design), in the default suite: running from the skid start
     (which lands on the plateau, tests/test_skid.py), then a common-random-number central
@@ -194,12 +229,9 @@ def test_frozen_load_estimator_agrees_with_crn_differences_on_settled_running():
     study is benchmarks/studies/bench_steady_gradient.py."""
     from jaxbearing.design import frozen_load_gradient, steady_design_metrics
 
-    b = dataclasses.replace(jb.reference_bearing(), num_slices=11)
-    op = jb.reference_operating_point()
-    x = np.asarray(DesignVariables.of(b).as_array())
+    # the skid start lands on the plateau (tests/test_skid.py): measured almost at once (5 us)
+    b, op, x, base = settled
     kw = dict(seeds=3, window_revs=2, workers=1)
-    # the skid start lands on the plateau (tests/test_skid.py): measure almost at once (5 us)
-    base = steady_design_metrics(b, op, DesignVariables.from_array(x), settle=0.005, **kw)
     h = 0.15 * np.radians(1.0)  # 15 % of the optimiser's theta_f range (1-2 deg)
     per_seed = []
     for sign in (1.0, -1.0):
