@@ -18,11 +18,14 @@ jax.config.update("jax_enable_x64", True)
 #: take whole files in collection order, so the longest start first and the short files fill
 #: in at the end (longest-processing-time-first scheduling). Unlisted files follow in their
 #: usual order.
+#: test_engine.py (issue 34: a settled sweep, vmapped members, a resumed batch, several
+#: operating points; about 3 minutes of 11-slice settled runs) sits with the steady-gradient file.
 SLOWEST_FILES_FIRST = (
     "test_notebooks.py",
     "test_sweep_distributed.py",
     "test_optimise.py",
     "test_steady_gradient.py",
+    "test_engine.py",
     "test_settle.py",
     "test_cmd_simulate.py",
     "test_skid.py",
