@@ -278,10 +278,11 @@ class SeedRun:
 
 
 def check_steady_options(
-    settle, window_revs, seeds, tolerance, cap_ms, names=None, *, start="skid", workers=1
+    settle, window_revs, seeds, tolerance, cap_ms, names=None, *, start="skid", workers=1, prefix=""
 ) -> None:
-    """One-line `UserInputError` naming the option for a bad value of the settled-run options."""
-    n = {
+    """One-line `UserInputError` naming the option for a bad value of the settled-run options
+    (named `prefix` + the keyword's name, e.g. "sweep.seeds", unless `names` says otherwise)."""
+    defaults = {
         "settle": "settle",
         "window_revs": "window_revs",
         "seeds": "seeds",
@@ -289,8 +290,8 @@ def check_steady_options(
         "cap_ms": "settle_cap_ms",
         "start": "start",
         "workers": "workers",
-        **(names or {}),
     }
+    n = {**{k: prefix + v for k, v in defaults.items()}, **(names or {})}
     if start not in STARTS:
         from .._errors import UserInputError
 

@@ -164,8 +164,8 @@ def _settled_fields(sweep: Mapping[str, Any]) -> dict[str, Any]:
         got["seeds"],
         got["settle_tolerance"],
         got["settle_cap_ms"],
-        {k: f"sweep.{v}" for k, v in _STEADY_NAMES.items()},
         start=got["start"],
+        prefix="sweep.",
     )
     return {
         "settle": settle if isinstance(settle, str) else float(settle),
@@ -175,17 +175,6 @@ def _settled_fields(sweep: Mapping[str, Any]) -> dict[str, Any]:
         "settle_cap_ms": float(got["settle_cap_ms"]),
         "start": got["start"],
     }
-
-
-#: `check_steady_options`' names of the [sweep] fields
-_STEADY_NAMES = {
-    "settle": "settle",
-    "window_revs": "window_revs",
-    "seeds": "seeds",
-    "tolerance": "settle_tolerance",
-    "cap_ms": "settle_cap_ms",
-    "start": "start",
-}
 
 
 def _sweep_table(sweep) -> Mapping[str, Any]:
