@@ -34,7 +34,6 @@ import time
 from collections.abc import Callable, Sequence
 
 import jax
-import jax.numpy as jnp
 import numpy as np
 
 from ._compile_cache import compiled_program
@@ -175,8 +174,3 @@ def drive_batched(
                 del pending[i]
         times.host_s += time.perf_counter() - h0
     return results
-
-
-def as_jax(tree):
-    """A pytree of numpy leaves as jax arrays (a member's given state)."""
-    return jax.tree_util.tree_map(jnp.asarray, tree)

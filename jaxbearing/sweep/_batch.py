@@ -209,32 +209,34 @@ def _summarise_case(spec: SweepSpec, sol, inputs) -> dict:
     row["status"] = np.asarray(res.status)
     row["result_code"] = np.int32(int(sol.result))
     # compact sample of contact positions on the end face (roller frame y, z [m])
-    h = res.histories
-    points = np.full((spec.max_positions, 2), np.nan)
-    count = 0
-    if res.ok and len(h["t"]):
-        mask = np.asarray(h["flange_force"]) > CONTACT_THRESHOLD  # (T, Z, 4)
-        pos = np.asarray(h["end_face_position"])[mask]  # (K, 2)
-        if len(pos) > spec.max_positions:
-            pos = pos[np.linspace(0, len(pos) - 1, spec.max_positions).round().astype(int)]
-        count = len(pos)
-        points[:count] = pos
-    row["contact_position"] = points
-    row["contact_position_count"] = np.int32(count)
+    row.update(_position_columns(_positions(res.histories if res.ok else {}, spec.max_positions), spec))
     return row
 
 
-# -- settled running -----------------------------------------------------------------------------
-def _positions(window: dict, max_positions: int) -> np.ndarray:
+def _evenly(points: np.ndarray, most: int) -> np.ndarray:
+    """At most `most` of `points`, evenly spaced over them."""
+    if len(points) > most:
+        points = points[np.linspace(0, len(points) - 1, most).round().astype(int)]
+    return points
+
+
+def _positions(histories: dict, max_positions: int) -> np.ndarray:
     """Up to `max_positions` flange contact points on the end face (roller frame y, z [m]),
-    evenly subsampled over the window's contact samples."""
-    if not window or not len(window.get("t", ())):
+    evenly subsampled over the contact samples of `histories` (none for empty histories)."""
+    if not histories or not len(histories.get("t", ())):
         return np.zeros((0, 2))
-    mask = np.asarray(window["flange_force"]) > CONTACT_THRESHOLD  # (T, Z, 4)
-    pos = np.asarray(window["end_face_position"])[mask]
-    if len(pos) > max_positions:
-        pos = pos[np.linspace(0, len(pos) - 1, max_positions).round().astype(int)]
-    return pos
+    mask = np.asarray(histories["flange_force"]) > CONTACT_THRESHOLD  # (T, Z, 4)
+    return _evenly(np.asarray(histories["end_face_position"])[mask], max_positions)  # (K, 2)
+
+
+def _position_columns(pos: np.ndarray, spec: SweepSpec) -> dict:
+    """A case's `contact_position` (NaN-padded to `spec.max_positions`) and its count."""
+    points = np.full((spec.max_positions, 2), np.nan)
+    points[: len(pos)] = pos
+    return {"contact_position": points, "contact_position_count": np.int32(len(pos))}
+
+
+# -- settled running -----------------------------------------------------------------------------
 
 
 @dataclasses.dataclass(frozen=True)
@@ -310,7 +312,7 @@ def settle_batch(spec: SweepSpec, cases: Sequence[int], devices: Sequence | None
 
 
 def _settled_row(spec: SweepSpec, runs, member) -> dict:
-    from ..run import SteadyResult, summarise_steady
+    from ..run import SteadyResult, revolution_statistic_keys, summarise_steady
 
     result = SteadyResult(
         runs=list(runs),
@@ -339,8 +341,6 @@ def _settled_row(spec: SweepSpec, runs, member) -> dict:
         "residual_drift_bound_rpm": num(block.get("residual_drift_bound_rpm")),
         "num_steps": np.float64(block["num_steps"]),
     }
-    from ..run import revolution_statistic_keys
-
     for key in revolution_statistic_keys():
         group, _, red = key.partition(".")
         est = (block.get(group, {}).get(red) if red else block.get(group)) or {}
@@ -350,11 +350,6 @@ def _settled_row(spec: SweepSpec, runs, member) -> dict:
         row[name + "_ci95_high"] = num(est.get("ci95_high"))
     row["status"] = np.asarray(block["status"])
     row["result_code"] = np.int32(0 if block["status"] == "ok" else 1)
-    points = np.full((spec.max_positions, 2), np.nan)
     pos = np.concatenate([r.extras.get("positions", np.zeros((0, 2))) for r in runs])
-    if len(pos) > spec.max_positions:
-        pos = pos[np.linspace(0, len(pos) - 1, spec.max_positions).round().astype(int)]
-    points[: len(pos)] = pos
-    row["contact_position"] = points
-    row["contact_position_count"] = np.int32(len(pos))
+    row.update(_position_columns(_evenly(pos, spec.max_positions), spec))
     return row
