@@ -19,7 +19,14 @@ Members per hour = members / wall time without compilation (each strategy's comp
 or loading from the persistent cache, is reported beside it). Ratios are against (1), measured in
 the same run. On an accelerator (`jax.default_backend() != "cpu"`), the vmapped engine is also
 timed against the batch size (`--batch-sizes 1,8,64,512,4096`; members = seeds of the reference
-case), members per second per size.
+case), members per second per size, and one iteration of the 3-speed design search is timed
+(`--search-iteration`: `optimise`'s `evaluate_starts`, 2 starts x 3 speeds (10,000, 20,000
+and 30,000 rpm) x 4 seeds settled as one engine call, then the frozen-load gradients of their
+48 trajectories as one vmapped program; twice: the first call compiles, the second continues
+from the first's states as the search's next iteration does).
+
+`--accelerator-only` skips the CPU strategies (on an accelerator, batch size 1 is the per-case
+loop's baseline); `--results-dir DIR` writes the JSON there, after every batch size.
 """
 
 from __future__ import annotations
@@ -78,15 +85,52 @@ def _intervals(engine, members, seeds):
     return out
 
 
-def main(quick: bool = False, batch_sizes: str | None = None) -> dict:
+def main(
+    quick: bool = False,
+    batch_sizes: str | None = None,
+    accelerator_only: bool = False,
+    search_iteration: bool = False,
+    results_dir: str | None = None,
+) -> dict:
     import jax
 
-    from jaxbearing.run import SteadyOptions, settle_members
+    from jaxbearing.run import SteadyOptions
 
     started = time.perf_counter()
     speeds = [20000.0] if quick else [15000.0, 20000.0]
     seeds = 2
     options = SteadyOptions(window_revs=2 if quick else 4, tolerance=2e-3)
+    data = {
+        "machine": _common.machine_info(),
+        "backend": jax.default_backend(),
+        "quick": quick,
+        "speeds_rpm": speeds,
+        "seeds": seeds,
+        "window_revs": options.window_revs,
+        "num_slices": 11,
+    }
+    name = NAME if not quick else NAME + "_quick"
+    if not accelerator_only:
+        data.update(_strategies(options, speeds, seeds))
+    if jax.default_backend() != "cpu":
+        sizes = [int(v) for v in (batch_sizes or "1,8,64,512,4096").split(",")]
+        data["accelerator_batch_sizes"] = []
+        for row in _batch_sizes(options, sizes):
+            data["accelerator_batch_sizes"].append(row)
+            _common.write_json(name, data, results_dir)
+    if search_iteration:
+        data["search_iteration"] = _search_iteration()
+    data["wall_s"] = time.perf_counter() - started
+    _common.write_json(name, data, results_dir)
+    return data
+
+
+def _strategies(options, speeds, seeds) -> dict:
+    """The three strategies on the same members, in this run (module docstring)."""
+    import jax
+
+    from jaxbearing.run import settle_members
+
     members = _members(speeds, seeds)
     # the worker processes import jaxbearing from this checkout
     os.environ["PYTHONPATH"] = os.pathsep.join(
@@ -145,47 +189,66 @@ def main(quick: bool = False, batch_sizes: str | None = None) -> dict:
         rows,
     )
     print(table)
-    accelerator = None
-    if jax.default_backend() != "cpu":
-        accelerator = _batch_sizes(options, [int(s) for s in (batch_sizes or "1,8,64,512,4096").split(",")])
-    data = {
-        "machine": _common.machine_info(),
-        "quick": quick,
-        "speeds_rpm": speeds,
-        "seeds": seeds,
-        "window_revs": options.window_revs,
-        "num_slices": 11,
-        "strategies": results,
-        "accelerator_batch_sizes": accelerator,
-        "wall_s": time.perf_counter() - started,
-        "table": table,
-    }
-    _common.write_json(NAME if not quick else NAME + "_quick", data)
-    return data
+    return {"strategies": results, "table": table}
 
 
 def _batch_sizes(options, sizes):
-    """Members per second of the vmapped engine against the batch size (accelerators only)."""
+    """Members per second of the vmapped engine against the batch size (accelerators only),
+    one row per size as it finishes."""
     from jaxbearing.run import settle_members
 
-    out = []
     for n in sizes:
         members = _members([20000.0], n)
         _common.log(f"{NAME}: vmapped batch of {n}")
         engine = settle_members(members, options, strategy="vmap")
-        out.append(
-            {
-                "batch_size": n,
-                "wall_s": engine.wall_time_s,
-                "compile_s": engine.compile_time_s,
-                "members_per_s": n / engine.wall_time_s,
-                "settled_share": sum(r.settled for r in engine.runs) / n,
-                "rounds": engine.batch_times.rounds,
-            }
-        )
-        print(out[-1], flush=True)
+        row = {
+            "batch_size": n,
+            "wall_s": engine.wall_time_s,
+            "compile_s": engine.compile_time_s,
+            "members_per_s": n / engine.wall_time_s,
+            "members_per_hour": n / engine.wall_time_s * 3600,
+            "settled_share": sum(r.settled for r in engine.runs) / n,
+            "batch_times": dataclasses.asdict(engine.batch_times),
+            "intervals": _intervals(engine, members, n),
+        }
+        print(row, flush=True)
+        yield row
+
+
+def _search_iteration() -> dict:
+    """One iteration of the 3-speed design search, twice (module docstring)."""
+    import jaxbearing as jb
+    from optimise import make_problem
+    from optimise._steady import SteadySettings, evaluate_starts, start_points
+
+    bearing = dataclasses.replace(jb.reference_bearing(), num_slices=11)
+    problem = make_problem(bearing, jb.reference_operating_point(), speeds_rpm=[10000.0, 20000.0, 30000.0])
+    settings = SteadySettings(seeds=4, window_revs=2)
+    us = list(start_points(problem, 2))
+    out, chains = {"starts": 2, "speeds_rpm": [10000, 20000, 30000], "seeds": 4, "calls": []}, [None, None]
+    for call in ("first (compiles)", "second (continuation)"):
+        _common.log(f"{NAME}: search iteration, {call}")
+        t0 = time.perf_counter()
+        evaluations = evaluate_starts(problem, settings, us, chains)
+        wall = time.perf_counter() - t0
+        chains = [ev.states for ev in evaluations]
+        row = {
+            "call": call,
+            "wall_s": wall,
+            "objective_GPa_m_s": [ev.objective for ev in evaluations],
+            "gradient": [ev.gradient.tolist() for ev in evaluations],
+            "simulated_ms": sum(ev.simulated_ms for ev in evaluations),
+        }
+        print(row, flush=True)
+        out["calls"].append(row)
     return out
 
 
 if __name__ == "__main__":
-    main(quick="--quick" in sys.argv, batch_sizes=_common.option_value(sys.argv, "--batch-sizes"))
+    main(
+        quick="--quick" in sys.argv,
+        batch_sizes=_common.option_value(sys.argv, "--batch-sizes"),
+        accelerator_only="--accelerator-only" in sys.argv,
+        search_iteration="--search-iteration" in sys.argv,
+        results_dir=_common.option_value(sys.argv, "--results-dir"),
+    )

@@ -62,7 +62,7 @@ from jaxbearing import UserInputError
 from jaxbearing.design import (
     CORNER_MARGIN,
     SteadyGradient,
-    frozen_load_gradient,
+    frozen_load_gradients,
     steady_design_metrics,
     steady_design_metrics_points,
     steady_gradient,
@@ -129,7 +129,11 @@ class SteadySettings:
 
     @property
     def num_workers(self) -> int:
-        return int(self.workers) or available_cpus()
+        """`workers`, or 0: one per CPU; on an accelerator one (the members are vmapped there,
+        and worker processes would each claim the device)."""
+        if int(self.workers):
+            return int(self.workers)
+        return available_cpus() if jax.default_backend() == "cpu" else 1
 
 
 def _in_shared_pool(function):
@@ -171,41 +175,76 @@ def evaluate(
 ) -> Evaluation:
     """Settled objective and constraints of the scaled design u (one settled ensemble per
     operating point, continuing from `states` when given) and, with `gradient`, the estimated
-    gradient (NaN without)."""
+    gradient (NaN without): `evaluate_starts` of one start."""
+    (ev,) = evaluate_starts(problem, settings, [u], [states], gradient=gradient)
+    return ev
+
+
+def evaluate_starts(
+    problem: DesignProblem, settings: SteadySettings, us, chains, *, gradient: bool = True
+) -> list[Evaluation]:
+    """`evaluate` of every scaled design of `us` (the starts of one iteration; `chains`: the
+    continuation states of each, or None): every start's operating points' seeds are members
+    of one call of the steady-running engine, and every trajectory of the frozen-load
+    gradients of one call of `frozen_load_gradients` (on an accelerator, one vmapped program
+    each). The wall time of each evaluation is the whole call's."""
     t0 = time.perf_counter()
-    design = problem.design(jnp.asarray(u))
     width = np.asarray(problem.bounds.upper - problem.bounds.lower)
-    per, new_states, simulated = [], [], 0.0
     ops = [_operating_point(problem, k) for k in range(problem.num_operating_points)]
-    # every operating point's seeds are members of one call of the steady-running engine
+    designs = [problem.design(jnp.asarray(u)) for u in us]
+    chains = [None] * len(designs) if chains is None else list(chains)
+    initial = [None if c is None else c[k] for c in chains for k in range(len(ops))]
     metrics = steady_design_metrics_points(
         problem.bearing,
-        ops,
-        design,
+        ops * len(designs),
+        [d for d in designs for _ in ops],
         seeds=settings.seeds,
         window_revs=settings.window_revs,
         settle=settings.settle,
         corner_margin=settings.corner_margin,
         flange_load=problem.flange_load,
-        initial_states=None if states is None else list(states),
+        initial_states=None if all(c is None for c in chains) else initial,
         workers=settings.num_workers,
         rtol=settings.rtol,
     )
-    for op, m in zip(ops, metrics):
-        estimate = frozen_load_gradient if settings.estimator == "frozen" else steady_gradient
-        g = (
-            SteadyGradient.missing()
-            if not gradient
-            else estimate(
-                design.apply(problem.bearing),
-                op,
-                design,
-                m.sample_states,
-                window=settings.gradient_window,
-                rtol=settings.rtol,
-                workers=settings.num_workers,
-            )
+    cases = [
+        (d.apply(problem.bearing), op, d, m.sample_states)
+        for d, (op, m) in zip([d for d in designs for _ in ops], zip(ops * len(designs), metrics))
+    ]
+    if not gradient:
+        gradients = [SteadyGradient.missing() for _ in cases]
+    elif settings.estimator == "frozen":
+        gradients = frozen_load_gradients(
+            cases, window=settings.gradient_window, rtol=settings.rtol, workers=settings.num_workers
         )
+    else:
+        gradients = [
+            steady_gradient(
+                *case, window=settings.gradient_window, rtol=settings.rtol, workers=settings.num_workers
+            )
+            for case in cases
+        ]
+    wall = time.perf_counter() - t0
+    n = len(ops)
+    return [
+        _evaluation(
+            problem,
+            settings,
+            u,
+            metrics[s * n : (s + 1) * n],
+            gradients[s * n : (s + 1) * n],
+            width,
+            wall,
+            gradient,
+        )
+        for s, u in enumerate(us)
+    ]
+
+
+def _evaluation(problem, settings, u, metrics, gradients, width, wall, gradient: bool) -> Evaluation:
+    """One start's `Evaluation` from its operating points' metrics and gradient estimates."""
+    per, new_states, simulated = [], [], 0.0
+    for m, g in zip(metrics, gradients):
         j = m.objective
         per.append(
             dict(
@@ -240,7 +279,7 @@ def evaluate(
         static_margins=np.asarray(problem.margins(jnp.asarray(u))),
         dynamic_margin=float(min(p["corner_margin"] for p in per)),
         states=new_states,
-        wall_time_s=time.perf_counter() - t0,
+        wall_time_s=wall,
         simulated_ms=simulated,
     )
 
@@ -385,9 +424,10 @@ def steady_search(
     for it in range(state["iteration"] + 1, num_iterations + 1):
         rows = {k: [] for k in empty}
         u_next, opt_next, lam_next = [], [], []
-        for s in range(num_starts):
+        # every start's evaluation in one engine call (and one gradient call)
+        evaluations = evaluate_starts(problem, settings, list(state["u"]), state["chains"])
+        for s, ev in enumerate(evaluations):
             us = state["u"][s]
-            ev = evaluate(problem, settings, us, state["chains"][s])
             state["chains"][s] = ev.states
             state["evaluations"] += problem.num_operating_points
             c, jc = _constraints(problem, us, ev.dynamic_margin, us)

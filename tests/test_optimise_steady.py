@@ -4,8 +4,10 @@
 Checked: the settings' one-line errors; a run killed after its first iteration resumes from
 the checkpoint and ends with exactly the result of an uninterrupted run; the verification uses
 seeds the search never saw and reports value and CI of mean PV, p95 PV and corner share. The
-mechanics run on stand-ins for the settled ensemble (seconds instead of minutes); the real
-ensemble is measured in tests/test_steady_design.py and by the search in notebook 05."""
+mechanics run on stand-ins for the settled ensemble (seconds instead of minutes); one
+iteration's evaluation of two starts runs on real settled running (one engine call, one
+gradient call), and the real ensemble is measured in tests/test_steady_design.py and by the
+search in notebook 05."""
 
 import json
 import math
@@ -106,12 +108,17 @@ def _stand_in(problem, settings, u, states=None, *, gradient=True):
     )
 
 
+def _stand_in_starts(problem, settings, us, chains, *, gradient=True):
+    """`_stand_in` for every start of an iteration (`steady.evaluate_starts`)."""
+    return [_stand_in(problem, settings, u, c, gradient=gradient) for u, c in zip(us, chains)]
+
+
 def test_killed_run_resumes_with_the_same_result(tmp_path, config, monkeypatch, capsys):
     """The checkpoint mechanics of the steady search through the command line, on a stand-in
     for the settled ensemble: a run killed in its second evaluation exits 130 with a checkpoint
     and no result, resumes after iteration 0 with the continuation states, and ends with exactly
     the history and design of an uninterrupted run; other settings are refused."""
-    monkeypatch.setattr(steady, "evaluate", _stand_in)
+    monkeypatch.setattr(steady, "evaluate_starts", _stand_in_starts)
     args = ["--estimator", "window", "--corner-margin-mm", "0.04", *ARGS]
     args[args.index("--iterations") + 1] = "2"
     whole, killed = tmp_path / "whole", tmp_path / "killed"
@@ -137,7 +144,7 @@ def test_killed_run_resumes_with_the_same_result(tmp_path, config, monkeypatch, 
 
     # kill the second run in its second evaluation (after iteration 0 was checkpointed)
     calls = {"n": 0}
-    evaluate = _stand_in
+    evaluate = _stand_in_starts
 
     def dying(*a, **k):
         calls["n"] += 1
@@ -145,11 +152,11 @@ def test_killed_run_resumes_with_the_same_result(tmp_path, config, monkeypatch, 
             raise KeyboardInterrupt
         return evaluate(*a, **k)
 
-    monkeypatch.setattr(steady, "evaluate", dying)
+    monkeypatch.setattr(steady, "evaluate_starts", dying)
     # the command line reports the interruption (exit code 130) and writes no result
     assert main(["run", "--config", config, *args, "--no-verify", "--out", str(killed)]) == 130
     assert (killed / "checkpoint.npz").exists() and not (killed / "result.json").exists()
-    monkeypatch.setattr(steady, "evaluate", evaluate)
+    monkeypatch.setattr(steady, "evaluate_starts", evaluate)
     assert main(["run", "--config", config, *args, "--no-verify", "--out", str(killed)]) == 0
     text = capsys.readouterr().out
     assert "resumed after iteration 0" in text and "iter   1" in text  # without --quiet
@@ -193,7 +200,7 @@ def test_verify_seeds_option_reaches_the_verification(tmp_path, config, monkeypa
     """`optimise run --verify-seeds 3`: the verification re-measures the reference and the found
     design with 3 seeds from 1000 on (stand-ins for the search's ensemble and for
     `steady_design_metrics`; the real ones are in tests/test_steady_design.py)."""
-    monkeypatch.setattr(steady, "evaluate", _stand_in)
+    monkeypatch.setattr(steady, "evaluate_starts", _stand_in_starts)
     calls = []
     monkeypatch.setattr(steady, "steady_design_metrics", _metrics_stand_in(calls))
     out = tmp_path / "verified"
@@ -275,3 +282,43 @@ def test_grid_picks_the_best_point_inside_every_margin_and_resumes(tmp_path, con
     seen.clear()
     again = steady.steady_grid(problem, settings, 4, 3, 0.15e-3, directory=tmp_path)
     assert seen == [] and again["best_objective"] == grid["best_objective"]
+
+
+def test_an_iteration_evaluates_every_start_in_one_engine_call(monkeypatch):
+    """`evaluate_starts` on real settled running (11 slices, 2 starts, 2 seeds, a 0.005 ms
+    settle: the skid start lands on the plateau, two-revolution windows, 0.1 ms frozen-load
+    windows): every start's seeds are members of one call of the steady-running engine and
+    every start's gradient trajectories of one `frozen_load_gradients` call, and each start
+    gets its own design's objective (its interval around it), gradient, static margins and
+    continuation states."""
+    import dataclasses
+
+    import jaxbearing as jb
+    from optimise import make_problem
+
+    calls = {"engine": 0, "gradients": []}
+    engine, gradients = steady.steady_design_metrics_points, steady.frozen_load_gradients
+
+    def counted_engine(*a, **k):
+        calls["engine"] += 1
+        return engine(*a, **k)
+
+    def counted_gradients(cases, **k):
+        calls["gradients"].append(len(cases))
+        return gradients(cases, **k)
+
+    monkeypatch.setattr(steady, "steady_design_metrics_points", counted_engine)
+    monkeypatch.setattr(steady, "frozen_load_gradients", counted_gradients)
+    bearing = dataclasses.replace(jb.reference_bearing(), num_slices=11)
+    problem = make_problem(bearing, jb.reference_operating_point())
+    settings = steady.SteadySettings(seeds=2, window_revs=2, settle=0.005, gradient_window=0.1e-3, workers=1)
+    us = [np.array([0.5, 0.5, 0.25]), np.array([0.8, 0.3, 0.25])]
+    evaluations = steady.evaluate_starts(problem, settings, us, [None, None])
+    assert calls == {"engine": 1, "gradients": [2]}
+    for u, ev in zip(us, evaluations):
+        lo, hi = ev.objective_ci
+        assert np.isfinite(ev.objective) and lo <= ev.objective <= hi
+        assert np.all(np.isfinite(ev.gradient[:2])) and np.any(ev.gradient[:2] != 0)
+        np.testing.assert_array_equal(ev.static_margins, np.asarray(problem.margins(jnp.asarray(u))))
+        assert len(ev.states) == 1 and len(ev.states[0]) == 2  # one operating point, two seeds
+    assert evaluations[0].objective != evaluations[1].objective

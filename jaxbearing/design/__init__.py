@@ -12,7 +12,7 @@
   95 % intervals over seeds; continuation from given states), `SteadyDesignMetrics`,
   `CORNER_MARGIN`;
 - its gradient: `steady_gradient` (an ensemble of short-window forward-mode sensitivities from
-  settled states, `GRADIENT_WINDOW`), `frozen_load_gradient`, `ratio_gradient`,
+  settled states, `GRADIENT_WINDOW`), `frozen_load_gradient` (`frozen_load_gradients`: many cases, one call), `ratio_gradient`,
   `SteadyGradient`, `tangent_growth` (finite-time growth of the tangents) and the smooth
   accumulators they differentiate, `STEADY_FUNCTIONALS`.
 
@@ -43,6 +43,7 @@ from ._steady_gradient import (
     STEADY_FUNCTIONALS,
     SteadyGradient,
     frozen_load_gradient,
+    frozen_load_gradients,
     ratio_gradient,
     steady_gradient,
     tangent_growth,
@@ -63,6 +64,7 @@ __all__ = [
     "design_metrics",
     "forward_jacobian",
     "frozen_load_gradient",
+    "frozen_load_gradients",
     "ratio_gradient",
     "seated_perturbation",
     "steady_design_metrics",

@@ -43,6 +43,7 @@ import dataclasses
 
 import numpy as np
 
+from .._errors import UserInputError
 from ..flange import (
     DEFAULT_FLANGE_LOAD,
     MARGIN_NAMES,
@@ -119,7 +120,7 @@ def steady_design_metrics(
 def steady_design_metrics_points(
     bearing: Bearing,
     ops,
-    design: DesignVariables,
+    design: DesignVariables | list[DesignVariables],
     *,
     seeds: int = 4,
     window_revs: int = 4,
@@ -132,18 +133,26 @@ def steady_design_metrics_points(
 ) -> list[SteadyDesignMetrics]:
     """`steady_design_metrics` at every operating point of `ops`, every point's seeds members of
     one call of the steady-running engine (`run.simulate_steady_points`: a design's whole
-    envelope in one process pool, or one vmapped program on an accelerator). `initial_states`:
-    None, or per point None or one state per seed."""
-    check_design(bearing, design)
+    envelope in one process pool, or one vmapped program on an accelerator). `design`: one
+    design, or one per point (several designs in one call: every start of an iteration of a
+    design search). `initial_states`: None, or per point None or one state per seed."""
+    ops = list(ops)
+    designs = [design] * len(ops) if isinstance(design, DesignVariables) else list(design)
+    if len(designs) != len(ops):
+        raise UserInputError(
+            f"design: {len(designs)} given, expected one, or one per operating point ({len(ops)})"
+        )
+    for d in designs:
+        check_design(bearing, d)
     require("corner_margin", corner_margin, lambda v: np.isfinite(v) & (v >= 0), ">= 0 m")
     require("first_seed", first_seed, lambda v: (v >= 0) & (v == np.round(v)), "an integer >= 0")
-    b = with_design(bearing, design.end_radius, design.layback_angle, design.axial_clearance)
+    bearings = [with_design(bearing, d.end_radius, d.layback_angle, d.axial_clearance) for d in designs]
     pert = steady_kwargs.pop("perturbation", Perturbation())
     pert = dataclasses.replace(pert, seed=int(first_seed))
     steady_kwargs.setdefault("functionals", STEADY_FUNCTIONALS)
     results = simulate_steady_points(
-        b,
-        list(ops),
+        bearings,
+        ops,
         settle=settle,
         window_revs=window_revs,
         seeds=seeds,
@@ -151,9 +160,11 @@ def steady_design_metrics_points(
         initial_states=initial_states,
         **steady_kwargs,
     )
-    margins = np.asarray(zone_margins(b, design, flange_load=flange_load))
     pv_ref = float(steady_kwargs["functionals"].pv_reference)
-    return [_metrics(result, design, margins, corner_margin, pv_ref) for result in results]
+    return [
+        _metrics(result, d, np.asarray(zone_margins(b, d, flange_load=flange_load)), corner_margin, pv_ref)
+        for result, b, d in zip(results, bearings, designs)
+    ]
 
 
 def _metrics(

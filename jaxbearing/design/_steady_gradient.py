@@ -44,19 +44,23 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from .._errors import UserInputError
 from ..contact import LOAD_FLOOR
 from ..dynamics import Functionals, Params, State, contact_loads
 from ..flange import DesignVariables, with_design
 from ..geometry import Bearing, OperatingPoint
 from ..io import require
 from ..run import (
+    STRATEGIES,
     checks_without_host_callbacks,
+    choose_strategy,
     compiled_program,
     parallel_map,
     prepare_from,
     result_code,
     scaled_diffeqsolve,
     solve_from,
+    stack_trees,
 )
 from ._design import forward_jacobian
 
@@ -353,16 +357,80 @@ def frozen_load_gradient(
     saves_per_ms: int = 200,
     rtol: float = 1e-3,
     workers: int = 1,
+    strategy: str = "auto",
 ) -> SteadyGradient:
     """The frozen-load estimate (module docstring) of the steady objective and its gradient at
     `design`: from each of `states`, a plain solve over `window` seconds saves the state every
     1 / `saves_per_ms` ms; at every saved state the flange PV is differentiated in the design at
     the loads the dynamics gave (`frozen_load_integrands`), summed, and combined through the
-    ratio estimator; jackknife over the trajectories."""
+    ratio estimator; jackknife over the trajectories. `strategy`: as `frozen_load_gradients`."""
+    forwarded = {k: v for k, v in locals().items() if k not in ("bearing", "op", "design", "states")}
+    (gradient,) = frozen_load_gradients([(bearing, op, design, states)], **forwarded)
+    return gradient
+
+
+def frozen_load_gradients(
+    cases,
+    *,
+    window: float = 1.0e-3,
+    saves_per_ms: int = 200,
+    rtol: float = 1e-3,
+    workers: int = 1,
+    strategy: str = "auto",
+) -> list[SteadyGradient]:
+    """`frozen_load_gradient` of every case (bearing, op, design, states), e.g. every start and
+    operating point of one iteration of the design search; one `SteadyGradient` per case, in
+    order. Every trajectory of every case is one member of one call (`strategy`, as the
+    steady-running engine's `choose_strategy`): "vmap" (the default on an accelerator) integrates
+    and differentiates them all in one vmapped program; on a CPU they run `workers` processes
+    at a time ("processes"), or one after another ("sequential")."""
     _check_window(window)
     require("saves_per_ms", saves_per_ms, lambda v: (v >= 1) & (v == np.round(v)), "an integer >= 1")
-    x = np.asarray(design.as_array(), dtype=float)
+    if strategy not in STRATEGIES:
+        raise UserInputError(f"strategy = {strategy!r}: must be one of {', '.join(map(repr, STRATEGIES))}")
     n = max(1, int(round(window * 1e3 * saves_per_ms)))
-    job = _FrozenSample(bearing, op, x, float(window), n, float(rtol))
-    outs = parallel_map(job, list(states), workers=workers)
-    return _combine(outs, window)
+    jobs, owner = [], []
+    for k, (bearing, op, design, states) in enumerate(cases):
+        x = np.asarray(design.as_array(), dtype=float)
+        job = _FrozenSample(bearing, op, x, float(window), n, float(rtol))
+        jobs += [(job, s) for s in states]
+        owner += [k] * len(states)
+    chosen = choose_strategy(strategy, min(int(workers), max(1, len(jobs))))
+    if not jobs:
+        outs = []
+    elif chosen == "vmap":
+        outs = _frozen_samples_batched(jobs)
+    else:
+        outs = parallel_map(_frozen_job, jobs, workers=workers if chosen == "processes" else 1)
+    return [_combine([o for o, j in zip(outs, owner) if j == k], window) for k in range(len(cases))]
+
+
+def _frozen_job(item):
+    """One (`_FrozenSample`, state) of `frozen_load_gradients` (picklable for `parallel_map`)."""
+    job, state = item
+    return job(state)
+
+
+def _frozen_samples_batched(jobs) -> list:
+    """Every (`_FrozenSample`, state) of `jobs` as one member of one vmapped program: its
+    trajectory and the frozen-load integrals and Jacobian along it."""
+    num_saves = jobs[0][0].num_saves
+
+    def one(b, o, x, s, d, r):
+        states, code = trajectory_states(b, o, s, d, num_saves, rtol=r)
+        val, jac = _frozen_jacobian(b, o, x, states)
+        return val, jac, code
+
+    args = stack_trees(
+        [
+            (job.bearing, job.op, jnp.asarray(job.x), state, np.float64(job.duration), np.float64(job.rtol))
+            for job, state in jobs
+        ]
+    )
+    vals, jacs, codes = jax.device_get(
+        compiled_program("frozen_load_members", jax.vmap(one), args, num_saves)(*args)
+    )
+    return [
+        (vals[i], jacs[i]) if int(codes[i]) == 0 else (np.full(2, np.nan), np.full((3, 2), np.nan))
+        for i in range(len(jobs))
+    ]

@@ -15,7 +15,8 @@
   seeds), `simulate_steady_points` (the same at several operating points, one engine call),
   `summarise_steady`; the steady-running engine under it, `settle_members` (many
   `Member`s, each a case and a seed, with `SteadyOptions`: one after another, one process per
-  core, or vmapped on accelerators, `STRATEGIES`; an `EngineRun`) and `window_statistics`
+  core, or vmapped on accelerators, `STRATEGIES`, `choose_strategy`, `stack_trees`; an
+  `EngineRun`) and `window_statistics`
   (`revolution_statistic_keys`); `solve_from` / `prepare_from` (continue from any state),
   `scaled_diffeqsolve` (diffrax's integration of the scaled state that `solve` and `solve_from`
   run, for callers that build their own programs around it), `check_steady_options` and the
@@ -45,7 +46,7 @@ from ._compile_cache import (
     enable_compilation_cache,
     program_cache_dir,
 )
-from ._engine import STRATEGIES
+from ._engine import STRATEGIES, choose_strategy, stack_trees
 from ._ensemble import as_completed_map, available_cpus, parallel_map, shared_workers, simulate_ensemble
 from ._initial import STARTS, Perturbation, SkidStart, initial_state, skid_start
 from ._measured import model_cage_speeds
@@ -167,6 +168,8 @@ __all__ = [
     "Member",
     "SteadyOptions",
     "STRATEGIES",
+    "choose_strategy",
+    "stack_trees",
     "WINDOW_REVS",
     "settle_members",
     "simulate_steady_points",

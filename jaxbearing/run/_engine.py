@@ -66,7 +66,8 @@ def choose_strategy(strategy: str, workers: int, devices: Sequence | None = None
     return "processes" if workers > 1 else "sequential"
 
 
-def _stack(trees):
+def stack_trees(trees):
+    """The pytrees `trees` (one structure) as one pytree of numpy arrays with a leading axis."""
     return jax.tree_util.tree_map(lambda *xs: np.stack([np.asarray(x) for x in xs]), *trees)
 
 
@@ -138,7 +139,7 @@ def drive_batched(
         except StopIteration as stop:
             results[i] = stop.value
     last = {i: req for i, req in pending.items()}
-    stacked_params = _stack([params[i] for i in pad])
+    stacked_params = stack_trees([params[i] for i in pad])
     rtol = np.asarray([tolerances[i][0] for i in pad], float)
     atol = np.asarray([tolerances[i][1] for i in pad], float)
     times.host_s += time.perf_counter() - h0
@@ -153,7 +154,7 @@ def drive_batched(
                 state, duration = last.get(i, next(iter(last.values())))[0], IDLE_DURATION
             states.append(jax.tree_util.tree_map(np.asarray, state))
             durations.append(float(duration))
-        stacked = _stack(states)
+        stacked = stack_trees(states)
         times.host_s += time.perf_counter() - h0
         if run is None:
             c0 = time.perf_counter()

@@ -708,7 +708,7 @@ def simulate_steady(
 
 
 def simulate_steady_points(
-    bearing: Bearing,
+    bearing: Bearing | list[Bearing],
     ops,
     *,
     settle="auto",
@@ -732,14 +732,21 @@ def simulate_steady_points(
     """`simulate_steady` at every operating point of `ops` (a sequence), every point's seeds
     members of one call of the steady-running engine (`settle_members`: one process pool or one
     vmapped program for all of them, e.g. a design's whole speed envelope); one `SteadyResult`
-    per point, in order. `initial_states`: None, or per point None or one state per seed. The
-    wall and compilation times of each result are those of the whole call."""
+    per point, in order. `bearing`: one bearing, or one per point (e.g. several designs, each at
+    its operating points: one call for a whole iteration of a design search). `initial_states`:
+    None, or per point None or one state per seed. The wall and compilation times of each result
+    are those of the whole call."""
     from ..io import validate_bearing
 
     ops = list(ops)
+    bearings = [bearing] * len(ops) if isinstance(bearing, Bearing) else list(bearing)
+    if len(bearings) != len(ops):
+        raise UserInputError(
+            f"bearing: {len(bearings)} given, expected one, or one per operating point ({len(ops)})"
+        )
     check_solver(solver)
-    for op in ops:
-        validate_bearing(bearing, op)
+    for b, op in zip(bearings, ops):
+        validate_bearing(b, op)
     check_steady_options(settle, window_revs, seeds, tolerance, settle_cap_ms, start=start, workers=workers)
     settle = settle if isinstance(settle, str) and settle in ("auto", "off") else float(settle)
     options = SteadyOptions(
@@ -764,12 +771,12 @@ def simulate_steady_points(
             f"initial_states: {len(given)} given, expected one list per operating point ({len(ops)})"
         )
     members = []
-    for op, states in zip(ops, given):
+    for b, op, states in zip(bearings, ops, given):
         if states is not None:
             states = list(states)
             if len(states) != n:
                 raise UserInputError(f"initial_states: {len(states)} given, expected one per seed ({n})")
-        members += [Member(bearing, op, p, s) for p, s in zip(perturbations, states or [None] * n)]
+        members += [Member(b, op, p, s) for p, s in zip(perturbations, states or [None] * n)]
     engine = settle_members(members, options, strategy=strategy, workers=workers)
     return [
         SteadyResult(
@@ -781,10 +788,10 @@ def simulate_steady_points(
             start=start if given[k] is None else "continuation",
             wall_time_s=engine.wall_time_s,
             compile_time_s=engine.compile_time_s,
-            bearing=bearing,
+            bearing=b,
             operating=op,
         )
-        for k, op in enumerate(ops)
+        for k, (b, op) in enumerate(zip(bearings, ops))
     ]
 
 
