@@ -204,20 +204,29 @@ def test_a_settled_sweep_missing_a_batch_resumes_exactly(settled_sweep, tmp_path
 
 def test_several_operating_points_in_one_engine_call_equal_their_single_runs():
     """`simulate_steady_points` (a design's envelope, e.g. the design search's speeds, as members
-    of one engine call) gives each point exactly its own `simulate_steady` (one member at a
-    time: the same decisions, the same numbers). A short run: 2 revolutions measured from the
+    of one engine call; here with one bearing per point, as a search iteration's starts) gives
+    each point exactly its own `simulate_steady` (one member at a time: the same decisions, the
+    same numbers). A short run: 2 revolutions measured from the
     kinematic start."""
+    from jaxbearing.flange import DesignVariables, with_design
     from jaxbearing.run import simulate_steady, simulate_steady_points
 
     bearing, op = _small()
     other = dataclasses.replace(op, inner_speed=op.inner_speed * 0.75)
+    d = DesignVariables.of(bearing)  # the second point with another design (one bearing per point)
+    redesigned = with_design(bearing, d.end_radius * 1.1, d.layback_angle, d.axial_clearance)
     kw = dict(settle="off", window_revs=2, start="quasi-static")
-    both = simulate_steady_points(bearing, [op, other], **kw)
-    alone = simulate_steady(bearing, other, **kw)
+    both = simulate_steady_points([bearing, redesigned], [op, other], **kw)
+    alone = simulate_steady(redesigned, other, **kw)
     assert [r.operating is o for r, o in zip(both, (op, other))] == [True, True]
+    assert [r.bearing is b for r, b in zip(both, (bearing, redesigned))] == [True, True]
     assert both[1].runs[0].revolution_speeds_rpm == alone.runs[0].revolution_speeds_rpm
     assert both[0].runs[0].revolution_speeds_rpm[-1] > both[1].runs[0].revolution_speeds_rpm[-1]
     with pytest.raises(
         jb.UserInputError, match=r"^initial_states: 1 given, expected one list per operating point"
     ):
         simulate_steady_points(bearing, [op, other], initial_states=[None], **kw)
+    with pytest.raises(
+        jb.UserInputError, match=r"^bearing: 3 given, expected one, or one per operating point \(2\)"
+    ):
+        simulate_steady_points([bearing] * 3, [op, other], **kw)
