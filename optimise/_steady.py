@@ -63,7 +63,6 @@ from jaxbearing.design import (
     CORNER_MARGIN,
     SteadyGradient,
     frozen_load_gradients,
-    steady_design_metrics,
     steady_design_metrics_points,
     steady_gradient,
 )
@@ -634,28 +633,28 @@ def _scaled(est: dict, unit: float = PV_SCALE) -> dict:
 @_in_shared_pool
 def verification(problem: DesignProblem, settings: SteadySettings, design, reference) -> dict:
     """The found design and the reference design re-simulated from the skid start with seeds
-    the search never used (module docstring), at every operating point."""
+    the search never used (module docstring), at every operating point: both designs' points'
+    seeds members of one call of the steady-running engine."""
     out = {
         "seeds": list(range(settings.verify_first_seed, settings.verify_first_seed + settings.verify_seeds))
     }
-    for name, x in (("reference", reference), ("optimum", design)):
-        d = DesignVariables.from_array(jnp.asarray(x))
-        rows = []
-        for k in range(problem.num_operating_points):  # one call per point: tests stand in for it
-            m = steady_design_metrics(
-                problem.bearing,
-                _operating_point(problem, k),
-                d,
-                seeds=settings.verify_seeds,
-                window_revs=settings.verify_window_revs,
-                settle=settings.settle,
-                corner_margin=settings.corner_margin,
-                flange_load=problem.flange_load,
-                first_seed=settings.verify_first_seed,
-                workers=settings.num_workers,
-                rtol=settings.rtol,
-            )
-            rows.append(_estimates(m))
+    ops = [_operating_point(problem, k) for k in range(problem.num_operating_points)]
+    designs = [DesignVariables.from_array(jnp.asarray(x)) for x in (reference, design)]
+    metrics = steady_design_metrics_points(
+        problem.bearing,
+        ops * 2,
+        [d for d in designs for _ in ops],
+        seeds=settings.verify_seeds,
+        window_revs=settings.verify_window_revs,
+        settle=settings.settle,
+        corner_margin=settings.corner_margin,
+        flange_load=problem.flange_load,
+        first_seed=settings.verify_first_seed,
+        workers=settings.num_workers,
+        rtol=settings.rtol,
+    )
+    for i, name in enumerate(("reference", "optimum")):
+        rows = [_estimates(m) for m in metrics[i * len(ops) : (i + 1) * len(ops)]]
         out[name] = rows[0] if len(rows) == 1 else {"per_operating_point": rows}
     ref, opt = out["reference"], out["optimum"]
     if "mean_pv_GPa_m_s" in ref:

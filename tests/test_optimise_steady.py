@@ -171,11 +171,12 @@ def test_killed_run_resumes_with_the_same_result(tmp_path, config, monkeypatch, 
 
 
 def _metrics_stand_in(calls):
-    """A stand-in for `steady_design_metrics` that records (R_end, seeds, first_seed, window)
-    of each call; mean PV proportional to R_end, corner contacts below R_end 75 mm."""
+    """A stand-in for `steady_design_metrics_points` that records (R_end, seeds, first_seed,
+    window) of each point and "call" after each call; mean PV proportional to R_end, corner
+    contacts below R_end 75 mm."""
     import types
 
-    def metrics(bearing, op, design, *, seeds, first_seed, window_revs, **kw):
+    def one(design, seeds, first_seed, window_revs):
         calls.append((float(design.end_radius), seeds, first_seed, window_revs))
         pv = 1e9 * float(design.end_radius) / 0.08  # lower for a smaller end radius here
 
@@ -193,26 +194,32 @@ def _metrics_stand_in(calls):
             seeds=list(range(first_seed, first_seed + seeds)),
         )
 
-    return metrics
+    def points(bearing, ops, designs, *, seeds, first_seed, window_revs, **kw):
+        out = [one(d, seeds, first_seed, window_revs) for d in designs]
+        calls.append("call")
+        return out
+
+    return points
 
 
 def test_verify_seeds_option_reaches_the_verification(tmp_path, config, monkeypatch):
     """`optimise run --verify-seeds 3`: the verification re-measures the reference and the found
     design with 3 seeds from 1000 on (stand-ins for the search's ensemble and for
-    `steady_design_metrics`; the real ones are in tests/test_steady_design.py)."""
+    `steady_design_metrics_points`; the real ones are in tests/test_steady_design.py)."""
     monkeypatch.setattr(steady, "evaluate_starts", _stand_in_starts)
     calls = []
-    monkeypatch.setattr(steady, "steady_design_metrics", _metrics_stand_in(calls))
+    monkeypatch.setattr(steady, "steady_design_metrics_points", _metrics_stand_in(calls))
     out = tmp_path / "verified"
     assert main(["run", "--config", config, *ARGS, "--verify-seeds", "3", "--quiet", "--out", str(out)]) == 0
     r = json.loads((out / "result.json").read_text())
     assert r["verification"]["seeds"] == [1000, 1001, 1002]
-    assert [c[1:] for c in calls] == [(3, 1000, 4), (3, 1000, 4)]  # reference, then the optimum
+    assert [c[1:] for c in calls[:2]] == [(3, 1000, 4), (3, 1000, 4)]  # reference, then the optimum
+    assert calls[2:] == ["call"]  # both designs in one engine call
 
 
 def test_verification_uses_unseen_seeds(config, monkeypatch):
     """`verification` re-measures both designs with the seeds from verify_first_seed on (a
-    stand-in for `steady_design_metrics` records them; the real one is tested in
+    stand-in for `steady_design_metrics_points` records them, both designs in one call; the real one is tested in
     tests/test_steady_design.py) and reports value and CI of mean PV, p95 PV and corner share,
     whether the mean-PV intervals are disjoint, and corner contacts of the found design."""
 
@@ -222,7 +229,7 @@ def test_verification_uses_unseen_seeds(config, monkeypatch):
     calls = []
     metrics = _metrics_stand_in(calls)
 
-    monkeypatch.setattr(steady, "steady_design_metrics", metrics)
+    monkeypatch.setattr(steady, "steady_design_metrics_points", metrics)
     cfg = jb.load_config(config)
     problem = make_problem(cfg.bearing(), cfg.operating_point())
     settings = steady.SteadySettings(
@@ -231,7 +238,7 @@ def test_verification_uses_unseen_seeds(config, monkeypatch):
     x = np.array([0.08, 1.6 * math.pi / 180, 0.15e-3])
     v = steady.verification(problem, settings, x, x)
     assert v["seeds"] == [7, 8, 9]
-    assert calls == [(0.08, 3, 7, 4), (0.08, 3, 7, 4)]
+    assert calls == [(0.08, 3, 7, 4), (0.08, 3, 7, 4), "call"]
     for name in ("reference", "optimum"):
         row = v[name]
         assert row["seeds"] == [7, 8, 9]
