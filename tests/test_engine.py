@@ -230,3 +230,27 @@ def test_several_operating_points_in_one_engine_call_equal_their_single_runs():
         jb.UserInputError, match=r"^bearing: 3 given, expected one, or one per operating point \(2\)"
     ):
         simulate_steady_points([bearing] * 3, [op, other], **kw)
+
+
+def test_continuing_seeds_share_their_case_time_constant(monkeypatch):
+    """Members continuing from given states with the settling verdict (the design search's
+    default) solve one static skid equilibrium per case, not one per seed: the verdict uses
+    only its time constant, so both seeds' verdicts carry the same one. (A short run: from
+    the quasi-static states, settling capped at 1 ms, a 2-revolution window.)"""
+    import jaxbearing.run._settle as settle
+
+    bearing, op = _small()
+    seeds = [jb.Perturbation(seed=k) for k in range(2)]
+    continuing = [Member(bearing, op, p, jb.run.initial_state(bearing, op, p)) for p in seeds]
+    fresh = Member(bearing, op, jb.Perturbation(seed=5))
+    assert settle._continuing_cases([fresh, *continuing], OPTIONS) == {1: 1, 2: 1}
+    assert settle._continuing_cases(continuing, dataclasses.replace(OPTIONS, settle="off")) == {}
+    solved = []
+    real = settle._static_skid_start
+    monkeypatch.setattr(settle, "_static_skid_start", lambda *a: solved.append(a[2].seed) or real(*a))
+    capped = dataclasses.replace(OPTIONS, settle_cap_ms=1.0)
+    runs = settle_members(continuing, capped, strategy="sequential").runs
+    assert solved == [0]
+    assert all(r.status == "ok" for r in runs)
+    taus = [r.verdict.time_constant_s for r in runs]
+    assert math.isfinite(taus[0]) and taus[0] > 0 and taus[0] == taus[1]

@@ -546,8 +546,9 @@ def member_steps(member: Member, options: SteadyOptions, reduce=None, static=Non
     return run if reduce is None else reduce(run, member)
 
 
-def _run_one(member: Member, options: SteadyOptions, reduce=None) -> tuple[SeedRun, float]:
-    """One member in this process (`drive`, its own compiled `solve_from`): (run, compile time)."""
+def _run_one(member: Member, options: SteadyOptions, reduce=None, static=None) -> tuple[SeedRun, float]:
+    """One member in this process (`drive`, its own compiled `solve_from`): (run, compile time);
+    `static`: as `member_steps`."""
     compiled: list = []
     rtol, atol = options.tolerances(member)
     integrate = _integrator(
@@ -559,8 +560,36 @@ def _run_one(member: Member, options: SteadyOptions, reduce=None) -> tuple[SeedR
         compiled,
         options.solver,
     )
-    run = drive(member_steps(member, options, reduce), integrate)
+    run = drive(member_steps(member, options, reduce, static), integrate)
     return run, sum(compiled)
+
+
+def _continuing_cases(members, options: SteadyOptions) -> dict:
+    """{member index: index of its case's first member} for the members that continue from a
+    given state and settle with the verdict: they share the static skid equilibrium of that
+    first member's seed (a case: one bearing and operating point). The verdict needs only its
+    time constant, which the seeds' scatters move by 3e-6 (reference bearing, 31 slices, seeds
+    0-2); solved per seed, the equilibria took 17 of the 66 s of a design-search evaluation (4
+    seeds, continuing) on the 2-core CPU, 2026-11-26."""
+    if options.settle != "auto":
+        return {}
+    first, out = {}, {}
+    for i, m in enumerate(members):
+        if m.initial_state is not None:
+            leaves, tree = jax.tree_util.tree_flatten((m.bearing, m.operating))
+            key = (str(tree), tuple(np.asarray(x).tobytes() for x in leaves))
+            out[i] = first.setdefault(key, i)
+    return out
+
+
+def _shared_time_constants(members, options: SteadyOptions) -> dict:
+    """{member index: static skid equilibrium} of `_continuing_cases`, one solve per case."""
+    cases = _continuing_cases(members, options)
+    solved = {
+        j: _static_skid_start(members[j].bearing, members[j].operating, members[j].perturbation)
+        for j in set(cases.values())
+    }
+    return {i: solved[j] for i, j in cases.items()}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -570,8 +599,9 @@ class _MemberJob:
     options: SteadyOptions
     reduce: object = None
 
-    def __call__(self, member: Member):
-        return _run_one(member, self.options, self.reduce)
+    def __call__(self, item):
+        member, static = item
+        return _run_one(member, self.options, self.reduce, static)
 
 
 @dataclasses.dataclass
@@ -622,10 +652,14 @@ def settle_members(
             # the static skid equilibria of the group in one vmapped program, not one by one:
             # for the skid start, and for the verdict's time constant (continuing members too;
             # solved one by one on the host they took 72 of an 84 s search iteration on a GPU)
+            cases = _continuing_cases([members[i] for i in idx], options)
             needs = [
                 i
-                for i in idx
-                if (members[i].initial_state is None and options.start == "skid") or options.settle == "auto"
+                for k, i in enumerate(idx)
+                if (
+                    members[i].initial_state is None and (options.start == "skid" or options.settle == "auto")
+                )
+                or cases.get(k) == k
             ]
             h0 = time.perf_counter()
             statics = dict(
@@ -638,6 +672,7 @@ def settle_members(
                     else [],
                 )
             )
+            statics.update({idx[k]: statics[idx[j]] for k, j in cases.items()})
             times.host_s += time.perf_counter() - h0
             outs = drive_batched(
                 [member_steps(members[i], quiet, reduce, statics.get(i)) for i in idx],
@@ -654,14 +689,16 @@ def settle_members(
                 runs[i] = out
         wall = time.perf_counter() - wall0 - times.compile_s
         return EngineRun(runs, chosen, wall, times.compile_s, times)
+    statics = _shared_time_constants(members, options)
     if chosen == "processes" and len(members) > 1:
-        outs = parallel_map(_MemberJob(options, reduce), members, workers=min(int(workers), len(members)))
+        items = [(m, statics.get(i)) for i, m in enumerate(members)]
+        outs = parallel_map(_MemberJob(options, reduce), items, workers=min(int(workers), len(members)))
         compile_time = max(c for _, c in outs)
         # the pool's wall time less its longest compilation (the workers compile side by side)
         return EngineRun(
             [r for r, _ in outs], chosen, time.perf_counter() - wall0 - compile_time, compile_time
         )
-    outs = [_run_one(m, options, reduce) for m in members]
+    outs = [_run_one(m, options, reduce, statics.get(i)) for i, m in enumerate(members)]
     compile_time = sum(c for _, c in outs)
     return EngineRun([r for r, _ in outs], chosen, time.perf_counter() - wall0 - compile_time, compile_time)
 
