@@ -585,6 +585,12 @@ def run_steady(args, problem, options, settings, out, meta=None) -> int:
             )
         if "mean_pv_lower_disjoint" in v:
             print(f"  verified lower mean PV with disjoint 95 % CIs: {v['mean_pv_lower_disjoint']}")
+        bound = v.get("optimum_corner_contact_per_revolution_upper95")
+        if bound is not None:
+            print(
+                f"  corner contact of the found design: at most {bound:.2f} of its revolutions "
+                "(upper 95 % bound from the verification's revolutions)"
+            )
     print(f"  {res.num_evaluations} settled ensembles, {res.wall_time_s:.1f} s wall")
     print(f"wrote {out / 'result.json'} and {plot_path}")
     return 0

@@ -618,6 +618,8 @@ def _estimates(m) -> dict:
         "objective_GPa_m_s": _scaled(m.objective),
         "corner_contact_share": dict(m.corner_contact_share),
         "corner_margin_mm": _scaled(m.corner_margin, 1e-3),
+        # how far zero corner contact in these seeds bounds the tail (upper 95 % bounds)
+        "corner_contact_bound": m.summary.get("corner_contact_bound"),
         "settled": m.settled,
         "seeds": m.seeds,
     }
@@ -663,6 +665,13 @@ def verification(problem: DesignProblem, settings: SteadySettings, design, refer
             None not in (r["ci95_low"], o["ci95_high"]) and o["ci95_high"] < r["ci95_low"]
         )
         out["optimum_corner_contacts"] = bool((opt["corner_contact_share"].get("value") or 0.0) > 0)
+    for name in ("reference", "optimum"):  # the weakest bound over the operating points
+        rows = out[name].get("per_operating_point", [out[name]])
+        bounds = [r["corner_contact_bound"] for r in rows if r.get("corner_contact_bound")]
+        if bounds:
+            out[f"{name}_corner_contact_per_revolution_upper95"] = max(
+                b["per_revolution_upper95"] for b in bounds
+            )
     return out
 
 

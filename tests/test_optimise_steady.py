@@ -190,6 +190,7 @@ def _metrics_stand_in(calls):
             objective=est(pv, 0.05e9),
             corner_contact_share=est(share, 0.0),
             corner_margin=est(1e-4, 1e-5),
+            summary={"corner_contact_bound": {"per_revolution_upper95": 0.17 if share == 0 else 1.0}},
             settled=True,
             seeds=list(range(first_seed, first_seed + seeds)),
         )
@@ -257,6 +258,8 @@ def test_verification_uses_unseen_seeds(config, monkeypatch):
     v = steady.verification(problem, settings, np.array([0.07, *x[1:]]), x)
     assert v["optimum"]["mean_pv_GPa_m_s"]["value"] == pytest.approx(0.875)
     assert v["mean_pv_lower_disjoint"] is True and v["optimum_corner_contacts"] is True
+    assert v["reference_corner_contact_per_revolution_upper95"] == 0.17
+    assert v["optimum_corner_contact_per_revolution_upper95"] == 1.0
 
 
 def test_grid_picks_the_best_point_inside_every_margin_and_resumes(tmp_path, config, monkeypatch):

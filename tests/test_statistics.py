@@ -118,3 +118,42 @@ def test_revolution_statistics_closed_form():
     np.testing.assert_allclose(s["cage_slip"], [1 - 100 / 120, 1 - 110 / 120])
     np.testing.assert_allclose(s["roller_skew_rad.max_abs"], [1e-4, 1e-4])
     assert isinstance(student_t_interval(s["flange_force_N.max"]), Estimate)
+
+
+def test_upper_probability_bound_is_clopper_pearson():
+    """The one-sided 95 % Clopper-Pearson bound: with no event in n trials exactly
+    1 - 0.05^(1/n) (about 3/n: the rule of three), 1 with every trial an event, and the bound
+    P(X <= k | p) = 0.05 of the binomial in between."""
+    from scipy import stats
+
+    from jaxbearing.run._statistics import upper_probability_bound
+
+    for n in (1, 8, 16, 100):
+        assert upper_probability_bound(0, n) == pytest.approx(1 - 0.05 ** (1 / n), rel=1e-12)
+    assert upper_probability_bound(0, 1000) == pytest.approx(3 / 1000, rel=0.01)
+    assert upper_probability_bound(5, 5) == 1.0 and np.isnan(upper_probability_bound(0, 0))
+    p = upper_probability_bound(3, 40)
+    assert stats.binom.cdf(3, 40, p) == pytest.approx(0.05, rel=1e-9)
+
+
+def test_corner_contact_bound_counts_revolutions_and_seeds():
+    """Revolutions whose largest contact radius lies beyond the limited circle, over the
+    measured revolutions (a NaN cage speed is no revolution; a NaN radius, no contact)."""
+    from jaxbearing.run._statistics import corner_contact_bound, upper_probability_bound
+
+    rho = 2.0e-3
+    seeds = [
+        {
+            "cage_speed_rpm": np.array([1.0, 1.0, 1.0, 1.0]),
+            "contact_radius_m.max_in_contact": np.array([1e-3, np.nan, 2.1e-3, 1.9e-3]),
+        },
+        {
+            "cage_speed_rpm": np.array([1.0, 1.0, np.nan, 1.0]),
+            "contact_radius_m.max_in_contact": np.array([1e-3, 1e-3, 3e-3, 1e-3]),
+        },
+    ]
+    b = corner_contact_bound(seeds, rho)
+    assert (b["revolutions"], b["revolutions_with_corner_contact"]) == (7, 1)
+    assert (b["seeds"], b["seeds_with_corner_contact"]) == (2, 1)
+    assert b["per_revolution_upper95"] == upper_probability_bound(1, 7)
+    assert b["per_seed_upper95"] == upper_probability_bound(1, 2)
