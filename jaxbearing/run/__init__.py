@@ -10,7 +10,8 @@
 - statistics: `contact_events`, `summarise`, `film_statistics` (film over contact time,
   `FILM_KEYS`); of settled running with 95 % confidence
   intervals: `steady_statistics`, `revolution_statistics`, `confidence_intervals`,
-  `batch_means`, `student_t_interval`, `Estimate`;
+  `batch_means`, `student_t_interval`, `Estimate`; how often the contact reached the corner,
+  with upper bounds: `corner_contact_bound`, `upper_probability_bound`;
 - settled running: `simulate_steady` (settling detection over cage revolutions, a window,
   seeds), `simulate_steady_points` (the same at several operating points, one engine call),
   `summarise_steady`; the steady-running engine under it, `settle_members` (many
@@ -84,10 +85,12 @@ from ._statistics import (
     Estimate,
     batch_means,
     confidence_intervals,
+    corner_contact_bound,
     revolution_statistic_keys,
     revolution_statistics,
     steady_statistics,
     student_t_interval,
+    upper_probability_bound,
     window_statistics,
 )
 from ._step_control import (
@@ -162,6 +165,8 @@ __all__ = [
     "solve_from",
     "steady_statistics",
     "student_t_interval",
+    "corner_contact_bound",
+    "upper_probability_bound",
     "summarise",
     "summarise_steady",
     "EngineRun",
