@@ -198,6 +198,13 @@ def build_parser() -> argparse.ArgumentParser:
         f"(default: {st.corner_margin * mm:g})",
     )
     r.add_argument(
+        "--clearance-step-mm",
+        type=float,
+        help="steady: half-step of the common-random-number central difference in Delta_bf [mm], "
+        "extra members of every evaluation, 0: off (the frozen-load estimator cannot see the "
+        f"clearance) (default: {st.clearance_step * mm:g})",
+    )
+    r.add_argument(
         "--verify-seeds",
         type=int,
         help=f"steady: unseen seeds of the verification (default: {st.verify_seeds})",
@@ -250,6 +257,7 @@ def _settings(args) -> dict:
         ("gradient_window_ms", args.gradient_window_ms),
         ("estimator", args.estimator),
         ("corner_margin_mm", args.corner_margin_mm),
+        ("clearance_step_mm", args.clearance_step_mm),
         ("verify_seeds", args.verify_seeds),
         ("workers", args.workers),
         ("learning_rate", args.learning_rate),
@@ -330,6 +338,7 @@ def steady_settings_from(s: dict):
         rtol=_positive(s, "rtol", SEARCH_DEFAULTS["rtol"]),
         workers=int(_positive(s, "workers", st.workers, int, strict=False)),
         verify_seeds=int(_positive(s, "verify_seeds", st.verify_seeds, int)),
+        clearance_step=_positive(s, "clearance_step_mm", st.clearance_step * 1e3, strict=False) * 1e-3,
     )
 
 
@@ -645,6 +654,16 @@ def _steady_result_json(problem, options, settings, res) -> dict:
         ],
         "axial_clearance_effect": {
             **CLEARANCE_EFFECT,
+            **(
+                {
+                    "estimator_sees_it": True,
+                    "why": "common-random-number central differences of the settled objective in "
+                    f"Delta_bf (half-step {settings.clearance_step * 1e3:g} mm, the same seeds from the same "
+                    "states, extra members of every evaluation): history gradient and gradient_stderr",
+                }
+                if settings.clearance_step > 0
+                else {}
+            ),
             "moved": bool(
                 res.design is not None and abs(float(res.design[2]) - float(res.start_design[2])) > 1e-12
             ),

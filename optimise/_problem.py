@@ -185,6 +185,7 @@ OPTIMISE_TOML_KEYS = {
         "gradient_window_ms",
         "estimator",
         "corner_margin_mm",
+        "clearance_step_mm",
         "verify_seeds",
         "workers",
     ),
@@ -201,7 +202,8 @@ def load_optimise_toml(path: str) -> dict:
                        aggregate = "max" | "mean", temperature_GPa_m_s = 0.1
         [search]       objective = "steady" | "startup", starts, iterations, learning_rate,
                        rtol; steady: seeds, window_revs, settle, gradient_window_ms, estimator,
-                       corner_margin_mm, verify_seeds, workers; startup: duration_ms, atol
+                       corner_margin_mm, clearance_step_mm, verify_seeds, workers;
+                       startup: duration_ms, atol
 
     Returns a flat dict {key: value}; unknown sections or keys raise UserInputError."""
     try:

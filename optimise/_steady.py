@@ -101,6 +101,9 @@ class SteadySettings:
     verify_seeds: int = 4
     verify_first_seed: int = 1000
     verify_window_revs: int = 4
+    #: half-step of the common-random-number central difference in Delta_bf [m] (0: off); the
+    #: frozen-load estimator cannot see the clearance (`evaluate_starts`)
+    clearance_step: float = 0.0
 
     def __post_init__(self):
         """One-line errors naming the setting, before anything runs."""
@@ -125,6 +128,12 @@ class SteadySettings:
         require("corner_margin", self.corner_margin, lambda v: np.isfinite(v) & (v >= 0), ">= 0 m")
         require("rtol", self.rtol, lambda v: np.isfinite(v) & (v > 0) & (v < 1), "in (0, 1)")
         require("workers", self.workers, lambda v: (v >= 0) & (v == np.round(v)), "an integer >= 0")
+        require(
+            "clearance_step",
+            self.clearance_step,
+            lambda v: np.isfinite(v) & (v >= 0) & (v < 1e-3),
+            "in [0, 1e-3) m",
+        )
 
     @property
     def num_workers(self) -> int:
@@ -186,17 +195,28 @@ def evaluate_starts(
     continuation states of each, or None): every start's operating points' seeds are members
     of one call of the steady-running engine, and every trajectory of the frozen-load
     gradients of one call of `frozen_load_gradients` (on an accelerator, one vmapped program
-    each). The wall time of each evaluation is the whole call's."""
+    each). The wall time of each evaluation is the whole call's.
+
+    The clearance (`settings.clearance_step` h > 0, Delta_bf free): the frozen-load estimator
+    cannot see Delta_bf (it moves the flange in its own plane at a fixed load), so dJ/dDelta_bf
+    is the common-random-number central difference of the settled objective, per seed
+    (J_k(Delta_bf + h) - J_k(Delta_bf - h)) / 2h with the same seeds from the same states,
+    averaged over the seeds with the paired standard error; the two shifted designs of every
+    start and operating point are further members of the same engine call."""
     t0 = time.perf_counter()
     width = np.asarray(problem.bounds.upper - problem.bounds.lower)
     ops = [_operating_point(problem, k) for k in range(problem.num_operating_points)]
+    h = float(settings.clearance_step)
+    shifts = (0.0, h, -h) if gradient and h > 0 and width[2] > 0 else (0.0,)
     designs = [problem.design(jnp.asarray(u)) for u in us]
     chains = [None] * len(designs) if chains is None else list(chains)
-    initial = [None if c is None else c[k] for c in chains for k in range(len(ops))]
+    # members: start s, shift j, operating point k at index (s * len(shifts) + j) * len(ops) + k
+    shifted = [_shift_clearance(d, dh) for d in designs for dh in shifts]
+    initial = [None if c is None else c[k] for c in chains for _ in shifts for k in range(len(ops))]
     metrics = steady_design_metrics_points(
         problem.bearing,
-        ops * len(designs),
-        [d for d in designs for _ in ops],
+        ops * len(shifted),
+        [d for d in shifted for _ in ops],
         seeds=settings.seeds,
         window_revs=settings.window_revs,
         settle=settings.settle,
@@ -206,9 +226,12 @@ def evaluate_starts(
         workers=settings.num_workers,
         rtol=settings.rtol,
     )
+    n, m = len(ops), len(shifts)
+    base = [metrics[(s * m) * n : (s * m + 1) * n] for s in range(len(designs))]
     cases = [
-        (d.apply(problem.bearing), op, d, m.sample_states)
-        for d, (op, m) in zip([d for d in designs for _ in ops], zip(ops * len(designs), metrics))
+        (d.apply(problem.bearing), op, d, mk.sample_states)
+        for d, b in zip(designs, base)
+        for op, mk in zip(ops, b)
     ]
     if not gradient:
         gradients = [SteadyGradient.missing() for _ in cases]
@@ -223,21 +246,44 @@ def evaluate_starts(
             )
             for case in cases
         ]
+    if m == 3:
+        for s in range(len(designs)):
+            for k in range(n):
+                plus, minus = metrics[(s * m + 1) * n + k], metrics[(s * m + 2) * n + k]
+                gradients[s * n + k] = _with_clearance_difference(gradients[s * n + k], plus, minus, h)
     wall = time.perf_counter() - t0
-    n = len(ops)
-    return [
-        _evaluation(
-            problem,
-            settings,
-            u,
-            metrics[s * n : (s + 1) * n],
-            gradients[s * n : (s + 1) * n],
-            width,
-            wall,
-            gradient,
-        )
-        for s, u in enumerate(us)
+    evaluations = [
+        _evaluation(problem, settings, u, b, gradients[s * n : (s + 1) * n], width, wall, gradient)
+        for s, (u, b) in enumerate(zip(us, base))
     ]
+    for s, ev in enumerate(evaluations):  # the shifted designs' simulated time
+        ev.simulated_ms += sum(_simulated_ms(mk) for mk in metrics[(s * m + 1) * n : (s + 1) * m * n])
+    return evaluations
+
+
+def _simulated_ms(m) -> float:
+    """Simulated ms of one operating point's settled ensemble: every seed's settling and window."""
+    return sum(r["settle_time_ms"] for r in m.summary["per_seed"]) + len(m.seeds) * m.summary.get(
+        "window_ms", 0.0
+    )
+
+
+def _shift_clearance(design: DesignVariables, dh: float) -> DesignVariables:
+    if dh == 0.0:
+        return design
+    x = np.asarray(design.as_array(), dtype=float)
+    return DesignVariables.from_array(jnp.asarray([x[0], x[1], x[2] + dh]))
+
+
+def _with_clearance_difference(g: SteadyGradient, plus, minus, h: float) -> SteadyGradient:
+    """`g` with its Delta_bf component the paired common-random-number central difference of
+    the objective per seed (`evaluate_starts`) and its standard error."""
+    d = (np.asarray(plus.objective_per_seed, float) - np.asarray(minus.objective_per_seed, float)) / (2 * h)
+    d = d[np.isfinite(d)]
+    grad, se = np.array(g.gradient, dtype=float), np.array(g.gradient_stderr, dtype=float)
+    grad[2] = np.mean(d) if d.size else np.nan
+    se[2] = np.std(d, ddof=1) / np.sqrt(d.size) if d.size > 1 else np.nan
+    return dataclasses.replace(g, gradient=grad, gradient_stderr=se)
 
 
 def _evaluation(problem, settings, u, metrics, gradients, width, wall, gradient: bool) -> Evaluation:
@@ -259,8 +305,7 @@ def _evaluation(problem, settings, u, metrics, gradients, width, wall, gradient:
             )
         )
         new_states.append(m.final_states)
-        simulated += sum(r["settle_time_ms"] for r in m.summary["per_seed"])
-        simulated += len(m.seeds) * m.summary.get("window_ms", 0.0)
+        simulated += _simulated_ms(m)
         simulated += (len(m.sample_states) * settings.gradient_window * 1e3) if gradient else 0.0
     values = jnp.asarray([p["value"] for p in per])
     val, vjp = jax.vjp(problem.combine, values)

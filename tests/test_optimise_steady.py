@@ -119,7 +119,7 @@ def test_killed_run_resumes_with_the_same_result(tmp_path, config, monkeypatch, 
     and no result, resumes after iteration 0 with the continuation states, and ends with exactly
     the history and design of an uninterrupted run; other settings are refused."""
     monkeypatch.setattr(steady, "evaluate_starts", _stand_in_starts)
-    args = ["--estimator", "window", "--corner-margin-mm", "0.04", *ARGS]
+    args = ["--estimator", "window", "--corner-margin-mm", "0.04", "--clearance-step-mm", "0.01", *ARGS]
     args[args.index("--iterations") + 1] = "2"
     whole, killed = tmp_path / "whole", tmp_path / "killed"
     assert main(["run", "--config", config, *args, "--no-verify", "--quiet", "--out", str(whole)]) == 0
@@ -136,6 +136,8 @@ def test_killed_run_resumes_with_the_same_result(tmp_path, config, monkeypatch, 
     )
     assert (r1["settings"]["seeds"], r1["settings"]["window_revs"], r1["settings"]["settle"]) == (2, 2, 0.5)
     assert r1["settings"]["gradient_window"] == pytest.approx(0.1e-3) and r1["settings"]["workers"] == 1
+    assert r1["settings"]["clearance_step"] == pytest.approx(0.01e-3)
+    assert r1["axial_clearance_effect"]["estimator_sees_it"] is True  # the CRN differences are on
     assert j1.shape == (3, 1) and np.all(np.isfinite(j1)) and np.all(j1 > 0)
     assert np.all(np.isfinite(np.asarray(r1["history"]["gradient_per_unit_box"])))
     lo, hi = r1["objective_GPa_m_s"]["ci95_low"], r1["objective_GPa_m_s"]["ci95_high"]
@@ -332,3 +334,69 @@ def test_an_iteration_evaluates_every_start_in_one_engine_call(monkeypatch):
         np.testing.assert_array_equal(ev.static_margins, np.asarray(problem.margins(jnp.asarray(u))))
         assert len(ev.states) == 1 and len(ev.states[0]) == 2  # one operating point, two seeds
     assert evaluations[0].objective != evaluations[1].objective
+
+
+def test_clearance_gradient_is_a_paired_crn_difference_in_the_same_engine_call(monkeypatch):
+    """`clearance_step` h: every start's design also runs at Delta_bf +- h, with the same seeds
+    from the same continuation states, as members of the same engine call, and the Delta_bf
+    component of the gradient is the mean over seeds of (J+ - J-) / 2h with its paired standard
+    error; the frozen-load estimate keeps the other two (stand-ins for the engine and the
+    estimator: J_seed = 1e9 (1 + 2000 Delta_bf / m) + 1e8 seed, so the seed term cancels)."""
+    import types
+
+    import jaxbearing as jb
+    from jaxbearing.design import SteadyGradient
+    from optimise import make_problem
+
+    seen = []
+
+    def engine(bearing, ops, designs, *, seeds, initial_states, **kw):
+        seen.append(([float(d.axial_clearance) for d in designs], initial_states))
+        out = []
+        for d in designs:
+            per_seed = [1e9 * (1 + 2000 * float(d.axial_clearance)) + 1e8 * k for k in range(seeds)]
+            est = {"value": float(np.mean(per_seed)), "ci95_low": 0.0, "ci95_high": 1e10, "n": seeds}
+            out.append(
+                types.SimpleNamespace(
+                    objective=est,
+                    objective_per_seed=per_seed,
+                    corner_margin=est,
+                    corner_contact_share=est,
+                    mean_pv=est,
+                    settled=True,
+                    seeds=list(range(seeds)),
+                    summary={"per_seed": [{"settle_time_ms": 1.0}] * seeds, "window_ms": 2.0},
+                    final_states=[("state", float(d.axial_clearance))] * seeds,
+                    sample_states=[],
+                )
+            )
+        return out
+
+    def frozen(cases, **kw):
+        return [
+            SteadyGradient(1e9, np.array([3e9, -4e9, 0.0]), np.full(3, 1e7), 1e6, 1e-4, 4, None, None, None)
+            for _ in cases
+        ]
+
+    monkeypatch.setattr(steady, "steady_design_metrics_points", engine)
+    monkeypatch.setattr(steady, "frozen_load_gradients", frozen)
+    problem = make_problem(jb.reference_bearing(), jb.reference_operating_point())
+    h = 0.01e-3
+    settings = steady.SteadySettings(seeds=3, workers=1, clearance_step=h)
+    u = np.array([0.5, 0.5, 0.25])
+    chain = [["a", "b", "c"]]
+    (ev,) = steady.evaluate_starts(problem, settings, [u], [chain])
+    ((clearances, initial),) = seen
+    base = float(problem.design(jnp.asarray(u)).axial_clearance)
+    np.testing.assert_allclose(clearances, [base, base + h, base - h], rtol=1e-12)
+    assert initial == [chain[0]] * 3  # the same states for the base and both shifted designs
+    width = np.asarray(problem.bounds.upper - problem.bounds.lower)
+    np.testing.assert_allclose(ev.gradient, np.array([3e9, -4e9, 2e12]) * width / 1e9, rtol=1e-6)
+    assert ev.gradient_stderr[2] == pytest.approx(0.0, abs=1e-6 * ev.gradient[2])
+    assert ev.simulated_ms == pytest.approx(3 * 3 * (1.0 + 2.0))
+    # off without a gradient (and by default): one design per start
+    seen.clear()
+    steady.evaluate_starts(problem, settings, [u], [chain], gradient=False)
+    assert len(seen[0][0]) == 1 and steady.SteadySettings().clearance_step == 0.0
+    with pytest.raises(UserInputError, match=r"^clearance_step = -1"):
+        steady.SteadySettings(clearance_step=-1.0)
