@@ -1,0 +1,199 @@
+"""Where does the axial clearance matter? dJ/dDelta_bf over speed, misalignment and load (issue
+35, item 1): ``python benchmarks/studies/study_clearance_effect.py``.
+
+J is the design search's objective (the smooth mean flange PV over contact time of settled
+running, docs/model.md 17). At every operating point and design:
+
+1. K seeds settle from the skid start at the design (settling verdict, `window` revolutions);
+2. from each seed's final state, the design with Delta_bf + h and with Delta_bf - h continue
+   with the same seed (common random numbers: both shifted designs start from the same settled
+   state), settle (verdict) and measure `window` revolutions;
+3. dJ/dDelta_bf = mean over seeds of (J_k(+h) - J_k(-h)) / 2h, its paired standard error and
+   Student-t 95 % interval; significant when the interval excludes 0. Also as a share of J per
+   10 um, the scale of a design step.
+
+All members of each step are one call of the steady-running engine (`jaxbearing.design.
+steady_design_metrics_points`): on an accelerator one vmapped program, on a CPU one process
+per core. Operating points, one factor at a time around 20,000 rpm / 1000 N / aligned:
+speeds 10,000, 20,000, 30,000 rpm; misalignment 0, 1, 2 mrad (inner ring, tilt held); radial
+loads 500, 1000, 4000 N. Designs: R_end / theta_f / Delta_bf = 100 mm / 1.4 deg / 0.15 mm (the
+24-seed measurement of `optimise`'s CLEARANCE_EFFECT) and 94.3 mm / 1.84 deg / 0.15 mm (a
+design the default search found). Defaults: K = 16, h = 0.01 mm, window 2, 31 slices; about
+2 x 7 x 2 x 16 = 448 settled members: minutes on one GPU, hours on the 2-core CPU.
+
+Options: `--seeds K`, `--step-mm H`, `--slices N`, `--window W`, `--points speed|all|ref`
+(one speed factor, all seven points, or the reference point alone), `--designs 1|2`,
+`--results-dir DIR`. `--quick`: the reference point, one design, 4 seeds, 11 slices (a check of
+the script, minutes on the CPU). Results: results/study_clearance_effect[_quick].json.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import sys
+import time
+from pathlib import Path
+
+sys.path[:0] = [str(Path(__file__).resolve().parent), str(Path(__file__).resolve().parents[1])]
+import _common  # noqa: E402
+
+NAME = "study_clearance_effect"
+DESIGNS = ((100.0, 1.4, 0.15), (94.3, 1.84, 0.15))  # R_end [mm], theta_f [deg], Delta_bf [mm]
+REFERENCE_POINT = (20000.0, 0.0, 1000.0)  # speed [rpm], misalignment [mrad], radial load [N]
+
+
+def operating_points(which: str) -> list[tuple[float, float, float]]:
+    """(speed rpm, misalignment mrad, load N): one factor at a time around the reference."""
+    speed, mis, load = REFERENCE_POINT
+    speeds = [(v, mis, load) for v in (10000.0, 20000.0, 30000.0)]
+    if which == "ref":
+        return [REFERENCE_POINT]
+    if which == "speed":
+        return speeds
+    return speeds + [(speed, m, load) for m in (1.0, 2.0)] + [(speed, mis, f) for f in (500.0, 4000.0)]
+
+
+def _op(point):
+    import jaxbearing as jb
+
+    speed, mis, load = point
+    return dataclasses.replace(
+        jb.reference_operating_point(),
+        inner_speed=jb.rpm_to_rad_s(speed),
+        misalignment=mis * 1e-3,
+        radial_load=load,
+    )
+
+
+def clearance_differences(per_plus, per_minus, h: float, objective: float) -> dict:
+    """The paired central difference over seeds (module docstring, step 3)."""
+    import numpy as np
+    from scipy import stats
+
+    d = (np.asarray(per_plus, float) - np.asarray(per_minus, float)) / (2 * h)
+    d = d[np.isfinite(d)]
+    n = d.size
+    mean = float(np.mean(d)) if n else math.nan
+    se = float(np.std(d, ddof=1) / math.sqrt(n)) if n > 1 else math.nan
+    half = float(stats.t.ppf(0.975, n - 1)) * se if n > 1 else math.nan
+    return {
+        "dJ_dDelta_bf_Pa_m_s_per_m": mean,
+        "stderr": se,
+        "ci95": [mean - half, mean + half],
+        "seeds": n,
+        "significant": bool(n > 1 and abs(mean) > half),
+        "share_of_J_per_10um": mean * 10e-6 / objective if objective else math.nan,
+    }
+
+
+def main(
+    quick: bool = False,
+    seeds: int = 16,
+    step_mm: float = 0.01,
+    slices: int = 31,
+    window: int = 2,
+    points: str = "all",
+    designs: int = 2,
+    results_dir: str | None = None,
+) -> dict:
+    import numpy as np
+
+    import jaxbearing as jb
+    from jaxbearing.design import steady_design_metrics_points
+    from jaxbearing.flange import DesignVariables
+
+    if quick:
+        seeds, slices, points, designs = 4, 11, "ref", 1
+    started = time.perf_counter()
+    bearing = dataclasses.replace(jb.reference_bearing(), num_slices=slices)
+    pts = operating_points(points)
+    ops = [_op(p) for p in pts]
+    chosen = [
+        DesignVariables.from_array(np.array([r * 1e-3, math.radians(t), c * 1e-3]))
+        for r, t, c in DESIGNS[:designs]
+    ]
+    h = step_mm * 1e-3
+    kw = dict(seeds=seeds, window_revs=window, settle="auto", workers=_common_workers())
+    cases = [(d, op) for d in chosen for op in ops]
+    _common.log(f"{NAME}: {len(cases)} cases x {seeds} seeds from the skid start")
+    t0 = time.perf_counter()
+    base = steady_design_metrics_points(bearing, [op for _, op in cases], [d for d, _ in cases], **kw)
+    base_s = time.perf_counter() - t0
+
+    def shifted(d, dh):
+        x = np.asarray(d.as_array(), float)
+        return DesignVariables.from_array(np.array([x[0], x[1], x[2] + dh]))
+
+    _common.log(f"{NAME}: {2 * len(cases)} cases x {seeds} seeds continuing at Delta_bf +- h")
+    t0 = time.perf_counter()
+    pm = steady_design_metrics_points(
+        bearing,
+        [op for _, op in cases] * 2,
+        [shifted(d, h) for d, _ in cases] + [shifted(d, -h) for d, _ in cases],
+        initial_states=[m.final_states for m in base] * 2,
+        **kw,
+    )
+    shifted_s = time.perf_counter() - t0
+    rows = []
+    for i, ((d, _), point) in enumerate(zip(cases, pts * len(chosen))):
+        plus, minus = pm[i], pm[len(cases) + i]
+        j = base[i].objective["value"]
+        row = {
+            "design": {
+                "end_radius_mm": float(d.end_radius) * 1e3,
+                "layback_angle_deg": math.degrees(float(d.layback_angle)),
+                "axial_clearance_mm": float(d.axial_clearance) * 1e3,
+            },
+            "speed_rpm": point[0],
+            "misalignment_mrad": point[1],
+            "radial_load_N": point[2],
+            "objective_Pa_m_s": base[i].objective,
+            "settled": bool(base[i].settled and plus.settled and minus.settled),
+            **clearance_differences(plus.objective_per_seed, minus.objective_per_seed, h, j),
+        }
+        rows.append(row)
+        _common.log(
+            f"{NAME}: {point}: dJ/dDelta_bf {row['dJ_dDelta_bf_Pa_m_s_per_m']:.3g} +- {row['stderr']:.2g} "
+            f"({100 * row['share_of_J_per_10um']:.2f} % of J per 10 um), significant {row['significant']}"
+        )
+    data = {
+        "seeds": seeds,
+        "step_mm": step_mm,
+        "num_slices": slices,
+        "window_revs": window,
+        "points": points,
+        "rows": rows,
+        "base_s": base_s,
+        "shifted_s": shifted_s,
+        "wall_s": time.perf_counter() - started,
+        "backend": __import__("jax").default_backend(),
+    }
+    _common.write_json(NAME + ("_quick" if quick else ""), data, results_dir)
+    return data
+
+
+def _common_workers() -> int:
+    """One process per CPU on a CPU (the engine's default there); ignored on an accelerator."""
+    from jaxbearing.run import available_cpus
+
+    return available_cpus()
+
+
+if __name__ == "__main__":
+    argv = sys.argv
+
+    def opt(name, kind, default):
+        v = _common.option_value(argv, name)
+        return default if v is None else kind(v)
+
+    main(
+        quick="--quick" in argv,
+        seeds=opt("--seeds", int, 16),
+        step_mm=opt("--step-mm", float, 0.01),
+        slices=opt("--slices", int, 31),
+        window=opt("--window", int, 2),
+        points=opt("--points", str, "all"),
+        designs=opt("--designs", int, 2),
+        results_dir=_common.option_value(argv, "--results-dir"),
+    )
