@@ -186,6 +186,7 @@ OPTIMISE_TOML_KEYS = {
         "estimator",
         "corner_margin_mm",
         "clearance_step_mm",
+        "statistic",
         "verify_seeds",
         "workers",
     ),
@@ -202,7 +203,7 @@ def load_optimise_toml(path: str) -> dict:
                        aggregate = "max" | "mean", temperature_GPa_m_s = 0.1
         [search]       objective = "steady" | "startup", starts, iterations, learning_rate,
                        rtol; steady: seeds, window_revs, settle, gradient_window_ms, estimator,
-                       corner_margin_mm, clearance_step_mm, verify_seeds, workers;
+                       corner_margin_mm, clearance_step_mm, statistic, verify_seeds, workers;
                        startup: duration_ms, atol
 
     Returns a flat dict {key: value}; unknown sections or keys raise UserInputError."""
@@ -231,7 +232,7 @@ def load_optimise_toml(path: str) -> dict:
 
 _PAIRS = ("end_radius_mm", "layback_angle_deg", "axial_clearance_mm")
 _LISTS = ("speeds_rpm", "loads_N", "weights")
-_TEXTS = ("aggregate", "objective", "estimator")
+_TEXTS = ("aggregate", "objective", "estimator", "statistic")
 _INTS = ("starts", "iterations", "seeds", "window_revs", "verify_seeds", "workers")
 #: most values of an envelope list
 _MAX_LIST = 1000

@@ -65,6 +65,9 @@ def test_bad_steady_settings_are_one_line(kw, text):
         (["--seeds", "0"], "seeds = 0"),
         (["--settle", "soon"], "settle = 'soon'"),
         (["--gradient-window-ms", "-1"], "gradient_window_ms = -1.0: must be > 0"),
+        (["--statistic", "max"], "statistic = 'max': must be one of 'mean', 'peak'"),
+        (["--statistic", "peak", "--estimator", "window"], "statistic = 'peak' needs estimator = 'frozen'"),
+        (["--clearance-step-mm", "-0.01"], "clearance_step_mm = -0.01: must be >= 0"),
     ],
 )
 def test_cli_steady_option_errors(tmp_path, capsys, args, text):
@@ -119,7 +122,17 @@ def test_killed_run_resumes_with_the_same_result(tmp_path, config, monkeypatch, 
     and no result, resumes after iteration 0 with the continuation states, and ends with exactly
     the history and design of an uninterrupted run; other settings are refused."""
     monkeypatch.setattr(steady, "evaluate_starts", _stand_in_starts)
-    args = ["--estimator", "window", "--corner-margin-mm", "0.04", "--clearance-step-mm", "0.01", *ARGS]
+    args = [
+        "--estimator",
+        "frozen",
+        "--statistic",
+        "peak",
+        "--corner-margin-mm",
+        "0.04",
+        "--clearance-step-mm",
+        "0.01",
+        *ARGS,
+    ]
     args[args.index("--iterations") + 1] = "2"
     whole, killed = tmp_path / "whole", tmp_path / "killed"
     assert main(["run", "--config", config, *args, "--no-verify", "--quiet", "--out", str(whole)]) == 0
@@ -131,7 +144,8 @@ def test_killed_run_resumes_with_the_same_result(tmp_path, config, monkeypatch, 
     assert r1["config"]["bearing"]["num_slices"] == 11 and "config_toml" in r1
     assert r1["seeds"]["search"] == [0, 1] and r1["seeds"]["verification"] == [1000, 1001, 1002, 1003]
     assert r1["optimiser_settings"]["seeds"] == 2 and "units" in r1
-    assert r1["settings"]["estimator"] == "window" and r1["settings"]["corner_margin"] == pytest.approx(
+    assert r1["settings"]["statistic"] == "peak"
+    assert r1["settings"]["estimator"] == "frozen" and r1["settings"]["corner_margin"] == pytest.approx(
         0.04e-3
     )
     assert (r1["settings"]["seeds"], r1["settings"]["window_revs"], r1["settings"]["settle"]) == (2, 2, 0.5)

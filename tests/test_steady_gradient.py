@@ -176,11 +176,36 @@ def _frozen_window_states(b, op, state, window=1e-3, num_saves=200):
     return compiled_program("trajectory_states", run, args, num_saves)(*args)
 
 
-def test_frozen_load_derivative_matches_central_differences(settled):
+def test_peak_statistic_combines_as_the_p_mean():
+    """`_combine` with exponent p: J = PV_ref (sum A / sum C)^(1/p) and its gradient by the
+    chain rule, on fabricated per-sample integrals and Jacobians (A and C linear in x)."""
+    from jaxbearing.design._steady_gradient import _combine
+
+    rng = np.random.default_rng(0)
+    vals = rng.uniform(0.5, 2.0, (6, 2))
+    jacs = rng.normal(size=(6, 3, 2))
+    p, ref = 8.0, STEADY_FUNCTIONALS.pv_reference
+
+    def j(x):  # A_k(x) = A_k + dA_k . x, C_k likewise
+        a = vals[:, 0] + jacs[:, :, 0] @ x
+        c = vals[:, 1] + jacs[:, :, 1] @ x
+        return ref * (np.sum(a) / np.sum(c)) ** (1 / p)
+
+    g = _combine(list(zip(vals, jacs)), 1e-3, p)
+    assert g.value == pytest.approx(j(np.zeros(3)), rel=1e-12)
+    fd = [(j(np.eye(3)[i] * 1e-7) - j(-np.eye(3)[i] * 1e-7)) / 2e-7 for i in range(3)]
+    np.testing.assert_allclose(g.gradient, fd, rtol=1e-6)
+    mean = _combine(list(zip(vals, jacs)), 1e-3)
+    assert mean.value == pytest.approx(ref * vals[:, 0].sum() / vals[:, 1].sum(), rel=1e-12)
+
+
+@pytest.mark.parametrize("exponent", [1.0, 8.0])
+def test_frozen_load_derivative_matches_central_differences(settled, exponent):
     """The frozen-load estimator's derivative (jax.jacfwd through the flange geometry and the
     exact-Hertz radii at the loads the dynamics gave) against central differences of the same
     frozen functional on the same saved states (relative steps 1e-6): the states of the
-    estimator's own 1 ms window from a settled state."""
+    estimator's own 1 ms window from a settled state; for the mean (p = 1) and the peak
+    statistic's p-mean (p = 8)."""
     from jaxbearing.design._steady_gradient import frozen_load_integrands
     from jaxbearing.dynamics import Params
 
@@ -194,7 +219,8 @@ def test_frozen_load_derivative_matches_central_differences(settled):
 
     @jax.jit
     def frozen(v):
-        return jnp.sum(jax.vmap(lambda s, q: frozen_load_integrands(b, op, v, s, q))(saved, q0), axis=0)
+        per = jax.vmap(lambda s, q: frozen_load_integrands(b, op, v, s, q, exponent))(saved, q0)
+        return jnp.sum(per, axis=0)
 
     value, jac = frozen(x), jax.jacfwd(frozen)(x)
     for i in range(3):
@@ -205,7 +231,7 @@ def test_frozen_load_derivative_matches_central_differences(settled):
     # at the dynamic loads themselves the frozen PV is the dynamic PV
     fl = jax.vmap(lambda s: contact_loads(s, params).flange)(saved)
     w = q0 / (q0 + STEADY_FUNCTIONALS.contact_load)
-    direct = jnp.sum(w * fl.pv) / STEADY_FUNCTIONALS.pv_reference
+    direct = jnp.sum(w * (fl.pv / STEADY_FUNCTIONALS.pv_reference) ** exponent)
     assert float(value[0]) == pytest.approx(float(direct), rel=1e-9)
 
 

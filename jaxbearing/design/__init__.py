@@ -14,7 +14,8 @@
 - its gradient: `steady_gradient` (an ensemble of short-window forward-mode sensitivities from
   settled states, `GRADIENT_WINDOW`), `frozen_load_gradient` (`frozen_load_gradients`: many cases, one call), `ratio_gradient`,
   `SteadyGradient`, `tangent_growth` (finite-time growth of the tangents) and the smooth
-  accumulators they differentiate, `STEADY_FUNCTIONALS`.
+  accumulators they differentiate, `STEADY_FUNCTIONALS` (`STATISTICS`: the mean, and the
+  peak statistic's p-mean with p = `PEAK_EXPONENT`).
 
 The `optimise` package searches designs with these.
 
@@ -40,6 +41,8 @@ from ._steady_design import (
 )
 from ._steady_gradient import (
     GRADIENT_WINDOW,
+    PEAK_EXPONENT,
+    STATISTICS,
     STEADY_FUNCTIONALS,
     SteadyGradient,
     frozen_load_gradient,
@@ -56,6 +59,8 @@ __all__ = [
     "GRADIENT_MODE_NOTE",
     "GRADIENT_RTOL",
     "GRADIENT_WINDOW",
+    "PEAK_EXPONENT",
+    "STATISTICS",
     "STEADY_FUNCTIONALS",
     "DesignMetrics",
     "SteadyDesignMetrics",

@@ -25,7 +25,9 @@ limited circle, clearance; positive when satisfied) and the full settled summary
   int w PV dt / int w dt with the smooth contact indicator w = Q / (Q + 1 N), integrated inside
   the solve over the window), per seed, with its Student-t interval over the seeds: the quantity
   the optimiser minimises and whose gradient `steady_gradient` estimates (`mean_pv` is the same
-  average over the saved samples with the hard 1 N threshold);
+  average over the saved samples with the hard 1 N threshold); with `statistic="peak"` the
+  p-mean PV_ref (int w (PV/PV_ref)^p dt / int w dt)^(1/p), p = `PEAK_EXPONENT`, which weights
+  the peaks (`STATISTICS`);
 
 It is a measurement, not a differentiable function: the gradient of a long impacting trajectory
 is not a design signal (`_design`, docs/model.md 14); `steady_gradient` estimates the gradient
@@ -55,7 +57,7 @@ from ..flange import (
 from ..geometry import Bearing, OperatingPoint
 from ..io import require
 from ..run import Perturbation, simulate_steady_points, student_t_interval, summarise_steady
-from ._steady_gradient import STEADY_FUNCTIONALS
+from ._steady_gradient import _functionals
 
 #: default dynamic corner margin [m]: the largest contact radius this far inside the limited circle
 CORNER_MARGIN = 0.05e-3
@@ -103,6 +105,7 @@ def steady_design_metrics(
     flange_load: float = DEFAULT_FLANGE_LOAD,
     first_seed: int = 0,
     initial_states=None,
+    statistic: str = "mean",
     **steady_kwargs,
 ) -> SteadyDesignMetrics:
     """Settled flange statistics of `design` over `seeds` seeds (module docstring); further
@@ -129,6 +132,7 @@ def steady_design_metrics_points(
     flange_load: float = DEFAULT_FLANGE_LOAD,
     first_seed: int = 0,
     initial_states=None,
+    statistic: str = "mean",
     **steady_kwargs,
 ) -> list[SteadyDesignMetrics]:
     """`steady_design_metrics` at every operating point of `ops`, every point's seeds members of
@@ -149,7 +153,7 @@ def steady_design_metrics_points(
     bearings = [with_design(bearing, d.end_radius, d.layback_angle, d.axial_clearance) for d in designs]
     pert = steady_kwargs.pop("perturbation", Perturbation())
     pert = dataclasses.replace(pert, seed=int(first_seed))
-    steady_kwargs.setdefault("functionals", STEADY_FUNCTIONALS)
+    steady_kwargs.setdefault("functionals", _functionals(statistic))
     results = simulate_steady_points(
         bearings,
         ops,
@@ -160,15 +164,15 @@ def steady_design_metrics_points(
         initial_states=initial_states,
         **steady_kwargs,
     )
-    pv_ref = float(steady_kwargs["functionals"].pv_reference)
+    fn = steady_kwargs["functionals"]
     return [
-        _metrics(result, d, np.asarray(zone_margins(b, d, flange_load=flange_load)), corner_margin, pv_ref)
+        _metrics(result, d, np.asarray(zone_margins(b, d, flange_load=flange_load)), corner_margin, fn)
         for result, b, d in zip(results, bearings, designs)
     ]
 
 
 def _metrics(
-    result, design: DesignVariables, margins, corner_margin: float, pv_ref: float
+    result, design: DesignVariables, margins, corner_margin: float, functionals
 ) -> SteadyDesignMetrics:
     """The design metrics of one operating point's settled run (module docstring)."""
     s = summarise_steady(result)
@@ -189,8 +193,9 @@ def _metrics(
             "n": est.get("n", 0),
         }
 
+    pv_ref, p = float(functionals.pv_reference), float(functionals.pv_exponent)
     per_seed = [
-        pv_ref * sum(a for a, _ in r.window_integrals) / sum(c for _, c in r.window_integrals)
+        pv_ref * (sum(a for a, _ in r.window_integrals) / sum(c for _, c in r.window_integrals)) ** (1.0 / p)
         if r.status == "ok" and r.window_integrals and sum(c for _, c in r.window_integrals) > 0
         else np.nan
         for r in result.runs

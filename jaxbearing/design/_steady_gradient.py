@@ -69,6 +69,14 @@ from ._design import forward_jacobian
 CONTACT_LOAD = 1.0
 #: the accumulators of the steady objective: p = 1 (the time integral of PV over contact)
 STEADY_FUNCTIONALS = Functionals(pv_exponent=1.0, contact_load=CONTACT_LOAD)
+#: p of the peak statistic: the p-mean of PV over contact time, PV_ref (sum A_p / sum C)^(1/p),
+#: which weights the tail (p = 8: a sample at twice the mean counts 256 times as much)
+PEAK_EXPONENT = 8.0
+#: the steady objective's statistics: "mean" (p = 1) and "peak" (p = `PEAK_EXPONENT`)
+STATISTICS = {
+    "mean": STEADY_FUNCTIONALS,
+    "peak": Functionals(pv_exponent=PEAK_EXPONENT, contact_load=CONTACT_LOAD),
+}
 #: default window of the short-window sensitivities [s] (benchmarks/studies/bench_steady_gradient.py)
 GRADIENT_WINDOW = 1.0e-3
 
@@ -200,9 +208,11 @@ def steady_gradient(
     return _combine([(v[:2] if v[2] > 0.5 else np.full(2, np.nan), j[:, :2]) for v, j in outs], window)
 
 
-def _combine(outs, window) -> SteadyGradient:
+def _combine(outs, window, exponent: float = 1.0) -> SteadyGradient:
     """The ratio estimator and its jackknife from per-sample ((A, C), Jacobian (3, 2)); a
-    failed sample carries NaN and is left out."""
+    failed sample carries NaN and is left out. With `exponent` p (A the integral of
+    (PV/PV_ref)^p): J = PV_ref R^(1/p) with R = sum A / sum C, dJ = J dR / (p R), and the
+    standard errors by the same factor (delta method)."""
     vals = np.stack([v for v, _ in outs])  # (K, 2): A, C
     jacs = np.stack([j for _, j in outs])  # (K, 3 variables, 2 outputs)
     ok = np.all(np.isfinite(vals), axis=1) & np.all(np.isfinite(jacs), axis=(1, 2))
@@ -216,6 +226,10 @@ def _combine(outs, window) -> SteadyGradient:
         )
     value, grad = ratio_gradient(a, c, da, dc, pv_ref)
     value_se, grad_se = _jackknife_stderr(a, c, da, dc, pv_ref)
+    if exponent != 1.0:  # value = PV_ref R above
+        j = pv_ref * (value / pv_ref) ** (1.0 / exponent)
+        factor = j / (exponent * value)
+        value, grad, value_se, grad_se = j, grad * factor, value_se * factor, grad_se * factor
     return SteadyGradient(
         value=float(value),
         gradient=grad,
@@ -296,7 +310,7 @@ def trajectory_states(
     return sol.ys, result_code(sol.result)
 
 
-def frozen_load_integrands(bearing, op, x, state: State, reference_load):
+def frozen_load_integrands(bearing, op, x, state: State, reference_load, exponent=1.0):
     """(sum_c w(Q0_c) PV_c(x) (Q0_c / Q_c(x))^(1/3), sum_c w(Q0_c)) over the flange contacts of
     one state: the flange PV with design x at the loads Q0 = `reference_load` (Z, 4) the
     dynamics gave (module docstring, frozen-load estimator). Hertz: p_max = c(radii) Q^(1/3),
@@ -308,7 +322,8 @@ def frozen_load_integrands(bearing, op, x, state: State, reference_load):
     safe_q = jnp.where(on, fl.normal_force, 1.0)
     ratio = jnp.where(on, (jnp.where(on, q0, 1.0) / safe_q) ** (1.0 / 3.0), 0.0)
     w = q0 / (q0 + STEADY_FUNCTIONALS.contact_load)
-    return jnp.stack([jnp.sum(w * fl.pv * ratio) / STEADY_FUNCTIONALS.pv_reference, jnp.sum(w)])
+    frozen = fl.pv * ratio / STEADY_FUNCTIONALS.pv_reference
+    return jnp.stack([jnp.sum(w * frozen**exponent), jnp.sum(w)])
 
 
 @dataclasses.dataclass(frozen=True)
@@ -321,6 +336,7 @@ class _FrozenSample:
     duration: float
     num_saves: int
     rtol: float
+    exponent: float = 1.0
 
     def __call__(self, state):
         x = jnp.asarray(self.x)
@@ -331,17 +347,18 @@ class _FrozenSample:
         states, code = compiled_program("trajectory_states", trajectory, args, num_saves)(*args)
         if int(code) != 0:
             return np.full(2, np.nan), np.full((3, 2), np.nan)
-        args = (self.bearing, self.op, x, states)
+        args = (self.bearing, self.op, x, states, np.float64(self.exponent))
         val, jac = compiled_program("frozen_load_jacobian", _frozen_jacobian, args)(*args)
         return np.asarray(val), np.asarray(jac)
 
 
-def _frozen_jacobian(bearing, op, x, states):
-    """Sum over the saved states of the frozen-load integrands and their Jacobian in x."""
+def _frozen_jacobian(bearing, op, x, states, exponent=1.0):
+    """Sum over the saved states of the frozen-load integrands (PV to the power `exponent`) and
+    their Jacobian in x."""
     q0 = jax.vmap(lambda s: contact_loads(s, _design_params(bearing, op, x)).flange.normal_force)(states)
 
     def total(v):
-        per = jax.vmap(lambda s, q: frozen_load_integrands(bearing, op, v, s, q))(states, q0)
+        per = jax.vmap(lambda s, q: frozen_load_integrands(bearing, op, v, s, q, exponent))(states, q0)
         return jnp.sum(per, axis=0)
 
     return forward_jacobian(total, x)
@@ -358,12 +375,14 @@ def frozen_load_gradient(
     rtol: float = 1e-3,
     workers: int = 1,
     strategy: str = "auto",
+    statistic: str = "mean",
 ) -> SteadyGradient:
     """The frozen-load estimate (module docstring) of the steady objective and its gradient at
     `design`: from each of `states`, a plain solve over `window` seconds saves the state every
     1 / `saves_per_ms` ms; at every saved state the flange PV is differentiated in the design at
     the loads the dynamics gave (`frozen_load_integrands`), summed, and combined through the
-    ratio estimator; jackknife over the trajectories. `strategy`: as `frozen_load_gradients`."""
+    ratio estimator; jackknife over the trajectories. `statistic`: "mean" (PV over contact
+    time) or "peak" (its p-mean, `STATISTICS`); `strategy`: as `frozen_load_gradients`."""
     forwarded = {k: v for k, v in locals().items() if k not in ("bearing", "op", "design", "states")}
     (gradient,) = frozen_load_gradients([(bearing, op, design, states)], **forwarded)
     return gradient
@@ -377,6 +396,7 @@ def frozen_load_gradients(
     rtol: float = 1e-3,
     workers: int = 1,
     strategy: str = "auto",
+    statistic: str = "mean",
 ) -> list[SteadyGradient]:
     """`frozen_load_gradient` of every case (bearing, op, design, states), e.g. every start and
     operating point of one iteration of the design search; one `SteadyGradient` per case, in
@@ -388,11 +408,12 @@ def frozen_load_gradients(
     require("saves_per_ms", saves_per_ms, lambda v: (v >= 1) & (v == np.round(v)), "an integer >= 1")
     if strategy not in STRATEGIES:
         raise UserInputError(f"strategy = {strategy!r}: must be one of {', '.join(map(repr, STRATEGIES))}")
+    exponent = float(_functionals(statistic).pv_exponent)
     n = max(1, int(round(window * 1e3 * saves_per_ms)))
     jobs, owner = [], []
     for k, (bearing, op, design, states) in enumerate(cases):
         x = np.asarray(design.as_array(), dtype=float)
-        job = _FrozenSample(bearing, op, x, float(window), n, float(rtol))
+        job = _FrozenSample(bearing, op, x, float(window), n, float(rtol), exponent)
         jobs += [(job, s) for s in states]
         owner += [k] * len(states)
     chosen = choose_strategy(strategy, min(int(workers), max(1, len(jobs))))
@@ -402,7 +423,14 @@ def frozen_load_gradients(
         outs = _frozen_samples_batched(jobs)
     else:
         outs = parallel_map(_frozen_job, jobs, workers=workers if chosen == "processes" else 1)
-    return [_combine([o for o, j in zip(outs, owner) if j == k], window) for k in range(len(cases))]
+    return [_combine([o for o, j in zip(outs, owner) if j == k], window, exponent) for k in range(len(cases))]
+
+
+def _functionals(statistic: str) -> Functionals:
+    """The accumulators of the steady objective's `statistic` (`STATISTICS`), or a one-line error."""
+    if statistic not in STATISTICS:
+        raise UserInputError(f"statistic = {statistic!r}: must be one of {', '.join(map(repr, STATISTICS))}")
+    return STATISTICS[statistic]
 
 
 def _frozen_job(item):
@@ -416,14 +444,22 @@ def _frozen_samples_batched(jobs) -> list:
     trajectory and the frozen-load integrals and Jacobian along it."""
     num_saves = jobs[0][0].num_saves
 
-    def one(b, o, x, s, d, r):
+    def one(b, o, x, s, d, r, p):
         states, code = trajectory_states(b, o, s, d, num_saves, rtol=r)
-        val, jac = _frozen_jacobian(b, o, x, states)
+        val, jac = _frozen_jacobian(b, o, x, states, p)
         return val, jac, code
 
     args = stack_trees(
         [
-            (job.bearing, job.op, jnp.asarray(job.x), state, np.float64(job.duration), np.float64(job.rtol))
+            (
+                job.bearing,
+                job.op,
+                jnp.asarray(job.x),
+                state,
+                np.float64(job.duration),
+                np.float64(job.rtol),
+                np.float64(job.exponent),
+            )
             for job, state in jobs
         ]
     )
