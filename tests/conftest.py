@@ -19,22 +19,27 @@ jax.config.update("jax_enable_x64", True)
 #: in at the end (longest-processing-time-first scheduling). Unlisted files follow in their
 #: usual order.
 #: test_engine.py (issue 34: a settled sweep, vmapped members, a resumed batch, several
-#: operating points; about 3 minutes of 11-slice settled runs) sits with the steady-gradient file.
+#: operating points; 11-slice settled runs). Cold, alone, 2026-11-26 (second measurement, the
+#: other core busy): notebooks 276 s, engine 260 s, sweep_distributed 78-94 s (process 0 of
+#: its two-process run loads the stored one-device batch program instead of compiling a
+#: shard_map), skid 81 s, settle 78 s, misalignment 61 s, dynamics 59 s, cmd_simulate 59 s, sweep 48 s, design 43 s,
+#: program_cache 31 s, quasistatic 21 s; so engine starts with the notebooks and
+#: sweep_distributed follows steady_gradient.
 SLOWEST_FILES_FIRST = (
     "test_notebooks.py",
-    "test_sweep_distributed.py",
+    "test_engine.py",
     "test_optimise.py",
     "test_steady_gradient.py",
-    "test_engine.py",
-    "test_settle.py",
-    "test_cmd_simulate.py",
+    "test_sweep_distributed.py",
     "test_skid.py",
-    "test_dynamics.py",
-    "test_design.py",
-    "test_quasistatic.py",
-    "test_program_cache.py",
-    "test_sweep.py",
+    "test_settle.py",
     "test_misalignment.py",
+    "test_dynamics.py",
+    "test_cmd_simulate.py",
+    "test_sweep.py",
+    "test_design.py",
+    "test_program_cache.py",
+    "test_quasistatic.py",
     "test_rosenbrock.py",
     "test_speed.py",
 )

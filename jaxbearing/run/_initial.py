@@ -159,6 +159,18 @@ class SkidStart(eqx.Module):
     static_time_constant: float = float("nan")
 
 
+def _kinematic(bearing, op, scatter):
+    return initial_state(bearing, op, perturbation_of(scatter))
+
+
+def kinematic_start(bearing: Bearing, op: OperatingPoint, perturbation: Perturbation | None) -> State:
+    """`initial_state` (the quasi-static, kinematic start) as one program, built once per
+    machine (`compiled_program`): called eagerly, its quasi-static Newton solve compiles every
+    operation on its own in every process (about 10 s)."""
+    dyn = (bearing, op, traced_scatter(perturbation))
+    return compiled_program("kinematic_start", _kinematic, dyn)(*dyn)
+
+
 def _skid(bearing, op, scatter):
     start = initial_state(bearing, op, perturbation_of(scatter))
     params = Params(bearing=bearing, operating=op)

@@ -61,7 +61,7 @@ from ._initial import (
     Perturbation,
     _static_skid_start,
     along_slow_mode,
-    initial_state,
+    kinematic_start,
     pre_start_steps,
     skid_start,
     static_skid_starts,
@@ -523,7 +523,7 @@ def member_steps(member: Member, options: SteadyOptions, reduce=None, static=Non
         y0 = skid.state
         tau = None if skid.pre_start_status == "ok" else float(skid.time_constant)
     else:
-        y0, tau = initial_state(bearing, op, pert), None
+        y0, tau = kinematic_start(bearing, op, pert), None
     slow_mode = float("nan")
     if options.settle == "auto":
         slow_mode = running_time_constant(skid if skid is not None else static, bearing, op, pert)

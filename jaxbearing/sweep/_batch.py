@@ -119,8 +119,9 @@ class BatchRunner:
 
         from ..run import compiled_program
 
-        if len(self._devices) == 1 and jax.process_count() == 1 and self._devices[0] == jax.devices()[0]:
-            # one device: the plain vmap, stored by `compiled_program` (traced once per machine)
+        if len(self._devices) == 1 and self._devices[0] == jax.local_devices()[0]:
+            # one device (also one process of several, each with one device): the plain vmap,
+            # stored by `compiled_program` (traced once per machine)
             return compiled_program("sweep_batch", jax.vmap(self._one), stacked, self._static)
         from jax.sharding import Mesh, PartitionSpec
 
