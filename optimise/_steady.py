@@ -225,19 +225,14 @@ def evaluate_starts(
     # members: start s, shift j, operating point k at index (s * len(shifts) + j) * len(ops) + k
     shifted = [_shift_clearance(d, dh) for d in designs for dh in shifts]
     initial = [None if c is None else c[k] for c in chains for _ in shifts for k in range(len(ops))]
-    metrics = steady_design_metrics_points(
-        problem.bearing,
+    metrics = _settled_metrics(
+        problem,
+        settings,
         ops * len(shifted),
         [d for d in shifted for _ in ops],
         seeds=settings.seeds,
         window_revs=settings.window_revs,
-        settle=settings.settle,
-        corner_margin=settings.corner_margin,
-        flange_load=problem.flange_load,
         initial_states=None if all(c is None for c in chains) else initial,
-        workers=settings.num_workers,
-        rtol=settings.rtol,
-        statistic=settings.statistic,
     )
     n, m = len(ops), len(shifts)
     base = [metrics[(s * m) * n : (s * m + 1) * n] for s in range(len(designs))]
@@ -282,6 +277,23 @@ def _simulated_ms(m) -> float:
     """Simulated ms of one operating point's settled ensemble: every seed's settling and window."""
     return sum(r["settle_time_ms"] for r in m.summary["per_seed"]) + len(m.seeds) * m.summary.get(
         "window_ms", 0.0
+    )
+
+
+def _settled_metrics(problem: DesignProblem, settings: SteadySettings, ops, designs, **kwargs):
+    """`steady_design_metrics_points` of (design, operating point) pairs, one engine call, with
+    the problem's and the settings' measurement options (`kwargs`: seeds, window, ...)."""
+    return steady_design_metrics_points(
+        problem.bearing,
+        ops,
+        designs,
+        settle=settings.settle,
+        corner_margin=settings.corner_margin,
+        flange_load=problem.flange_load,
+        workers=settings.num_workers,
+        rtol=settings.rtol,
+        statistic=settings.statistic,
+        **kwargs,
     )
 
 
@@ -706,19 +718,14 @@ def verification(problem: DesignProblem, settings: SteadySettings, design, refer
     }
     ops = [_operating_point(problem, k) for k in range(problem.num_operating_points)]
     designs = [DesignVariables.from_array(jnp.asarray(x)) for x in (reference, design)]
-    metrics = steady_design_metrics_points(
-        problem.bearing,
+    metrics = _settled_metrics(
+        problem,
+        settings,
         ops * 2,
         [d for d in designs for _ in ops],
         seeds=settings.verify_seeds,
         window_revs=settings.verify_window_revs,
-        settle=settings.settle,
-        corner_margin=settings.corner_margin,
-        flange_load=problem.flange_load,
         first_seed=settings.verify_first_seed,
-        workers=settings.num_workers,
-        rtol=settings.rtol,
-        statistic=settings.statistic,
     )
     for i, name in enumerate(("reference", "optimum")):
         rows = [_estimates(m) for m in metrics[i * len(ops) : (i + 1) * len(ops)]]
