@@ -166,6 +166,27 @@ def settled():
     return b, op, x, base
 
 
+@pytest.fixture(scope="module")
+def settled_peak():
+    """`settled` with the peak statistic's accumulators (p = 8)."""
+    from jaxbearing.design import steady_design_metrics
+
+    b = dataclasses.replace(jb.reference_bearing(), num_slices=11)
+    op = jb.reference_operating_point()
+    x = np.asarray(DesignVariables.of(b).as_array())
+    base = steady_design_metrics(
+        b,
+        op,
+        DesignVariables.from_array(x),
+        settle=0.005,
+        seeds=3,
+        window_revs=2,
+        workers=1,
+        statistic="peak",
+    )
+    return b, op, x, base
+
+
 def _frozen_window_states(b, op, state, window=1e-3, num_saves=200):
     """The saved states of `frozen_load_gradient`'s window from `state` (its default 1 ms, 200
     saves: the very program it compiles, `trajectory_states`) and the solve's result code."""
@@ -235,7 +256,8 @@ def test_frozen_load_derivative_matches_central_differences(settled, exponent):
     assert float(value[0]) == pytest.approx(float(direct), rel=1e-9)
 
 
-def test_frozen_load_estimator_agrees_with_crn_differences_on_settled_running(settled):
+@pytest.mark.parametrize("statistic", ["mean", "peak"])
+def test_frozen_load_estimator_agrees_with_crn_differences_on_settled_running(request, statistic):
     """The acceptance check of benchmarks/studies/bench_steady_gradient.py at reduced size (11 slices,
     3 seeds, theta_f at the reference design), in the default suite: running from the skid start
     (which lands on the plateau, tests/test_skid.py), then a common-random-number central
@@ -252,12 +274,17 @@ def test_frozen_load_estimator_agrees_with_crn_differences_on_settled_running(se
     cold alone on the 2-core machine): CRN FD -1.233e11 +- 2.2e10 per rad (5.6 standard errors),
     frozen load -9.70e10 +- 2.1e9, 21 % apart. The settling times are in ms: 0.005 ms from the
     skid start and 0.0035 ms after the design change, i.e. none to speak of. The full-size
-    study is benchmarks/studies/bench_steady_gradient.py."""
+    study is benchmarks/studies/bench_steady_gradient.py.
+
+    The peak statistic (the p-mean of PV over contact time, p = 8) the same way (2026-11-26,
+    2 workers): CRN FD -1.96e11 +- 2.0e10 per rad (9.7 standard errors), frozen load
+    -1.57e11 +- 5.6e10, 20 % apart; at two further designs in
+    benchmarks/studies/bench_peak_gradient.py."""
     from jaxbearing.design import frozen_load_gradient, steady_design_metrics
 
     # the skid start lands on the plateau (tests/test_skid.py): measured almost at once (5 us)
-    b, op, x, base = settled
-    kw = dict(seeds=3, window_revs=2, workers=1)
+    b, op, x, base = request.getfixturevalue("settled" if statistic == "mean" else "settled_peak")
+    kw = dict(seeds=3, window_revs=2, workers=1, statistic=statistic)
     h = 0.15 * np.radians(1.0)  # 15 % of the optimiser's theta_f range (1-2 deg)
     per_seed = []
     for sign in (1.0, -1.0):
@@ -269,7 +296,9 @@ def test_frozen_load_estimator_agrees_with_crn_differences_on_settled_running(se
         per_seed.append(np.asarray(m.objective_per_seed))
     d = (per_seed[0] - per_seed[1]) / (2 * h)
     fd, se = float(np.mean(d)), float(np.std(d, ddof=1) / np.sqrt(d.size))
-    g = frozen_load_gradient(b, op, DesignVariables.from_array(x), base.sample_states, workers=1)
+    g = frozen_load_gradient(
+        b, op, DesignVariables.from_array(x), base.sample_states, workers=1, statistic=statistic
+    )
     print(
         f"dJ/dtheta_f: CRN FD {fd:.3e} +- {se:.1e}, frozen load {g.gradient[1]:.3e} +- {g.gradient_stderr[1]:.1e}"
     )
