@@ -594,7 +594,10 @@ CLEARANCE_EFFECT = {
     "+1.83e12 +- 0.95e12 Pa m/s per m, 95 % CI [-0.13e12, +3.79e12] (24 seeds, common-random-number "
     "central differences): not significant; up to about 2.3 % of J per 10 um is not excluded. "
     "Not significant at 80 mm / 1.6 deg and 70 mm / 1.8 deg either (8 seeds)",
-    "unmeasured": "other speeds, misalignment and loads (issue 35, item 1)",
+    "speeds": "R_end 100 mm, theta_f 1.4 deg at reduced size (11 slices, 8 seeds): not significant at 10,000, "
+    "20,000 and 30,000 rpm, 95 % CIs [-1.2e12, 2.0e12], [-3.0e12, 6.1e12], [-11.6e12, 3.7e12] Pa m/s per m "
+    "(benchmarks/studies/study_clearance_effect.py)",
+    "unmeasured": "misalignment and loads, and the speeds at full size (issue 35, item 1)",
 }
 
 
