@@ -21,8 +21,9 @@ loads 500, 1000, 4000 N. Designs: R_end / theta_f / Delta_bf = 100 mm / 1.4 deg 
 design the default search found). Defaults: K = 16, h = 0.01 mm, window 2, 31 slices; about
 2 x 7 x 2 x 16 = 448 settled members: minutes on one GPU, hours on the 2-core CPU.
 
-Options: `--seeds K`, `--step-mm H`, `--slices N`, `--window W`, `--points speed|all|ref`
-(one speed factor, all seven points, or the reference point alone), `--designs 1|2`,
+Options: `--seeds K`, `--step-mm H`, `--slices N`, `--window W`, `--points
+speed|others|all|ref` (the speed factor, the misalignment and load factors, all seven points,
+or the reference point alone), `--designs 1|2`,
 `--results-dir DIR`. `--quick`: the reference point, one design, 4 seeds, 11 slices (a check of
 the script, minutes on the CPU). Results: results/study_clearance_effect[_quick].json.
 """
@@ -47,11 +48,10 @@ def operating_points(which: str) -> list[tuple[float, float, float]]:
     """(speed rpm, misalignment mrad, load N): one factor at a time around the reference."""
     speed, mis, load = REFERENCE_POINT
     speeds = [(v, mis, load) for v in (10000.0, 20000.0, 30000.0)]
-    if which == "ref":
-        return [REFERENCE_POINT]
-    if which == "speed":
-        return speeds
-    return speeds + [(speed, m, load) for m in (1.0, 2.0)] + [(speed, mis, f) for f in (500.0, 4000.0)]
+    others = [(speed, m, load) for m in (1.0, 2.0)] + [(speed, mis, f) for f in (500.0, 4000.0)]
+    if which not in ("ref", "speed", "others", "all"):
+        raise SystemExit(f"--points {which!r}: must be one of ref, speed, others, all")
+    return {"ref": [REFERENCE_POINT], "speed": speeds, "others": others, "all": speeds + others}[which]
 
 
 def _op(point):
