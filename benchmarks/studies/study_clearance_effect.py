@@ -18,8 +18,9 @@ per core. Operating points, one factor at a time around 20,000 rpm / 1000 N / al
 speeds 10,000, 20,000, 30,000 rpm; misalignment 0, 1, 2 mrad (inner ring, tilt held); radial
 loads 500, 1000, 4000 N. Designs: R_end / theta_f / Delta_bf = 100 mm / 1.4 deg / 0.15 mm (the
 24-seed measurement of `optimise`'s CLEARANCE_EFFECT) and 94.3 mm / 1.84 deg / 0.15 mm (a
-design the default search found). Defaults: K = 16, h = 0.01 mm, window 2, 31 slices; about
-2 x 7 x 2 x 16 = 448 settled members: minutes on one GPU, hours on the 2-core CPU.
+design the default search found). Defaults: K = 16, h = 0.01 mm, window 2, 31 slices: 2 x 7 x
+16 = 224 members from the skid start, then 448 continuing, minutes on one GPU (10,800 settled
+members per hour at 11 slices on an H200), hours on the 2-core CPU.
 
 Options: `--seeds K`, `--step-mm H`, `--slices N`, `--window W`, `--points
 speed|others|all|ref` (the speed factor, the misalignment and load factors, all seven points,
