@@ -597,7 +597,11 @@ CLEARANCE_EFFECT = {
     "speeds": "R_end 100 mm, theta_f 1.4 deg at reduced size (11 slices, 8 seeds): not significant at 10,000, "
     "20,000 and 30,000 rpm, 95 % CIs [-1.2e12, 2.0e12], [-3.0e12, 6.1e12], [-11.6e12, 3.7e12] Pa m/s per m "
     "(benchmarks/studies/study_clearance_effect.py)",
-    "unmeasured": "misalignment and loads, and the speeds at full size (issue 35, item 1)",
+    "misalignment_and_load": "the same design and size at 20,000 rpm: significant at 2 mrad misalignment, "
+    "+4.37e12 Pa m/s per m, 95 % CI [2.49e12, 6.24e12] (+2.4 % of J per 10 um: a larger clearance raises "
+    "PV); not significant at 1 mrad ([-0.69e12, 0.69e12]; one seed not settled), 500 N ([-1.1e12, 8.6e12]) "
+    "or 4000 N ([-4.6e12, 9.1e12])",
+    "unmeasured": "the full size (31 slices, 16 seeds), the second design, combined factors (issue 35, item 1)",
 }
 
 
