@@ -64,6 +64,7 @@ from jaxbearing.design import (
     STATISTICS,
     SteadyGradient,
     frozen_load_gradients,
+    paired_central_difference,
     steady_design_metrics_points,
     steady_gradient,
 )
@@ -307,11 +308,8 @@ def _shift_clearance(design: DesignVariables, dh: float) -> DesignVariables:
 def _with_clearance_difference(g: SteadyGradient, plus, minus, h: float) -> SteadyGradient:
     """`g` with its Delta_bf component the paired common-random-number central difference of
     the objective per seed (`evaluate_starts`) and its standard error."""
-    d = (np.asarray(plus.objective_per_seed, float) - np.asarray(minus.objective_per_seed, float)) / (2 * h)
-    d = d[np.isfinite(d)]
     grad, se = np.array(g.gradient, dtype=float), np.array(g.gradient_stderr, dtype=float)
-    grad[2] = np.mean(d) if d.size else np.nan
-    se[2] = np.std(d, ddof=1) / np.sqrt(d.size) if d.size > 1 else np.nan
+    grad[2], se[2], _ = paired_central_difference(plus.objective_per_seed, minus.objective_per_seed, h)
     return dataclasses.replace(g, gradient=grad, gradient_stderr=se)
 
 

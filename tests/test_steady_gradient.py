@@ -336,3 +336,13 @@ def test_frozen_load_gradients_batched_equal_one_at_a_time(settled):
         floor = 1e-9 * np.max(np.abs(a.gradient))
         assert np.all(np.abs(v.gradient - a.gradient) <= a.gradient_stderr + floor)
     assert [g.num_samples for g in batched] == [2, 3] and one[0].value != one[1].value
+
+
+def test_paired_central_difference():
+    """Mean and standard error of (J+ - J-) / 2h over the seeds with both values finite."""
+    from jaxbearing.design import paired_central_difference
+
+    plus, minus = [3.0, 5.0, np.nan, 10.0], [1.0, 1.0, 2.0, 4.0]
+    mean, se, n = paired_central_difference(plus, minus, 0.5)  # differences 2, 4, 6
+    assert (mean, n) == (4.0, 3) and se == pytest.approx(2.0 / np.sqrt(3), rel=1e-12)
+    assert np.isnan(paired_central_difference([1.0], [0.0], 0.5)[1])

@@ -38,7 +38,7 @@ def check(bearing, op, x, statistic: str, workers: int) -> list[dict]:
     """Per variable (theta_f, R_end): the CRN difference and the frozen-load estimate."""
     import numpy as np
 
-    from jaxbearing.design import frozen_load_gradient, steady_design_metrics
+    from jaxbearing.design import frozen_load_gradient, paired_central_difference, steady_design_metrics
     from jaxbearing.flange import DesignVariables
 
     kw = dict(seeds=SEEDS, window_revs=2, workers=workers, statistic=statistic)
@@ -61,8 +61,7 @@ def check(bearing, op, x, statistic: str, workers: int) -> list[dict]:
                 **kw,
             )
             per.append(np.asarray(m.objective_per_seed))
-        d = (per[0] - per[1]) / (2 * h)
-        fd, se = float(np.mean(d)), float(np.std(d, ddof=1) / math.sqrt(d.size))
+        fd, se, _ = paired_central_difference(per[0], per[1], h)
         est = float(g.gradient[i])
         significant = abs(fd) > 3 * se
         rows.append(

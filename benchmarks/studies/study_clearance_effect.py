@@ -69,14 +69,11 @@ def _op(point):
 
 def clearance_differences(per_plus, per_minus, h: float, objective: float) -> dict:
     """The paired central difference over seeds (module docstring, step 3)."""
-    import numpy as np
     from scipy import stats
 
-    d = (np.asarray(per_plus, float) - np.asarray(per_minus, float)) / (2 * h)
-    d = d[np.isfinite(d)]
-    n = d.size
-    mean = float(np.mean(d)) if n else math.nan
-    se = float(np.std(d, ddof=1) / math.sqrt(n)) if n > 1 else math.nan
+    from jaxbearing.design import paired_central_difference
+
+    mean, se, n = paired_central_difference(per_plus, per_minus, h)
     half = float(stats.t.ppf(0.975, n - 1)) * se if n > 1 else math.nan
     return {
         "dJ_dDelta_bf_Pa_m_s_per_m": mean,

@@ -12,7 +12,7 @@
   95 % intervals over seeds; continuation from given states), `SteadyDesignMetrics`,
   `CORNER_MARGIN`;
 - its gradient: `steady_gradient` (an ensemble of short-window forward-mode sensitivities from
-  settled states, `GRADIENT_WINDOW`), `frozen_load_gradient` (`frozen_load_gradients`: many cases, one call), `ratio_gradient`,
+  settled states, `GRADIENT_WINDOW`), `frozen_load_gradient` (`frozen_load_gradients`: many cases, one call), `ratio_gradient`, `paired_central_difference` (common-random-number differences),
   `SteadyGradient`, `tangent_growth` (finite-time growth of the tangents) and the smooth
   accumulators they differentiate, `STEADY_FUNCTIONALS` (`STATISTICS`: the mean, and the
   peak statistic's p-mean with p = `PEAK_EXPONENT`).
@@ -47,6 +47,7 @@ from ._steady_gradient import (
     SteadyGradient,
     frozen_load_gradient,
     frozen_load_gradients,
+    paired_central_difference,
     ratio_gradient,
     steady_gradient,
     tangent_growth,
@@ -70,6 +71,7 @@ __all__ = [
     "forward_jacobian",
     "frozen_load_gradient",
     "frozen_load_gradients",
+    "paired_central_difference",
     "ratio_gradient",
     "seated_perturbation",
     "steady_design_metrics",

@@ -164,6 +164,20 @@ def _check_window(window) -> None:
     require("window", window, lambda v: np.isfinite(v) & (v > 0), "> 0 s and finite")
 
 
+def paired_central_difference(plus, minus, h: float) -> tuple[float, float, int]:
+    """The common-random-number central difference of a settled statistic over paired seeds:
+    the mean over seeds k of (J_k(x + h) - J_k(x - h)) / 2h, its standard error
+    std_k / sqrt(n) and n, the seeds with both values finite (NaN mean without any, NaN error
+    with fewer than two). Each pair shares its seed and starting state, so the seed's scatter
+    cancels in the difference."""
+    d = (np.asarray(plus, float) - np.asarray(minus, float)) / (2 * h)
+    d = d[np.isfinite(d)]
+    n = int(d.size)
+    mean = float(np.mean(d)) if n else float("nan")
+    se = float(np.std(d, ddof=1) / np.sqrt(n)) if n > 1 else float("nan")
+    return mean, se, n
+
+
 def ratio_gradient(a, c, da, dc, pv_reference: float):
     """(J, dJ/dx) of J = PV_ref sum a / sum c from per-sample a (K,), c (K,), da, dc (K, n)."""
     sa, sc = np.sum(a), np.sum(c)
