@@ -19,7 +19,7 @@ Members per hour = members / wall time without compilation (each strategy's comp
 or loading from the persistent cache, is reported beside it). Ratios are against (1), measured in
 the same run. On an accelerator (`jax.default_backend() != "cpu"`), the vmapped engine is also
 timed against the batch size (`--batch-sizes 1,8,64,512,4096`; members = seeds of the reference
-case), members per second per size, and one iteration of the 3-speed design search is timed
+case; `--batch-sizes none` skips them), members per second per size, and one iteration of the 3-speed design search is timed
 (`--search-iteration`: `optimise`'s `evaluate_starts`, 2 starts x 3 speeds (10,000, 20,000
 and 30,000 rpm) x 4 seeds settled as one engine call, then the frozen-load gradients of their
 48 trajectories as one vmapped program; twice: the first call compiles, the second continues
@@ -112,7 +112,7 @@ def main(
     name = NAME if not quick else NAME + "_quick"
     if not accelerator_only:
         data.update(_strategies(options, speeds, seeds))
-    if jax.default_backend() != "cpu":
+    if jax.default_backend() != "cpu" and batch_sizes != "none":
         sizes = [int(v) for v in (batch_sizes or "1,8,64,512,4096").split(",")]
         data["accelerator_batch_sizes"] = []
         for row in _batch_sizes(options, sizes):

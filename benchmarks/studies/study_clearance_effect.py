@@ -98,21 +98,53 @@ def main(
     import numpy as np
 
     import jaxbearing as jb
-    from jaxbearing.design import steady_design_metrics_points
     from jaxbearing.flange import DesignVariables
 
     if quick:
         seeds, slices, points, designs = 4, 11, "ref", 1
+    operating_points(points)  # a bad --points is refused before anything runs
     started = time.perf_counter()
     bearing = dataclasses.replace(jb.reference_bearing(), num_slices=slices)
-    pts = operating_points(points)
-    ops = [_op(p) for p in pts]
     chosen = [
         DesignVariables.from_array(np.array([r * 1e-3, math.radians(t), c * 1e-3]))
         for r, t, c in DESIGNS[:designs]
     ]
     h = step_mm * 1e-3
     kw = dict(seeds=seeds, window_revs=window, settle="auto", workers=_common_workers())
+    data = {
+        "seeds": seeds,
+        "step_mm": step_mm,
+        "num_slices": slices,
+        "window_revs": window,
+        "points": points,
+        "rows": [],
+        "base_s": 0.0,
+        "shifted_s": 0.0,
+        "backend": __import__("jax").default_backend(),
+    }
+    # `all` runs the speed factor, then the misalignment and load factors, writing the results
+    # after each group: a long run never loses a finished group.
+    for group in ("speed", "others") if points == "all" else (points,):
+        rows, base_s, shifted_s = _group(bearing, chosen, operating_points(group), h, kw)
+        data["rows"] += rows
+        data["base_s"] += base_s
+        data["shifted_s"] += shifted_s
+        data["wall_s"] = time.perf_counter() - started
+        data["groups_done"] = data.get("groups_done", []) + [group]
+        _common.write_json(NAME + ("_quick" if quick else ""), data, results_dir)
+    return data
+
+
+def _group(bearing, chosen, pts, h, kw) -> tuple[list[dict], float, float]:
+    """One group of operating points at every design: steps 1-3 of the module docstring, each
+    step's members one call of the engine. Returns the rows and the two steps' wall times."""
+    import numpy as np
+
+    from jaxbearing.design import steady_design_metrics_points
+    from jaxbearing.flange import DesignVariables
+
+    seeds = kw["seeds"]
+    ops = [_op(p) for p in pts]
     cases = [(d, op) for d in chosen for op in ops]
     _common.log(f"{NAME}: {len(cases)} cases x {seeds} seeds from the skid start")
     t0 = time.perf_counter()
@@ -155,20 +187,7 @@ def main(
             f"{NAME}: {point}: dJ/dDelta_bf {row['dJ_dDelta_bf_Pa_m_s_per_m']:.3g} +- {row['stderr']:.2g} "
             f"({100 * row['share_of_J_per_10um']:.2f} % of J per 10 um), significant {row['significant']}"
         )
-    data = {
-        "seeds": seeds,
-        "step_mm": step_mm,
-        "num_slices": slices,
-        "window_revs": window,
-        "points": points,
-        "rows": rows,
-        "base_s": base_s,
-        "shifted_s": shifted_s,
-        "wall_s": time.perf_counter() - started,
-        "backend": __import__("jax").default_backend(),
-    }
-    _common.write_json(NAME + ("_quick" if quick else ""), data, results_dir)
-    return data
+    return rows, base_s, shifted_s
 
 
 def _common_workers() -> int:
