@@ -581,9 +581,9 @@ def steady_search(
 
 
 #: what the search knows about the axial clearance's effect on its objective (result.json
-#: `axial_clearance_effect`; docs/model.md 17): the frozen-load estimator cannot see Delta_bf,
-#: and the only measurement, common-random-number central differences of settled ensembles,
-#: found no significant effect
+#: `axial_clearance_effect`; docs/model.md 17): the frozen-load estimator cannot see Delta_bf;
+#: common-random-number central differences of settled ensembles found it significant only
+#: with the inner ring misaligned by 2 mrad (issue 35, item 1)
 CLEARANCE_EFFECT = {
     "estimator_sees_it": False,
     "why": "the frozen-load estimator moves the flange in its own plane at a fixed load: its dJ/dDelta_bf "
@@ -592,14 +592,20 @@ CLEARANCE_EFFECT = {
     "+1.83e12 +- 0.95e12 Pa m/s per m, 95 % CI [-0.13e12, +3.79e12] (24 seeds, common-random-number "
     "central differences): not significant; up to about 2.3 % of J per 10 um is not excluded. "
     "Not significant at 80 mm / 1.6 deg and 70 mm / 1.8 deg either (8 seeds)",
-    "speeds": "R_end 100 mm, theta_f 1.4 deg at reduced size (11 slices, 8 seeds): not significant at 10,000, "
-    "20,000 and 30,000 rpm, 95 % CIs [-1.2e12, 2.0e12], [-3.0e12, 6.1e12], [-11.6e12, 3.7e12] Pa m/s per m "
-    "(benchmarks/studies/study_clearance_effect.py)",
-    "misalignment_and_load": "the same design and size at 20,000 rpm: significant at 2 mrad misalignment, "
-    "+4.37e12 Pa m/s per m, 95 % CI [2.49e12, 6.24e12] (+2.4 % of J per 10 um: a larger clearance raises "
-    "PV); not significant at 1 mrad ([-0.69e12, 0.69e12]; one seed not settled), 500 N ([-1.1e12, 8.6e12]) "
-    "or 4000 N ([-4.6e12, 9.1e12])",
-    "unmeasured": "the full size (31 slices, 16 seeds), the second design, combined factors (issue 35, item 1)",
+    "study": "benchmarks/studies/study_clearance_effect.py on one H200 (11 slices, 16 seeds, h = 0.01 mm, "
+    "results/study_clearance_effect.json, docs/figures/clearance_effect): 7 operating points (10,000, 20,000, "
+    "30,000 rpm; 1 and 2 mrad; 500 and 4000 N) x 2 designs (100 mm / 1.4 deg and 94.3 mm / 1.84 deg, "
+    "Delta_bf 0.15 mm). Never significantly negative: where the clearance matters, a larger one raises PV",
+    "significant": "100 mm / 1.4 deg at 2 mrad misalignment: +4.41e12 Pa m/s per m, 95 % CI [3.15e12, 5.67e12] "
+    "(+2.5 % of J per 10 um, 7.5 standard errors; 8 seeds on the CPU gave +4.37e12). Marginal (2.2-2.3 "
+    "standard errors; with 14 comparisons, not significant after a Bonferroni correction): 100 mm / 1.4 deg "
+    "at 30,000 rpm, +6.5e12 [0.4e12, 12.6e12] (+2.1 %, one member not settled); 94.3 mm / 1.84 deg at "
+    "500 N, +14.2e12 [0.6e12, 27.8e12] (+8.9 %)",
+    "not_significant": "the other 11: 10,000 and 20,000 rpm, 1 mrad and 4000 N at both designs, 30,000 rpm and "
+    "2 mrad at 94.3 mm / 1.84 deg, 500 N at 100 mm / 1.4 deg; 95 % intervals within -6e12 .. +5e12 Pa m/s "
+    "per m, within -4.2 .. +3.6 % of J per 10 um except 94.3 mm / 1.84 deg at 10,000 rpm (-7.8 .. +6.2 %, "
+    "where J is smallest)",
+    "unmeasured": "31 slices (the study ran at 11), combined factors (misaligned and fast), other designs",
 }
 
 

@@ -27,6 +27,9 @@ speed|others|all|ref` (the speed factor, the misalignment and load factors, all 
 or the reference point alone), `--designs 1|2`,
 `--results-dir DIR`. `--quick`: the reference point, one design, 4 seeds, 11 slices (a check of
 the script, minutes on the CPU). Results: results/study_clearance_effect[_quick].json.
+`--plot [RESULTS.json]` draws a results file (default results/study_clearance_effect.json) as
+docs/figures/clearance_effect/clearance_effect.png: dJ/dDelta_bf as a share of J per 10 um at
+every point and design, with its 95 % interval (filled where significant).
 """
 
 from __future__ import annotations
@@ -190,6 +193,70 @@ def _group(bearing, chosen, pts, h, kw) -> tuple[list[dict], float, float]:
     return rows, base_s, shifted_s
 
 
+FIGURE = (
+    Path(__file__).resolve().parents[2] / "docs" / "figures" / "clearance_effect" / "clearance_effect.png"
+)
+
+
+def plot(results: str | Path | None = None, path: Path = FIGURE) -> Path:
+    """The study's figure (module docstring, `--plot`): one column per operating point, one
+    marker per design, the 95 % interval as a bar; hollow where not significant."""
+    import json
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    data = json.loads(Path(results or _common.RESULTS_DIR / f"{NAME}.json").read_text())
+    rows = data["rows"]
+    labels = []
+    for r in rows:
+        label = (
+            f"{r['speed_rpm'] / 1e3:.0f} krpm\n{r['misalignment_mrad']:g} mrad\n{r['radial_load_N']:.0f} N"
+        )
+        if label not in labels:
+            labels.append(label)
+    designs = []
+    for r in rows:
+        d = (r["design"]["end_radius_mm"], r["design"]["layback_angle_deg"])
+        if d not in designs:
+            designs.append(d)
+    fig, ax = plt.subplots(figsize=(8.0, 4.2))
+    for k, d in enumerate(designs):
+        offset = (k - (len(designs) - 1) / 2) * 0.18
+        color = f"C{k}"
+        for r in rows:
+            if (r["design"]["end_radius_mm"], r["design"]["layback_angle_deg"]) != d:
+                continue
+            j = r["objective_Pa_m_s"]["value"]
+            x = (
+                labels.index(
+                    f"{r['speed_rpm'] / 1e3:.0f} krpm\n{r['misalignment_mrad']:g} mrad\n{r['radial_load_N']:.0f} N"
+                )
+                + offset
+            )
+            y = 100 * r["share_of_J_per_10um"]
+            lo, hi = (100 * v * 10e-6 / j for v in r["ci95"])
+            ax.plot([x, x], [lo, hi], color=color, lw=1.5)
+            ax.plot(x, y, "o", color=color, mfc=color if r["significant"] else "white", ms=6)
+        ax.plot([], [], "o", color=color, label=f"R_end {d[0]:g} mm, theta_f {d[1]:g} deg")
+    ax.axhline(0.0, color="0.5", lw=0.8)
+    ax.set_xticks(range(len(labels)), labels, fontsize=8)
+    ax.set_ylabel("dJ/dDelta_bf x 10 um / J  [%]")
+    ax.set_title(
+        f"Axial clearance effect on the mean flange PV ({data['seeds']} seeds, {data['num_slices']} slices, "
+        f"95 % intervals; filled: significant)",
+        fontsize=9,
+    )
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
 def _common_workers() -> int:
     """One process per CPU on a CPU (the engine's default there); ignored on an accelerator."""
     from jaxbearing.run import available_cpus
@@ -199,6 +266,11 @@ def _common_workers() -> int:
 
 if __name__ == "__main__":
     argv = sys.argv
+    if "--plot" in argv:
+        i = argv.index("--plot")
+        given = argv[i + 1] if i + 1 < len(argv) and not argv[i + 1].startswith("--") else None
+        print(plot(given))
+        raise SystemExit(0)
 
     def opt(name, kind, default):
         v = _common.option_value(argv, name)
