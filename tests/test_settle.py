@@ -206,6 +206,32 @@ def test_bad_start_or_workers_in_python_one_line(kwargs, name):
         jb.simulate(jb.reference_bearing(), jb.reference_operating_point(), settle="auto", **kwargs)
 
 
+def test_continuation_settles_whole_revolutions_of_its_own_cage():
+    """`continuation_settle`: without `continuation_settle_revs` the run's `settle`; with n, 2 pi n /
+    |omega_c| of the given state's cage speed, in ms (the unit of `settle`)."""
+    from types import SimpleNamespace
+
+    from jaxbearing.run._settle import SteadyOptions, continuation_settle
+
+    state = SimpleNamespace(cage=SimpleNamespace(speed=-800.0))  # rad/s; the sign is the direction
+    assert continuation_settle(SteadyOptions(settle="auto"), state) == "auto"
+    two = continuation_settle(SteadyOptions(settle="auto", continuation_settle_revs=2), state)
+    assert two == pytest.approx(2 * 2 * math.pi / 800.0 * 1e3, rel=1e-15)
+    assert continuation_settle(SteadyOptions(settle=5.0, continuation_settle_revs=0), state) == 0.0
+
+
+@pytest.mark.parametrize("value", [-1, 1.5])
+def test_bad_continuation_settle_revs_one_line(value):
+    import jaxbearing as jb
+    from jaxbearing import UserInputError
+    from jaxbearing.run import simulate_steady_points
+
+    with pytest.raises(UserInputError, match="^continuation_settle_revs = .*integer >= 0"):
+        simulate_steady_points(
+            jb.reference_bearing(), [jb.reference_operating_point()], continuation_settle_revs=value
+        )
+
+
 #: a revolution of the reference cage near its plateau (8420 rpm) [s]
 REV = 60.0 / 8420.0
 

@@ -492,6 +492,10 @@ class SteadyOptions:
     functionals: Functionals = Functionals()
     progress: bool = False
     solver: str = DEFAULT_SOLVER
+    #: members continuing from a given state settle this many of their own cage revolutions
+    #: (fixed, declared settled) instead of by `settle` (None: by `settle`); for a small design
+    #: step from a settled state (`continuation_settle`)
+    continuation_settle_revs: int | None = None
 
     def tolerances(self, member: Member) -> tuple[float, float]:
         return (
@@ -512,8 +516,10 @@ def member_steps(member: Member, options: SteadyOptions, reduce=None, static=Non
     (`static_skid_starts`, the vmapped path), else it is solved here when needed."""
     bearing, op, pert, given = member.bearing, member.operating, member.perturbation, member.initial_state
     skid = None
+    settle = options.settle
     if given is not None:  # continuation from a given state
         y0, tau = jax.tree_util.tree_map(jnp.asarray, given), None
+        settle = continuation_settle(options, y0)
     elif options.start == "skid":
         skid = yield from pre_start_steps(
             static if static is not None else _static_skid_start(bearing, op, pert)
@@ -525,16 +531,16 @@ def member_steps(member: Member, options: SteadyOptions, reduce=None, static=Non
     else:
         y0, tau = kinematic_start(bearing, op, pert), None
     slow_mode = float("nan")
-    if options.settle == "auto":
+    if settle == "auto":
         slow_mode = running_time_constant(skid if skid is not None else static, bearing, op, pert)
     if options.progress:
         print(
-            f"seed {pert.seed}: settling ({options.settle}), then {options.window_revs} revolutions",
+            f"seed {pert.seed}: settling ({settle}), then {options.window_revs} revolutions",
             flush=True,
         )
     *out, verdict = yield from settle_and_measure_steps(
         y0,
-        settle=options.settle,
+        settle=settle,
         window_revs=int(options.window_revs),
         tolerance=options.tolerance,
         cap=options.settle_cap_ms * 1e-3,
@@ -544,6 +550,19 @@ def member_steps(member: Member, options: SteadyOptions, reduce=None, static=Non
     )
     run = SeedRun(pert.seed, *out, start_cage_speed_rpm=float(rad_s_to_rpm(y0.cage.speed)), verdict=verdict)
     return run if reduce is None else reduce(run, member)
+
+
+def continuation_settle(options: SteadyOptions, state) -> object:
+    """How a member continuing from `state` settles: `options.settle`, or with
+    `options.continuation_settle_revs` = n a fixed n revolutions of its own cage, 2 pi n /
+    |omega_c| (in ms, as `settle`), where omega_c is `state`'s cage speed. A design search's next
+    iterate starts from the settled states of a design a few per cent of the box away; the
+    settling verdict would need at least `VERDICT_MIN_REVS` revolutions for what is mostly a
+    small shift (docs/model.md 17)."""
+    n = options.continuation_settle_revs
+    if n is None:
+        return options.settle
+    return 2e3 * math.pi * float(n) / abs(float(state.cage.speed))
 
 
 def _run_one(member: Member, options: SteadyOptions, reduce=None, static=None) -> tuple[SeedRun, float]:
@@ -571,7 +590,7 @@ def _continuing_cases(members, options: SteadyOptions) -> dict:
     time constant, which the seeds' scatters move by 3e-6 (reference bearing, 31 slices, seeds
     0-2); solved per seed, the equilibria took 17 of the 66 s of a design-search evaluation (4
     seeds, continuing) on the 2-core CPU, 2026-11-26."""
-    if options.settle != "auto":
+    if options.settle != "auto" or options.continuation_settle_revs is not None:
         return {}
     first, out = {}, {}
     for i, m in enumerate(members):
@@ -724,6 +743,7 @@ def simulate_steady(
     initial_states=None,
     solver: str = DEFAULT_SOLVER,
     strategy: str = "auto",
+    continuation_settle_revs: int | None = None,
 ) -> SteadyResult:
     """Settle (module docstring), then measure `window_revs` cage revolutions, for each of
     `seeds` seeded initial scatters, each from `start`: "skid" (default; the skid equilibrium and
@@ -767,14 +787,16 @@ def simulate_steady_points(
     initial_states=None,
     solver: str = DEFAULT_SOLVER,
     strategy: str = "auto",
+    continuation_settle_revs: int | None = None,
 ) -> list[SteadyResult]:
     """`simulate_steady` at every operating point of `ops` (a sequence), every point's seeds
     members of one call of the steady-running engine (`settle_members`: one process pool or one
     vmapped program for all of them, e.g. a design's whole speed envelope); one `SteadyResult`
     per point, in order. `bearing`: one bearing, or one per point (e.g. several designs, each at
     its operating points: one call for a whole iteration of a design search). `initial_states`:
-    None, or per point None or one state per seed. The wall and compilation times of each result
-    are those of the whole call."""
+    None, or per point None or one state per seed; `continuation_settle_revs` = n: members given
+    a state settle n revolutions of their own cage instead of by `settle` (`continuation_settle`).
+    The wall and compilation times of each result are those of the whole call."""
     from ..io import validate_bearing
 
     ops = list(ops)
@@ -787,6 +809,14 @@ def simulate_steady_points(
     for b, op in zip(bearings, ops):
         validate_bearing(b, op)
     check_steady_options(settle, window_revs, seeds, tolerance, settle_cap_ms, start=start, workers=workers)
+    if continuation_settle_revs is not None:
+        require(
+            "continuation_settle_revs",
+            continuation_settle_revs,
+            lambda v: (v >= 0) & (v == np.round(v)),
+            "an integer >= 0 (revolutions), or None",
+        )
+        continuation_settle_revs = int(continuation_settle_revs)
     settle = settle if isinstance(settle, str) and settle in ("auto", "off") else float(settle)
     options = SteadyOptions(
         settle=settle,
@@ -801,6 +831,7 @@ def simulate_steady_points(
         functionals=functionals,
         progress=progress,
         solver=solver,
+        continuation_settle_revs=continuation_settle_revs,
     )
     n = int(seeds)
     perturbations = [dataclasses.replace(perturbation, seed=perturbation.seed + k) for k in range(n)]
@@ -820,7 +851,9 @@ def simulate_steady_points(
     return [
         SteadyResult(
             runs=engine.runs[k * n : (k + 1) * n],
-            settle=settle,
+            settle=settle
+            if given[k] is None or continuation_settle_revs is None
+            else f"continuation, {continuation_settle_revs} revolutions",
             window_revs=int(window_revs),
             tolerance=tolerance,
             cap=settle_cap_ms * 1e-3,
