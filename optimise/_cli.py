@@ -211,6 +211,18 @@ def build_parser() -> argparse.ArgumentParser:
         f"clearance) (default: {st.clearance_step * mm:g})",
     )
     r.add_argument(
+        "--skip-weight",
+        type=float,
+        help="steady, smooth max: an operating point whose weight in the objective stays below this is "
+        f"not simulated, at most --recheck-every iterations in a row; 0: every point, every iteration "
+        f"(default: {st.skip_weight:g})",
+    )
+    r.add_argument(
+        "--recheck-every",
+        type=int,
+        help=f"steady: every operating point is simulated at least every N iterations (default: {st.recheck_every})",
+    )
+    r.add_argument(
         "--verify-seeds",
         type=int,
         help=f"steady: unseen seeds of the verification (default: {st.verify_seeds})",
@@ -265,6 +277,8 @@ def _settings(args) -> dict:
         ("corner_margin_mm", args.corner_margin_mm),
         ("clearance_step_mm", args.clearance_step_mm),
         ("statistic", args.statistic),
+        ("skip_weight", args.skip_weight),
+        ("recheck_every", args.recheck_every),
         ("verify_seeds", args.verify_seeds),
         ("workers", args.workers),
         ("learning_rate", args.learning_rate),
@@ -347,6 +361,8 @@ def steady_settings_from(s: dict):
         verify_seeds=int(_positive(s, "verify_seeds", st.verify_seeds, int)),
         clearance_step=_positive(s, "clearance_step_mm", st.clearance_step * 1e3, strict=False) * 1e-3,
         statistic=s.get("statistic", st.statistic),
+        skip_weight=_positive(s, "skip_weight", st.skip_weight, strict=False),
+        recheck_every=int(_positive(s, "recheck_every", st.recheck_every, int)),
     )
 
 
@@ -715,6 +731,8 @@ def _steady_result_json(problem, options, settings, res) -> dict:
             "margins_mm": {n: (margins[..., i] * 1e3).tolist() for i, n in enumerate(CONSTRAINT_NAMES)},
             "wall_s": np.asarray(h["wall_s"]).tolist(),
             "simulated_ms": np.asarray(h["simulated_ms"]).tolist(),
+            # per iteration, start and operating point: simulated (True) or its last values reused
+            "points_simulated": np.asarray(h.get("points_simulated", []), dtype=bool).tolist(),
         },
     }
 

@@ -170,7 +170,15 @@ def bounds_from_engineering(
 OPTIMISE_TOML_KEYS = {
     "bounds": ("end_radius_mm", "layback_angle_deg", "axial_clearance_mm"),
     "constraints": ("min_clearance_mm", "flange_load_N"),
-    "envelope": ("speeds_rpm", "loads_N", "weights", "aggregate", "temperature_GPa_m_s"),
+    "envelope": (
+        "speeds_rpm",
+        "loads_N",
+        "weights",
+        "aggregate",
+        "temperature_GPa_m_s",
+        "skip_weight",
+        "recheck_every",
+    ),
     "search": (
         "objective",
         "starts",
@@ -200,7 +208,8 @@ def load_optimise_toml(path: str) -> dict:
                        axial_clearance_mm = [0.10, 0.30]
         [constraints]  min_clearance_mm = 0.0, flange_load_N = 100
         [envelope]     speeds_rpm = [...], loads_N = [...], weights = [...],
-                       aggregate = "max" | "mean", temperature_GPa_m_s = 0.1
+                       aggregate = "max" | "mean", temperature_GPa_m_s = 0.1,
+                       skip_weight = 1e-3, recheck_every = 3 (steady: the active set)
         [search]       objective = "steady" | "startup", starts, iterations, learning_rate,
                        rtol; steady: seeds, window_revs, settle, gradient_window_ms, estimator,
                        corner_margin_mm, clearance_step_mm, statistic, verify_seeds, workers;

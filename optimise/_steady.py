@@ -27,8 +27,14 @@ static margin's. All five enter the same augmented Lagrangian as `_search` (proj
 in the unit box, multiplier update).
 
 Continuation. Every start carries the settled states of its last design, per operating point;
-the next iterate (a step of a few per cent of the box) starts from them, so it settles in the
-minimum two revolutions instead of from the skid start.
+the next iterate (a step of a few per cent of the box) starts from them instead of from the skid
+start, and settles by the verdict (at least four revolutions; a fixed shorter settle is biased,
+docs/model.md 17).
+
+The envelope's active set (`next_active`, smooth max only): an operating point whose weight in
+the objective stays below `skip_weight` even at its interval's bounds is not simulated in the
+next iteration (its last values are reused), unless it holds the smallest corner margin or was
+last simulated `recheck_every` iterations ago.
 
 Resume. After every iteration the whole search state (iterates, optimiser and multiplier
 states, continuation states, history, best design) is written atomically to
@@ -109,11 +115,20 @@ class SteadySettings:
     #: half-step of the common-random-number central difference in Delta_bf [m] (0: off); the
     #: frozen-load estimator cannot see the clearance (`evaluate_starts`)
     clearance_step: float = 0.0
+    #: the envelope's active set (`next_active`): an operating point whose weight in the smooth
+    #: max stays below this is not simulated (0: every point, every iteration) ...
+    skip_weight: float = 1e-3
+    #: ... for at most this many iterations in a row
+    recheck_every: int = 3
 
     def __post_init__(self):
         """One-line errors naming the setting, before anything runs."""
         for name in ("seeds", "verify_seeds"):
             require(name, getattr(self, name), lambda v: (v >= 1) & (v == np.round(v)), "an integer >= 1")
+        require("skip_weight", self.skip_weight, lambda v: (v >= 0) & (v < 1), "in [0, 1)")
+        require(
+            "recheck_every", self.recheck_every, lambda v: (v >= 1) & (v == np.round(v)), "an integer >= 1"
+        )
         for name in ("window_revs", "verify_window_revs"):  # batch means need two batches
             require(name, getattr(self, name), lambda v: (v >= 2) & (v == np.round(v)), "an integer >= 2")
         require(
@@ -202,7 +217,14 @@ def evaluate(
 
 
 def evaluate_starts(
-    problem: DesignProblem, settings: SteadySettings, us, chains, *, gradient: bool = True
+    problem: DesignProblem,
+    settings: SteadySettings,
+    us,
+    chains,
+    *,
+    gradient: bool = True,
+    active=None,
+    previous=None,
 ) -> list[Evaluation]:
     """`evaluate` of every scaled design of `us` (the starts of one iteration; `chains`: the
     continuation states of each, or None): every start's operating points' seeds are members
@@ -215,37 +237,50 @@ def evaluate_starts(
     is the common-random-number central difference of the settled objective, per seed
     (J_k(Delta_bf + h) - J_k(Delta_bf - h)) / 2h with the same seeds from the same states,
     averaged over the seeds with the paired standard error; the two shifted designs of every
-    start and operating point are further members of the same engine call."""
+    start and operating point are further members of the same engine call.
+
+    The envelope (`active`: per start, one flag per operating point, or None: all): a point
+    not active is not simulated; its value, interval, gradient and corner margin are those of
+    `previous` (the start's last `Evaluation`), the margin moved by the static limited-circle
+    margin's change since it was measured, and it continues later from its old states
+    (`next_active`)."""
     t0 = time.perf_counter()
     width = np.asarray(problem.bounds.upper - problem.bounds.lower)
     ops = [_operating_point(problem, k) for k in range(problem.num_operating_points)]
+    n = len(ops)
     h = float(settings.clearance_step)
     shifts = (0.0, h, -h) if gradient and h > 0 and width[2] > 0 else (0.0,)
     designs = [problem.design(jnp.asarray(u)) for u in us]
     chains = [None] * len(designs) if chains is None else list(chains)
-    # members: start s, shift j, operating point k at index (s * len(shifts) + j) * len(ops) + k
-    shifted = [_shift_clearance(d, dh) for d in designs for dh in shifts]
-    initial = [None if c is None else c[k] for c in chains for _ in shifts for k in range(len(ops))]
-    metrics = _settled_metrics(
+    active = [[True] * n for _ in designs] if active is None else [[bool(a) for a in row] for row in active]
+    for s, row in enumerate(active):
+        if not all(row) and (previous is None or previous[s] is None):
+            raise ValueError(f"start {s}: an operating point left out needs the start's previous evaluation")
+    # every active (start, shift, operating point) is one member group of the engine call
+    jobs = [
+        (s, j, k) for s in range(len(designs)) for j in range(len(shifts)) for k in range(n) if active[s][k]
+    ]
+    listed = _settled_metrics(
         problem,
         settings,
-        ops * len(shifted),
-        [d for d in shifted for _ in ops],
+        [ops[k] for _, _, k in jobs],
+        [_shift_clearance(designs[s], shifts[j]) for s, j, _ in jobs],
         seeds=settings.seeds,
         window_revs=settings.window_revs,
-        initial_states=None if all(c is None for c in chains) else initial,
+        initial_states=None
+        if all(c is None for c in chains)
+        else [None if chains[s] is None else chains[s][k] for s, _, k in jobs],
     )
-    n, m = len(ops), len(shifts)
-    base = [metrics[(s * m) * n : (s * m + 1) * n] for s in range(len(designs))]
+    metrics = dict(zip(jobs, listed))
+    keys = [(s, k) for (s, j, k) in jobs if j == 0]
     cases = [
-        (d.apply(problem.bearing), op, d, mk.sample_states)
-        for d, b in zip(designs, base)
-        for op, mk in zip(ops, b)
+        (designs[s].apply(problem.bearing), ops[k], designs[s], metrics[(s, 0, k)].sample_states)
+        for s, k in keys
     ]
     if not gradient:
-        gradients = [SteadyGradient.missing() for _ in cases]
+        found = [SteadyGradient.missing() for _ in cases]
     elif settings.estimator == "frozen":
-        gradients = frozen_load_gradients(
+        found = frozen_load_gradients(
             cases,
             window=settings.gradient_window,
             rtol=settings.rtol,
@@ -253,24 +288,29 @@ def evaluate_starts(
             statistic=settings.statistic,
         )
     else:
-        gradients = [
+        found = [
             steady_gradient(
                 *case, window=settings.gradient_window, rtol=settings.rtol, workers=settings.num_workers
             )
             for case in cases
         ]
-    if m == 3:
-        for s in range(len(designs)):
-            for k in range(n):
-                plus, minus = metrics[(s * m + 1) * n + k], metrics[(s * m + 2) * n + k]
-                gradients[s * n + k] = _with_clearance_difference(gradients[s * n + k], plus, minus, h)
+    gradients = dict(zip(keys, found))
+    if len(shifts) == 3:
+        for s, k in keys:
+            gradients[(s, k)] = _with_clearance_difference(
+                gradients[(s, k)], metrics[(s, 1, k)], metrics[(s, 2, k)], h
+            )
     wall = time.perf_counter() - t0
-    evaluations = [
-        _evaluation(problem, settings, u, b, gradients[s * n : (s + 1) * n], width, wall, gradient)
-        for s, (u, b) in enumerate(zip(us, base))
-    ]
-    for s, ev in enumerate(evaluations):  # the shifted designs' simulated time
-        ev.simulated_ms += sum(_simulated_ms(mk) for mk in metrics[(s * m + 1) * n : (s + 1) * m * n])
+    evaluations = []
+    for s, u in enumerate(us):
+        measured = {k: (metrics[(s, 0, k)], gradients[(s, k)]) for k in range(n) if active[s][k]}
+        ev = _evaluation(
+            problem, settings, u, measured, None if previous is None else previous[s], width, wall, gradient
+        )
+        ev.simulated_ms += sum(
+            _simulated_ms(metrics[(s, j, k)]) for j in range(1, len(shifts)) for k in measured
+        )
+        evaluations.append(ev)
     return evaluations
 
 
@@ -313,11 +353,25 @@ def _with_clearance_difference(g: SteadyGradient, plus, minus, h: float) -> Stea
     return dataclasses.replace(g, gradient=grad, gradient_stderr=se)
 
 
-def _evaluation(problem, settings, u, metrics, gradients, width, wall, gradient: bool) -> Evaluation:
-    """One start's `Evaluation` from its operating points' metrics and gradient estimates."""
+def _evaluation(problem, settings, u, measured, previous, width, wall, gradient: bool) -> Evaluation:
+    """One start's `Evaluation` from the metrics and gradient estimates of its simulated
+    operating points (`measured`: {point: (metrics, gradient)}) and, for the others, `previous`
+    (`evaluate_starts`)."""
     per, new_states, simulated = [], [], 0.0
-    for m, g in zip(metrics, gradients):
+    lc = MARGIN_NAMES.index("limited_circle")
+    here = np.asarray(problem.margins(jnp.asarray(u)))
+    for k in range(problem.num_operating_points):
+        if k not in measured:  # left out: the previous values, the margin moved statically
+            old = dict(previous.per_point[k])
+            then = np.asarray(problem.margins(jnp.asarray(old["measured_at"])))
+            old["corner_margin"] = old["measured_corner_margin"] + float(here[lc] - then[lc])
+            old["simulated"] = False
+            per.append(old)
+            new_states.append(previous.states[k])
+            continue
+        m, g = measured[k]
         j = m.objective
+        margin = _num(m.corner_margin["value"])
         per.append(
             dict(
                 value=_num(j["value"]) / PV_SCALE,
@@ -325,10 +379,13 @@ def _evaluation(problem, settings, u, metrics, gradients, width, wall, gradient:
                 gradient=g.gradient * width / PV_SCALE,
                 gradient_stderr=g.gradient_stderr * width / PV_SCALE,
                 estimator_value=g.value / PV_SCALE,
-                corner_margin=_num(m.corner_margin["value"]),
+                corner_margin=margin,
+                measured_corner_margin=margin,
+                measured_at=np.asarray(u, dtype=float),
                 corner_contact_share=_num(m.corner_contact_share["value"]),
                 mean_pv=m.mean_pv,
                 settled=m.settled,
+                simulated=True,
             )
         )
         new_states.append(m.final_states)
@@ -347,12 +404,40 @@ def _evaluation(problem, settings, u, metrics, gradients, width, wall, gradient:
         gradient=np.where(width > 0, grad, 0.0),
         gradient_stderr=grad_se,
         per_point=per,
-        static_margins=np.asarray(problem.margins(jnp.asarray(u))),
+        static_margins=here,
         dynamic_margin=float(min(p["corner_margin"] for p in per)),
         states=new_states,
         wall_time_s=wall,
         simulated_ms=simulated,
     )
+
+
+def next_active(problem: DesignProblem, settings: SteadySettings, ev: Evaluation, since) -> list[bool]:
+    """Which operating points the next evaluation of a start simulates (the envelope's active
+    set), from its last evaluation `ev` and `since[k]`, the iterations since point k was last
+    simulated. With the smooth max (weights exp(J_k / T), docs/model.md 17) a point whose upper
+    95 % bound J_k^hi is so far below the worst point's lower bound J_w^lo that its weight
+    w_k exp((J_k^hi - J_w^lo) / T) stays below `settings.skip_weight` adds less than that share to
+    the objective and its gradient: it is left out, unless it holds (within `corner_margin`) the
+    smallest dynamic corner margin, or was last simulated `settings.recheck_every` iterations
+    ago. Every point is simulated with the weighted mean, or with `skip_weight` 0."""
+    n = problem.num_operating_points
+    if problem.aggregate != "max" or settings.skip_weight <= 0 or n == 1:
+        return [True] * n
+    w = np.asarray(problem.weights, float) / float(np.sum(problem.weights))
+    hi = np.array([p["ci"][1] for p in ev.per_point], float)
+    lo = np.array([p["ci"][0] for p in ev.per_point], float)
+    values = np.array([p["value"] for p in ev.per_point], float)
+    margins = np.array([p["corner_margin"] for p in ev.per_point], float)
+    if not (np.all(np.isfinite(hi)) and np.all(np.isfinite(lo)) and np.all(np.isfinite(margins))):
+        return [True] * n
+    worst = int(np.argmax(values))
+    bound = w * np.exp(np.minimum((hi - lo[worst]) / problem.temperature, 0.0))
+    near_corner = margins <= margins.min() + settings.corner_margin
+    due = np.asarray(since) + 1 >= settings.recheck_every
+    keep = (bound >= settings.skip_weight) | near_corner | due
+    keep[worst] = True
+    return [bool(v) for v in keep]
 
 
 def _num(v) -> float:
@@ -450,7 +535,15 @@ def steady_search(
     x_start = np.asarray(problem.bounds.from_scaled(u[0]))
     hyper = _Hyper(float(learning_rate), int(num_iterations), float(rho))
     empty = dict(
-        x=[], objective=[], ci=[], gradient=[], gradient_stderr=[], margins=[], wall_s=[], simulated_ms=[]
+        x=[],
+        objective=[],
+        ci=[],
+        gradient=[],
+        gradient_stderr=[],
+        margins=[],
+        wall_s=[],
+        simulated_ms=[],
+        points_simulated=[],
     )
     if not any_feasible(problem)[0]:
         return SteadySearchResult(
@@ -477,6 +570,7 @@ def steady_search(
         history={k: [] for k in empty},
         best=(np.inf, -1, -1, None, None),
         evaluations=0,
+        envelope=_fresh_envelope(num_starts, problem.num_operating_points),
     )
     path = None if directory is None else pathlib.Path(directory) / CHECKPOINT
     key = _fingerprint(problem, settings, hyper, u)
@@ -495,12 +589,23 @@ def steady_search(
     for it in range(state["iteration"] + 1, num_iterations + 1):
         rows = {k: [] for k in empty}
         u_next, opt_next, lam_next = [], [], []
-        # every start's evaluation in one engine call (and one gradient call)
-        evaluations = evaluate_starts(problem, settings, list(state["u"]), state["chains"])
+        # every start's evaluation in one engine call (and one gradient call), at the
+        # operating points of the envelope's active set
+        env = state["envelope"]
+        evaluations = evaluate_starts(
+            problem,
+            settings,
+            list(state["u"]),
+            state["chains"],
+            active=env["active"],
+            previous=[_previous(env, s, state["chains"][s]) for s in range(num_starts)],
+        )
         for s, ev in enumerate(evaluations):
             us = state["u"][s]
             state["chains"][s] = ev.states
-            state["evaluations"] += problem.num_operating_points
+            state["evaluations"] += int(np.sum(env["active"][s]))
+            rows["points_simulated"].append(env["active"][s].copy())
+            _record_envelope(problem, settings, env, s, ev)
             c, jc = _constraints(problem, us, ev.dynamic_margin, us)
             g_obj = ev.gradient if np.all(np.isfinite(ev.gradient)) else np.zeros(3)
             act = np.maximum(0.0, state["lam"][s] - rho * c)
@@ -688,7 +793,78 @@ def _checked_state(path: pathlib.Path, state, template: dict, num_iterations: in
         raise bad("history length")
     if not isinstance(state["best"], tuple) or len(state["best"]) != 5:
         raise bad("best design")
+    env = state["envelope"]
+    if not isinstance(env, dict) or set(env) != set(template["envelope"]):
+        raise bad("envelope")
+    for k, v in template["envelope"].items():
+        check_like(env[k], v, path, "checkpoint")
     return state
+
+
+def _fresh_envelope(num_starts: int, num_points: int) -> dict:
+    """The envelope's active set of every start (`next_active`) and, per start and operating
+    point, what was last measured there (`Evaluation.per_point`): arrays, for the checkpoint."""
+    shape = (num_starts, num_points)
+    nan = np.full(shape, np.nan)
+    return dict(
+        active=np.ones(shape, bool),
+        since=np.zeros(shape, np.int64),
+        value=nan.copy(),
+        ci=np.full(shape + (2,), np.nan),
+        gradient=np.zeros(shape + (3,)),
+        gradient_stderr=np.zeros(shape + (3,)),
+        corner_margin=nan.copy(),
+        measured_at=np.zeros(shape + (3,)),
+        share=nan.copy(),
+        settled=np.zeros(shape, bool),
+    )
+
+
+def _record_envelope(problem: DesignProblem, settings: SteadySettings, env: dict, s: int, ev: Evaluation):
+    """Store start `s`'s simulated points of `ev` in `env` and choose its next active set."""
+    for k, p in enumerate(ev.per_point):
+        if not p["simulated"]:
+            env["since"][s, k] += 1
+            continue
+        env["since"][s, k] = 0
+        env["value"][s, k], env["ci"][s, k] = p["value"], p["ci"]
+        env["gradient"][s, k], env["gradient_stderr"][s, k] = p["gradient"], p["gradient_stderr"]
+        env["corner_margin"][s, k], env["measured_at"][s, k] = p["measured_corner_margin"], p["measured_at"]
+        env["share"][s, k], env["settled"][s, k] = p["corner_contact_share"], p["settled"]
+    env["active"][s] = next_active(problem, settings, ev, env["since"][s])
+
+
+def _previous(env: dict, s: int, states):
+    """Start `s`'s last measurements at every operating point (`evaluate_starts`' `previous`),
+    None before its first evaluation."""
+    if states is None:
+        return None
+    per = [
+        dict(
+            value=float(env["value"][s, k]),
+            ci=tuple(float(v) for v in env["ci"][s, k]),
+            gradient=np.array(env["gradient"][s, k]),
+            gradient_stderr=np.array(env["gradient_stderr"][s, k]),
+            estimator_value=float("nan"),
+            corner_margin=float(env["corner_margin"][s, k]),
+            measured_corner_margin=float(env["corner_margin"][s, k]),
+            measured_at=np.array(env["measured_at"][s, k]),
+            corner_contact_share=float(env["share"][s, k]),
+            mean_pv={},
+            settled=bool(env["settled"][s, k]),
+            simulated=False,
+        )
+        for k in range(env["value"].shape[1])
+    ]
+    return _Previous(per, list(states))
+
+
+@dataclasses.dataclass(frozen=True)
+class _Previous:
+    """What `evaluate_starts` reuses of a start's operating points left out."""
+
+    per_point: list
+    states: list
 
 
 def _estimates(m) -> dict:

@@ -68,6 +68,8 @@ def test_bad_steady_settings_are_one_line(kw, text):
         (["--statistic", "max"], "statistic = 'max': must be one of 'mean', 'peak'"),
         (["--statistic", "peak", "--estimator", "window"], "statistic = 'peak' needs estimator = 'frozen'"),
         (["--clearance-step-mm", "-0.01"], "clearance_step_mm = -0.01: must be >= 0"),
+        (["--skip-weight", "1.5"], "skip_weight = 1.5: must be in [0, 1)"),
+        (["--recheck-every", "0"], "recheck_every = 0: must be > 0"),
     ],
 )
 def test_cli_steady_option_errors(tmp_path, capsys, args, text):
@@ -111,7 +113,7 @@ def _stand_in(problem, settings, u, states=None, *, gradient=True):
     )
 
 
-def _stand_in_starts(problem, settings, us, chains, *, gradient=True):
+def _stand_in_starts(problem, settings, us, chains, *, gradient=True, active=None, previous=None):
     """`_stand_in` for every start of an iteration (`steady.evaluate_starts`)."""
     return [_stand_in(problem, settings, u, c, gradient=gradient) for u, c in zip(us, chains)]
 
@@ -131,6 +133,10 @@ def test_killed_run_resumes_with_the_same_result(tmp_path, config, monkeypatch, 
         "0.04",
         "--clearance-step-mm",
         "0.01",
+        "--skip-weight",
+        "0",
+        "--recheck-every",
+        "2",
         *ARGS,
     ]
     args[args.index("--iterations") + 1] = "2"
@@ -145,6 +151,7 @@ def test_killed_run_resumes_with_the_same_result(tmp_path, config, monkeypatch, 
     assert r1["seeds"]["search"] == [0, 1] and r1["seeds"]["verification"] == [1000, 1001, 1002, 1003]
     assert r1["optimiser_settings"]["seeds"] == 2 and "units" in r1
     assert r1["settings"]["statistic"] == "peak"
+    assert (r1["settings"]["skip_weight"], r1["settings"]["recheck_every"]) == (0.0, 2)
     assert r1["settings"]["estimator"] == "frozen" and r1["settings"]["corner_margin"] == pytest.approx(
         0.04e-3
     )
@@ -414,3 +421,149 @@ def test_clearance_gradient_is_a_paired_crn_difference_in_the_same_engine_call(m
     assert len(seen[0][0]) == 1 and steady.SteadySettings().clearance_step == 0.0
     with pytest.raises(UserInputError, match=r"^clearance_step = -1"):
         steady.SteadySettings(clearance_step=-1.0)
+
+
+def _envelope_engine(seen):
+    """A stand-in for the engine at several speeds: J [Pa m/s] = 1e9 (omega / 1000 rad/s)^2 per
+    seed with an interval of +- 5 %, corner margin 1 mm / (omega / 1000 rad/s); each state
+    counts the evaluations along its chain."""
+    import types
+
+    def engine(bearing, ops, designs, *, seeds, initial_states, **kw):
+        seen.append([float(op.inner_speed) for op in ops])
+        out = []
+        for k, op in enumerate(ops):
+            w = float(op.inner_speed) / 1000.0
+            j = 1e9 * w * w
+            est = {"value": j, "ci95_low": 0.95 * j, "ci95_high": 1.05 * j, "n": seeds}
+            margin = {"value": 1e-3 / w, "ci95_low": 0.0, "ci95_high": 1.0, "n": seeds}
+            steps = 0 if initial_states is None or initial_states[k] is None else initial_states[k][0][1]
+            out.append(
+                types.SimpleNamespace(
+                    objective=est,
+                    objective_per_seed=[j] * seeds,
+                    corner_margin=margin,
+                    corner_contact_share={"value": 0.0},
+                    mean_pv=est,
+                    settled=True,
+                    seeds=list(range(seeds)),
+                    summary={"per_seed": [{"settle_time_ms": 1.0}] * seeds, "window_ms": 2.0},
+                    final_states=[(w, steps + 1)] * seeds,
+                    sample_states=[],
+                )
+            )
+        return out
+
+    return engine
+
+
+def test_envelope_leaves_out_points_of_negligible_weight(monkeypatch):
+    """The envelope's active set (`next_active`): with the smooth max (T = 0.1 GPa m/s) the
+    points whose upper bound is far below the worst point's lower bound are not simulated; their
+    values, gradients and states are the last ones, their corner margin moved by the static
+    limited-circle change; a point near the smallest corner margin, a point due for its recheck,
+    and every point of the weighted mean are simulated (stand-ins for the engine and estimator)."""
+    import jaxbearing as jb
+    from jaxbearing.design import SteadyGradient
+    from jaxbearing.flange import MARGIN_NAMES
+    from optimise import make_problem
+
+    seen = []
+    monkeypatch.setattr(steady, "steady_design_metrics_points", _envelope_engine(seen))
+    monkeypatch.setattr(
+        steady,
+        "frozen_load_gradients",
+        lambda cases, **kw: [
+            SteadyGradient(1e9, np.array([3e9, -4e9, 0.0]), np.full(3, 1e7), 1e6, 1e-4, 4, None, None, None)
+            for _ in cases
+        ],
+    )
+    problem = make_problem(
+        jb.reference_bearing(), jb.reference_operating_point(), speeds_rpm=[10e3, 20e3, 30e3]
+    )
+    settings = steady.SteadySettings(seeds=2, workers=1)
+    u0, u1 = np.array([0.5, 0.5, 0.25]), np.array([0.55, 0.45, 0.25])
+    (ev0,) = steady.evaluate_starts(problem, settings, [u0], [None])
+    assert len(seen[-1]) == 3
+    assert steady.next_active(problem, settings, ev0, [0, 0, 0]) == [False, False, True]
+    assert steady.next_active(problem, settings, ev0, [2, 0, 0]) == [True, False, True]  # recheck due
+    wide = steady.SteadySettings(seeds=2, workers=1, corner_margin=0.6e-3)  # 20k within 0.6 mm of 30k's
+    assert steady.next_active(problem, wide, ev0, [0, 0, 0]) == [False, True, True]
+    assert steady.next_active(problem, steady.SteadySettings(skip_weight=0.0), ev0, [0, 0, 0]) == [True] * 3
+    mean = make_problem(
+        jb.reference_bearing(),
+        jb.reference_operating_point(),
+        speeds_rpm=[10e3, 20e3, 30e3],
+        aggregate="mean",
+    )
+    assert steady.next_active(mean, settings, ev0, [0, 0, 0]) == [True] * 3
+
+    (ev1,) = steady.evaluate_starts(
+        problem, settings, [u1], [ev0.states], active=[[False, False, True]], previous=[ev0]
+    )
+    assert len(seen[-1]) == 1  # only 30,000 rpm simulated
+    for k in (0, 1):
+        old, new = ev0.per_point[k], ev1.per_point[k]
+        assert new["value"] == old["value"] and new["simulated"] is False and ev1.states[k] is ev0.states[k]
+        lc = MARGIN_NAMES.index("limited_circle")
+        moved = float(problem.margins(jnp.asarray(u1))[lc] - problem.margins(jnp.asarray(u0))[lc])
+        assert new["corner_margin"] == pytest.approx(old["corner_margin"] + moved, rel=1e-12)
+    assert ev1.states[2][0][1] == 2  # the simulated point continued its chain
+    assert ev1.objective == pytest.approx(ev0.objective, rel=1e-12)  # the worst point's value, unchanged here
+    with pytest.raises(ValueError, match="previous evaluation"):
+        steady.evaluate_starts(problem, settings, [u1], [ev0.states], active=[[False, False, True]])
+    for bad, name in ((1.0, "skip_weight"), (-0.1, "skip_weight")):
+        with pytest.raises(UserInputError, match=f"^{name} = "):
+            steady.SteadySettings(skip_weight=bad)
+    with pytest.raises(UserInputError, match="^recheck_every = 0"):
+        steady.SteadySettings(recheck_every=0)
+
+
+def test_envelope_search_rechecks_and_resumes_identically(tmp_path, monkeypatch):
+    """`steady_search` at three speeds on the stand-in engine: iteration 0 simulates every point,
+    then only the worst until the recheck (every 3 iterations); the settled ensembles counted are
+    those simulated; a search killed after iteration 1 resumes from its checkpoint (the active set
+    and the last measurements included) to exactly the uninterrupted history."""
+    import jaxbearing as jb
+    from jaxbearing.design import SteadyGradient
+    from optimise import make_problem
+
+    seen = []
+    engine = _envelope_engine(seen)
+    monkeypatch.setattr(steady, "steady_design_metrics_points", engine)
+    monkeypatch.setattr(
+        steady,
+        "frozen_load_gradients",
+        lambda cases, **kw: [
+            SteadyGradient(1e9, np.array([3e9, -4e9, 0.0]), np.full(3, 1e7), 1e6, 1e-4, 4, None, None, None)
+            for _ in cases
+        ],
+    )
+    problem = make_problem(
+        jb.reference_bearing(), jb.reference_operating_point(), speeds_rpm=[10e3, 20e3, 30e3]
+    )
+    settings = steady.SteadySettings(seeds=2, workers=1)
+    kw = dict(num_starts=1, num_iterations=4, verify=False)
+    whole = steady.steady_search(problem, settings, directory=tmp_path / "whole", **kw)
+    assert [len(s) for s in seen] == [3, 1, 1, 3, 1]
+    simulated = whole.history["points_simulated"][:, 0]
+    np.testing.assert_array_equal(simulated.sum(axis=1), [3, 1, 1, 3, 1])
+    assert whole.num_evaluations == 9
+
+    calls = {"n": 0}
+
+    def dying(*a, **k):
+        calls["n"] += 1
+        if calls["n"] == 3:
+            raise KeyboardInterrupt
+        return engine(*a, **k)
+
+    monkeypatch.setattr(steady, "steady_design_metrics_points", dying)
+    with pytest.raises(KeyboardInterrupt):
+        steady.steady_search(problem, settings, directory=tmp_path / "killed", **kw)
+    monkeypatch.setattr(steady, "steady_design_metrics_points", engine)
+    seen.clear()
+    resumed = steady.steady_search(problem, settings, directory=tmp_path / "killed", **kw)
+    assert resumed.resumed_from == 1 and [len(s) for s in seen] == [1, 3, 1]
+    for key in ("x", "objective", "gradient", "margins", "points_simulated"):
+        np.testing.assert_array_equal(resumed.history[key], whole.history[key])
