@@ -211,6 +211,13 @@ def build_parser() -> argparse.ArgumentParser:
         f"clearance) (default: {st.clearance_step * mm:g})",
     )
     r.add_argument(
+        "--corner-constraint",
+        metavar="{prediction,mean}",  # checked by `SteadySettings`: one-line errors
+        help="steady: the dynamic corner margin on the upper 95 %% prediction bound of one revolution's "
+        "largest contact radius (prediction: holds for a further revolution with 95 %% probability) or on "
+        f"its expectation per revolution (mean) (default: {st.corner_constraint})",
+    )
+    r.add_argument(
         "--skip-weight",
         type=float,
         help="steady, smooth max: an operating point whose weight in the objective stays below this is "
@@ -277,6 +284,7 @@ def _settings(args) -> dict:
         ("corner_margin_mm", args.corner_margin_mm),
         ("clearance_step_mm", args.clearance_step_mm),
         ("statistic", args.statistic),
+        ("corner_constraint", args.corner_constraint),
         ("skip_weight", args.skip_weight),
         ("recheck_every", args.recheck_every),
         ("verify_seeds", args.verify_seeds),
@@ -361,6 +369,7 @@ def steady_settings_from(s: dict):
         verify_seeds=int(_positive(s, "verify_seeds", st.verify_seeds, int)),
         clearance_step=_positive(s, "clearance_step_mm", st.clearance_step * 1e3, strict=False) * 1e-3,
         statistic=s.get("statistic", st.statistic),
+        corner_constraint=s.get("corner_constraint", st.corner_constraint),
         skip_weight=_positive(s, "skip_weight", st.skip_weight, strict=False),
         recheck_every=int(_positive(s, "recheck_every", st.recheck_every, int)),
     )

@@ -193,6 +193,7 @@ OPTIMISE_TOML_KEYS = {
         "gradient_window_ms",
         "estimator",
         "corner_margin_mm",
+        "corner_constraint",
         "clearance_step_mm",
         "statistic",
         "verify_seeds",
@@ -212,7 +213,8 @@ def load_optimise_toml(path: str) -> dict:
                        skip_weight = 1e-3, recheck_every = 3 (steady: the active set)
         [search]       objective = "steady" | "startup", starts, iterations, learning_rate,
                        rtol; steady: seeds, window_revs, settle, gradient_window_ms, estimator,
-                       corner_margin_mm, clearance_step_mm, statistic, verify_seeds, workers;
+                       corner_margin_mm, corner_constraint, clearance_step_mm, statistic,
+                       verify_seeds, workers;
                        startup: duration_ms, atol
 
     Returns a flat dict {key: value}; unknown sections or keys raise UserInputError."""
@@ -241,8 +243,8 @@ def load_optimise_toml(path: str) -> dict:
 
 _PAIRS = ("end_radius_mm", "layback_angle_deg", "axial_clearance_mm")
 _LISTS = ("speeds_rpm", "loads_N", "weights")
-_TEXTS = ("aggregate", "objective", "estimator", "statistic")
-_INTS = ("starts", "iterations", "seeds", "window_revs", "verify_seeds", "workers")
+_TEXTS = ("aggregate", "objective", "estimator", "statistic", "corner_constraint")
+_INTS = ("starts", "iterations", "seeds", "window_revs", "verify_seeds", "workers", "recheck_every")
 #: most values of an envelope list
 _MAX_LIST = 1000
 

@@ -88,10 +88,13 @@ CHECKPOINT = "checkpoint.npz"
 LEGACY_CHECKPOINT = "checkpoint.pkl"
 #: version of the measured objective and margins, part of a checkpoint's fingerprint: a
 #: checkpoint of an older definition (2: the dynamic corner margin on the largest contact
-#: radius instead of the p99) is refused, not resumed
-MEASUREMENT_VERSION = 2
+#: radius instead of the p99; 3: the envelope's active set, the corner constraint's prediction
+#: bound) is refused, not resumed
+MEASUREMENT_VERSION = 3
 #: gradient estimators (module docstring)
 ESTIMATORS = ("frozen", "window")
+#: the dynamic corner constraint's statistic (`SteadySettings.corner_constraint`)
+CORNER_CONSTRAINTS = ("prediction", "mean")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -115,6 +118,10 @@ class SteadySettings:
     #: half-step of the common-random-number central difference in Delta_bf [m] (0: off); the
     #: frozen-load estimator cannot see the clearance (`evaluate_starts`)
     clearance_step: float = 0.0
+    #: the dynamic corner constraint: "prediction" (the margin on the upper 95 % prediction bound
+    #: of one revolution's largest contact radius: it holds for a further revolution with 95 %
+    #: probability) or "mean" (on its expectation per revolution: holds on average)
+    corner_constraint: str = "prediction"
     #: the envelope's active set (`next_active`): an operating point whose weight in the smooth
     #: max stays below this is not simulated (0: every point, every iteration) ...
     skip_weight: float = 1e-3
@@ -125,6 +132,10 @@ class SteadySettings:
         """One-line errors naming the setting, before anything runs."""
         for name in ("seeds", "verify_seeds"):
             require(name, getattr(self, name), lambda v: (v >= 1) & (v == np.round(v)), "an integer >= 1")
+        if self.corner_constraint not in CORNER_CONSTRAINTS:
+            raise UserInputError(
+                f"corner_constraint = {self.corner_constraint!r}: must be one of {', '.join(CORNER_CONSTRAINTS)}"
+            )
         require("skip_weight", self.skip_weight, lambda v: (v >= 0) & (v < 1), "in [0, 1)")
         require(
             "recheck_every", self.recheck_every, lambda v: (v >= 1) & (v == np.round(v)), "an integer >= 1"
@@ -371,7 +382,11 @@ def _evaluation(problem, settings, u, measured, previous, width, wall, gradient:
             continue
         m, g = measured[k]
         j = m.objective
-        margin = _num(m.corner_margin["value"])
+        margin = (
+            _num(m.corner_margin_bound)
+            if settings.corner_constraint == "prediction"
+            else _num(m.corner_margin["value"])
+        )
         per.append(
             dict(
                 value=_num(j["value"]) / PV_SCALE,
@@ -881,6 +896,8 @@ def _estimates(m) -> dict:
         "peak_pv_GPa_m_s": _scaled(m.summary.get("flange_pv_Pa_m_s", {}).get("max", {})),
         "corner_contact_share": dict(m.corner_contact_share),
         "corner_margin_mm": _scaled(m.corner_margin, 1e-3),
+        # the margin on the upper 95 % prediction bound of one revolution's largest contact radius
+        "corner_margin_bound_mm": float(m.corner_margin_bound) * 1e3,
         # how far zero corner contact in these seeds bounds the tail (upper 95 % bounds)
         "corner_contact_bound": m.summary.get("corner_contact_bound"),
         "settled": m.settled,

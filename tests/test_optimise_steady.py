@@ -69,6 +69,7 @@ def test_bad_steady_settings_are_one_line(kw, text):
         (["--statistic", "peak", "--estimator", "window"], "statistic = 'peak' needs estimator = 'frozen'"),
         (["--clearance-step-mm", "-0.01"], "clearance_step_mm = -0.01: must be >= 0"),
         (["--skip-weight", "1.5"], "skip_weight = 1.5: must be in [0, 1)"),
+        (["--corner-constraint", "p99"], "corner_constraint = 'p99': must be one of prediction, mean"),
         (["--recheck-every", "0"], "recheck_every = 0: must be > 0"),
     ],
 )
@@ -213,6 +214,7 @@ def _metrics_stand_in(calls):
             objective=est(pv, 0.05e9),
             corner_contact_share=est(share, 0.0),
             corner_margin=est(1e-4, 1e-5),
+            corner_margin_bound=0.5e-4,
             summary={"corner_contact_bound": {"per_revolution_upper95": 0.17 if share == 0 else 1.0}},
             settled=True,
             seeds=list(range(first_seed, first_seed + seeds)),
@@ -382,6 +384,7 @@ def test_clearance_gradient_is_a_paired_crn_difference_in_the_same_engine_call(m
                     objective=est,
                     objective_per_seed=per_seed,
                     corner_margin=est,
+                    corner_margin_bound=1e-4,
                     corner_contact_share=est,
                     mean_pv=est,
                     settled=True,
@@ -443,6 +446,7 @@ def _envelope_engine(seen):
                     objective=est,
                     objective_per_seed=[j] * seeds,
                     corner_margin=margin,
+                    corner_margin_bound=0.5e-3 / w,
                     corner_contact_share={"value": 0.0},
                     mean_pv=est,
                     settled=True,
@@ -485,9 +489,15 @@ def test_envelope_leaves_out_points_of_negligible_weight(monkeypatch):
     u0, u1 = np.array([0.5, 0.5, 0.25]), np.array([0.55, 0.45, 0.25])
     (ev0,) = steady.evaluate_starts(problem, settings, [u0], [None])
     assert len(seen[-1]) == 3
+    # the corner constraint: by default on the prediction bound, "mean" on the expectation
+    assert ev0.dynamic_margin == pytest.approx(0.5e-3 / (float(problem.operating.inner_speed[2]) / 1000.0))
+    (ev_mean,) = steady.evaluate_starts(
+        problem, steady.SteadySettings(seeds=2, workers=1, corner_constraint="mean"), [u0], [None]
+    )
+    assert ev_mean.dynamic_margin == pytest.approx(2 * ev0.dynamic_margin)
     assert steady.next_active(problem, settings, ev0, [0, 0, 0]) == [False, False, True]
     assert steady.next_active(problem, settings, ev0, [2, 0, 0]) == [True, False, True]  # recheck due
-    wide = steady.SteadySettings(seeds=2, workers=1, corner_margin=0.6e-3)  # 20k within 0.6 mm of 30k's
+    wide = steady.SteadySettings(seeds=2, workers=1, corner_margin=0.3e-3)  # 20k within 0.3 mm of 30k's
     assert steady.next_active(problem, wide, ev0, [0, 0, 0]) == [False, True, True]
     assert steady.next_active(problem, steady.SteadySettings(skip_weight=0.0), ev0, [0, 0, 0]) == [True] * 3
     mean = make_problem(

@@ -17,6 +17,9 @@ confidence interval (Student-t over the seeds' batch means, `jaxbearing.run.stud
   margin: skewing rollers ride out towards the corner, the paper's Figure 13b). A percentile is
   not enough: at R_end 106.9 mm / theta_f 1.616 deg the p99 stayed 0.083 mm inside while 0.15 %
   of the contact time reached the corner (docs/model.md 17);
+- `corner_margin_bound` [m]: the same margin on the upper 95 % prediction bound of one
+  revolution's largest contact radius (`jaxbearing.run.max_contact_radius_bound`): it holds for
+  a further revolution with 95 % probability, where `corner_margin` holds on average;
 
 beside the four static design-zone margins of `flange.zone_margins` (relief, height,
 limited circle, clearance; positive when satisfied) and the full settled summary.
@@ -83,6 +86,10 @@ class SteadyDesignMetrics:
     final_states: list = dataclasses.field(default_factory=list, repr=False)
     #: settled states of every seed (window start and end): samples for `steady_gradient`
     sample_states: list = dataclasses.field(default_factory=list, repr=False)
+    #: rho_lim - `margin` - the upper 95 % prediction bound of one revolution's largest contact
+    #: radius (`run.max_contact_radius_bound`) [m]: the corner margin that holds for a further
+    #: revolution with 95 % probability, not only on average
+    corner_margin_bound: float = float("nan")
 
     def as_dict(self) -> dict:
         """Everything but the final states, as plain (JSON-able) values."""
@@ -193,6 +200,7 @@ def _metrics(
             "n": est.get("n", 0),
         }
 
+    bound = float(s.get("max_contact_radius_bound", {}).get("value", np.nan))  # NaN stays NaN
     pv_ref, p = float(functionals.pv_reference), float(functionals.pv_exponent)
     per_seed = [
         pv_ref * (sum(a for a, _ in r.window_integrals) / sum(c for _, c in r.window_integrals)) ** (1.0 / p)
@@ -220,4 +228,5 @@ def _metrics(
         sample_states=[
             x for r in result.runs if r.status == "ok" for x in (r.window_start_state, r.final_state)
         ],
+        corner_margin_bound=float("nan") if rho_lim is None else rho_lim - corner_margin - bound,
     )

@@ -11,7 +11,8 @@
   `FILM_KEYS`); of settled running with 95 % confidence
   intervals: `steady_statistics`, `revolution_statistics`, `confidence_intervals`,
   `batch_means`, `student_t_interval`, `Estimate`; how often the contact reached the corner,
-  with upper bounds: `corner_contact_bound`, `upper_probability_bound`;
+  with upper bounds: `corner_contact_bound`, `upper_probability_bound`; the prediction bound
+  of one revolution's largest contact radius: `max_contact_radius_bound`;
 - settled running: `simulate_steady` (settling detection over cage revolutions, a window,
   seeds), `simulate_steady_points` (the same at several operating points, one engine call),
   `summarise_steady`; the steady-running engine under it, `settle_members` (many
@@ -86,6 +87,7 @@ from ._statistics import (
     batch_means,
     confidence_intervals,
     corner_contact_bound,
+    max_contact_radius_bound,
     revolution_statistic_keys,
     revolution_statistics,
     steady_statistics,
@@ -166,6 +168,7 @@ __all__ = [
     "steady_statistics",
     "student_t_interval",
     "corner_contact_bound",
+    "max_contact_radius_bound",
     "upper_probability_bound",
     "summarise",
     "summarise_steady",

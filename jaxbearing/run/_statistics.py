@@ -246,6 +246,33 @@ def corner_contact_bound(per_revolution: list[dict[str, np.ndarray]], rho_lim: f
     }
 
 
+def max_contact_radius_bound(
+    per_revolution: list[dict[str, np.ndarray]], confidence: float = CONFIDENCE
+) -> dict:
+    """The one-sided upper prediction bound of the largest contact radius in contact of one
+    further cage revolution: over the N measured revolutions of every seed (taken as
+    independent: the rollers' axial memory is 3-4 ms against a 7 ms revolution, docs/model.md
+    17) with mean m and standard deviation s,
+
+        U = m + t_{confidence, N-1} s sqrt(1 + 1/N)
+
+    (the normal prediction interval; Hahn & Meeker 1991, Statistical Intervals, section 4.7):
+    a new revolution stays below U with probability `confidence`, where the expectation of the
+    per-revolution maximum (the `contact_radius_m.max_in_contact` estimate) says nothing about
+    single revolutions. NaN with fewer than two revolutions."""
+    values = np.concatenate(
+        [np.asarray(r["contact_radius_m.max_in_contact"], float).ravel() for r in per_revolution]
+        or [np.zeros(0)]
+    )
+    values = values[np.isfinite(values)]
+    n = int(values.size)
+    bound = float("nan")
+    if n >= 2:
+        t = float(_sp_stats.t.ppf(confidence, n - 1))
+        bound = float(np.mean(values) + t * np.std(values, ddof=1) * np.sqrt(1.0 + 1.0 / n))
+    return {"value": bound, "revolutions": n, "confidence": float(confidence)}
+
+
 def window_statistics(window: dict, edges, bearing, op, threshold: float = 1.0) -> dict[str, np.ndarray]:
     """`revolution_statistics` of one seed's measurement window `window` with revolution
     boundaries `edges` [s], for `bearing` at `op`."""
@@ -268,6 +295,7 @@ def steady_statistics(
     block = _nest(est)
     block["ci_method"] = method
     block["corner_contact_bound"] = corner_contact_bound(per_rev, rho_lim)
+    block["max_contact_radius_bound"] = max_contact_radius_bound(per_rev)
     block["limited_circle_radius_m"] = rho_lim
     block["kinematic_cage_speed_rpm"] = float(rad_s_to_rpm(kin))
     return block
