@@ -32,6 +32,10 @@ def test_steady_design_metrics_report_intervals_and_margins(small):
     widest = m.summary["contact_radius_m"]["max_in_contact"]["value"]
     assert widest >= m.summary["contact_radius_m"]["p99"]["value"]
     assert m.corner_margin["value"] == pytest.approx(rho_lim - jb.design.CORNER_MARGIN - widest)
+    # the prediction bound of one further revolution over the 4 revolutions lies above their mean
+    bound = m.summary["max_contact_radius_bound"]
+    assert bound["revolutions"] == 4 and bound["value"] > widest
+    assert m.corner_margin_bound == pytest.approx(rho_lim - jb.design.CORNER_MARGIN - bound["value"])
     assert set(m.static_margins) == set(MARGIN_NAMES)
     assert m.design["axial_clearance_m"] == pytest.approx(0.15e-3)
 
