@@ -461,19 +461,14 @@ def _envelope_engine(seen):
     return engine
 
 
-def test_envelope_leaves_out_points_of_negligible_weight(monkeypatch):
-    """The envelope's active set (`next_active`): with the smooth max (T = 0.1 GPa m/s) the
-    points whose upper bound is far below the worst point's lower bound are not simulated; their
-    values, gradients and states are the last ones, their corner margin moved by the static
-    limited-circle change; a point near the smallest corner margin, a point due for its recheck,
-    and every point of the weighted mean are simulated (stand-ins for the engine and estimator)."""
+def _three_speed_stand_ins(monkeypatch, engine):
+    """The reference problem at 10,000, 20,000 and 30,000 rpm with `engine` for the settled
+    ensembles and a constant frozen-load gradient; 2 seeds, one worker."""
     import jaxbearing as jb
     from jaxbearing.design import SteadyGradient
-    from jaxbearing.flange import MARGIN_NAMES
     from optimise import make_problem
 
-    seen = []
-    monkeypatch.setattr(steady, "steady_design_metrics_points", _envelope_engine(seen))
+    monkeypatch.setattr(steady, "steady_design_metrics_points", engine)
     monkeypatch.setattr(
         steady,
         "frozen_load_gradients",
@@ -485,7 +480,21 @@ def test_envelope_leaves_out_points_of_negligible_weight(monkeypatch):
     problem = make_problem(
         jb.reference_bearing(), jb.reference_operating_point(), speeds_rpm=[10e3, 20e3, 30e3]
     )
-    settings = steady.SteadySettings(seeds=2, workers=1)
+    return problem, steady.SteadySettings(seeds=2, workers=1)
+
+
+def test_envelope_leaves_out_points_of_negligible_weight(monkeypatch):
+    """The envelope's active set (`next_active`): with the smooth max (T = 0.1 GPa m/s) the
+    points whose upper bound is far below the worst point's lower bound are not simulated; their
+    values, gradients and states are the last ones, their corner margin moved by the static
+    limited-circle change; a point near the smallest corner margin, a point due for its recheck,
+    and every point of the weighted mean are simulated (stand-ins for the engine and estimator)."""
+    import jaxbearing as jb
+    from jaxbearing.flange import MARGIN_NAMES
+    from optimise import make_problem
+
+    seen = []
+    problem, settings = _three_speed_stand_ins(monkeypatch, _envelope_engine(seen))
     u0, u1 = np.array([0.5, 0.5, 0.25]), np.array([0.55, 0.45, 0.25])
     (ev0,) = steady.evaluate_starts(problem, settings, [u0], [None])
     assert len(seen[-1]) == 3
@@ -534,25 +543,10 @@ def test_envelope_search_rechecks_and_resumes_identically(tmp_path, monkeypatch)
     then only the worst until the recheck (every 3 iterations); the settled ensembles counted are
     those simulated; a search killed after iteration 1 resumes from its checkpoint (the active set
     and the last measurements included) to exactly the uninterrupted history."""
-    import jaxbearing as jb
-    from jaxbearing.design import SteadyGradient
-    from optimise import make_problem
 
     seen = []
     engine = _envelope_engine(seen)
-    monkeypatch.setattr(steady, "steady_design_metrics_points", engine)
-    monkeypatch.setattr(
-        steady,
-        "frozen_load_gradients",
-        lambda cases, **kw: [
-            SteadyGradient(1e9, np.array([3e9, -4e9, 0.0]), np.full(3, 1e7), 1e6, 1e-4, 4, None, None, None)
-            for _ in cases
-        ],
-    )
-    problem = make_problem(
-        jb.reference_bearing(), jb.reference_operating_point(), speeds_rpm=[10e3, 20e3, 30e3]
-    )
-    settings = steady.SteadySettings(seeds=2, workers=1)
+    problem, settings = _three_speed_stand_ins(monkeypatch, engine)
     kw = dict(num_starts=1, num_iterations=4, verify=False)
     whole = steady.steady_search(problem, settings, directory=tmp_path / "whole", **kw)
     assert [len(s) for s in seen] == [3, 1, 1, 3, 1]
