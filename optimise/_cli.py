@@ -618,22 +618,23 @@ def run_steady(args, problem, options, settings, out, meta=None) -> int:
         )
     v = res.verification
     if v:
-        for name in ("reference", "optimum"):
-            row = v[name] if "mean_pv_GPa_m_s" in v[name] else v[name]["per_operating_point"][0]
-            e, c = row["mean_pv_GPa_m_s"], row["corner_contact_share"]
-            pk = row.get("peak_pv_GPa_m_s") or {}
-            peak = (
-                f", peak PV {pk['value']:.3f} [{pk['ci95_low']:.3f}, {pk['ci95_high']:.3f}]"
-                if None not in (pk.get("value"), pk.get("ci95_low"), pk.get("ci95_high"))
-                else ""
-            )
-            print(
-                f"  verification {name:9s} mean PV {e['value']:.4f} [{e['ci95_low']:.4f}, "
-                f"{e['ci95_high']:.4f}]{peak} GPa m/s, corner share {c['value']:.3f} "
-                f"(seeds {v['seeds'][0]}-{v['seeds'][-1]})"
-            )
+        import numpy as np
+
+        speeds = np.asarray(problem.operating.inner_speed).ravel() * 30 / math.pi
+        loads = np.asarray(problem.operating.radial_load).ravel()
+        for k in range(problem.num_operating_points):
+            where = f" at {speeds[k]:.0f} rpm, {loads[k]:.0f} N" if problem.num_operating_points > 1 else ""
+            for name in ("reference", "optimum"):
+                row = v[name] if "mean_pv_GPa_m_s" in v[name] else v[name]["per_operating_point"][k]
+                label = name if where else f"{name:9s}"
+                seeds = f"seeds {v['seeds'][0]}-{v['seeds'][-1]}"
+                print(f"  verification {label}{where}: {_verified_text(row)} ({seeds})")
         if "mean_pv_lower_disjoint" in v:
-            print(f"  verified lower mean PV with disjoint 95 % CIs: {v['mean_pv_lower_disjoint']}")
+            print(
+                "  verified lower mean PV with disjoint 95 % CIs"
+                f"{' at every operating point' if problem.num_operating_points > 1 else ''}: "
+                f"{v['mean_pv_lower_disjoint']}"
+            )
         bound = v.get("optimum_corner_contact_per_revolution_upper95")
         if bound is not None:
             print(
@@ -643,6 +644,21 @@ def run_steady(args, problem, options, settings, out, meta=None) -> int:
     print(f"  {res.num_evaluations} settled ensembles, {res.wall_time_s:.1f} s wall")
     print(f"wrote {out / 'result.json'} and {plot_path}")
     return 0
+
+
+def _verified_text(row: dict) -> str:
+    """One design's verification at one operating point, in one line."""
+    e, c = row["mean_pv_GPa_m_s"], row["corner_contact_share"]
+    pk = row.get("peak_pv_GPa_m_s") or {}
+    peak = (
+        f", peak PV {pk['value']:.3f} [{pk['ci95_low']:.3f}, {pk['ci95_high']:.3f}]"
+        if None not in (pk.get("value"), pk.get("ci95_low"), pk.get("ci95_high"))
+        else ""
+    )
+    return (
+        f"mean PV {e['value']:.4f} [{e['ci95_low']:.4f}, {e['ci95_high']:.4f}]{peak} GPa m/s, "
+        f"corner share {c['value']:.3f}"
+    )
 
 
 def _engineering(x):

@@ -437,7 +437,7 @@ def next_active(problem: DesignProblem, settings: SteadySettings, ev: Evaluation
     smallest dynamic corner margin, or was last simulated `settings.recheck_every` iterations
     ago. Every point is simulated with the weighted mean, or with `skip_weight` 0."""
     n = problem.num_operating_points
-    if problem.aggregate != "max" or settings.skip_weight <= 0 or n == 1:
+    if problem.aggregate != "max" or settings.skip_weight <= 0 or n == 1 or len(ev.per_point) != n:
         return [True] * n
     w = np.asarray(problem.weights, float) / float(np.sum(problem.weights))
     hi = np.array([p["ci"][1] for p in ev.per_point], float)
@@ -934,13 +934,25 @@ def verification(problem: DesignProblem, settings: SteadySettings, design, refer
     for i, name in enumerate(("reference", "optimum")):
         rows = [_estimates(m) for m in metrics[i * len(ops) : (i + 1) * len(ops)]]
         out[name] = rows[0] if len(rows) == 1 else {"per_operating_point": rows}
-    ref, opt = out["reference"], out["optimum"]
-    if "mean_pv_GPa_m_s" in ref:
-        r, o = ref["mean_pv_GPa_m_s"], opt["mean_pv_GPa_m_s"]
-        out["mean_pv_lower_disjoint"] = bool(
-            None not in (r["ci95_low"], o["ci95_high"]) and o["ci95_high"] < r["ci95_low"]
-        )
-        out["optimum_corner_contacts"] = bool((opt["corner_contact_share"].get("value") or 0.0) > 0)
+    refs = out["reference"].get("per_operating_point", [out["reference"]])
+    opts = out["optimum"].get("per_operating_point", [out["optimum"]])
+
+    def lower(key: str) -> list[bool]:  # per point: the optimum's interval below the reference's
+        return [
+            bool(
+                None not in (r[key]["ci95_low"], o[key]["ci95_high"])
+                and o[key]["ci95_high"] < r[key]["ci95_low"]
+            )
+            for r, o in zip(refs, opts)
+        ]
+
+    # at every operating point (the whole envelope)
+    out["mean_pv_lower_disjoint"] = all(lower("mean_pv_GPa_m_s"))
+    out["objective_lower_disjoint"] = all(lower("objective_GPa_m_s"))
+    if len(ops) > 1:
+        out["mean_pv_lower_disjoint_per_operating_point"] = lower("mean_pv_GPa_m_s")
+        out["objective_lower_disjoint_per_operating_point"] = lower("objective_GPa_m_s")
+    out["optimum_corner_contacts"] = any((o["corner_contact_share"].get("value") or 0.0) > 0 for o in opts)
     for name in ("reference", "optimum"):  # the weakest bound over the operating points
         rows = out[name].get("per_operating_point", [out[name]])
         bounds = [r["corner_contact_bound"] for r in rows if r.get("corner_contact_bound")]

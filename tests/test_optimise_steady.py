@@ -228,7 +228,7 @@ def _metrics_stand_in(calls):
     return points
 
 
-def test_verify_seeds_option_reaches_the_verification(tmp_path, config, monkeypatch):
+def test_verify_seeds_option_reaches_the_verification(tmp_path, config, monkeypatch, capsys):
     """`optimise run --verify-seeds 3`: the verification re-measures the reference and the found
     design with 3 seeds from 1000 on (stand-ins for the search's ensemble and for
     `steady_design_metrics_points`; the real ones are in tests/test_steady_design.py)."""
@@ -241,6 +241,16 @@ def test_verify_seeds_option_reaches_the_verification(tmp_path, config, monkeypa
     assert r["verification"]["seeds"] == [1000, 1001, 1002]
     assert [c[1:] for c in calls[:2]] == [(3, 1000, 4), (3, 1000, 4)]  # reference, then the optimum
     assert calls[2:] == ["call"]  # both designs in one engine call
+    # at two speeds: one line per design and operating point
+    out = tmp_path / "two_speeds"
+    args = [*ARGS, "--speeds-rpm", "10000,30000", "--verify-seeds", "3", "--out", str(out)]
+    assert main(["run", "--config", config, *args]) == 0
+    text = capsys.readouterr().out
+    for where in ("at 10000 rpm", "at 30000 rpm"):
+        assert (
+            text.count(f"verification reference {where}") == text.count(f"verification optimum {where}") == 1
+        )
+    assert "disjoint 95 % CIs at every operating point: False" in text
 
 
 def test_verification_uses_unseen_seeds(config, monkeypatch):
@@ -571,3 +581,35 @@ def test_envelope_search_rechecks_and_resumes_identically(tmp_path, monkeypatch)
     assert resumed.resumed_from == 1 and [len(s) for s in seen] == [1, 3, 1]
     for key in ("x", "objective", "gradient", "margins", "points_simulated"):
         np.testing.assert_array_equal(resumed.history[key], whole.history[key])
+
+
+def test_verification_reports_every_operating_point(monkeypatch, capsys):
+    """At several operating points the verification reports each one, and says whether the
+    found design's intervals lie below the reference's at every point (here lower at 30,000
+    rpm only: the stand-in's mean PV rises with R_end and the speed, its interval +-0.05 GPa m/s
+    at 30,000 rpm, +-1 GPa m/s elsewhere), and whether it touched the corner at any."""
+    import jaxbearing as jb
+    from optimise import make_problem
+
+    inner = _metrics_stand_in([])
+
+    def engine(bearing, ops, designs, **kw):
+        out = inner(bearing, ops, designs, **kw)
+        for m, op in zip(out, ops):
+            fast = float(op.inner_speed) > 3000.0
+            for est in (m.mean_pv, m.objective):
+                hw = 0.05e9 if fast else 1e9
+                est["ci95_low"], est["ci95_high"] = est["value"] - hw, est["value"] + hw
+        return out
+
+    monkeypatch.setattr(steady, "steady_design_metrics_points", engine)
+    problem = make_problem(jb.reference_bearing(), jb.reference_operating_point(), speeds_rpm=[10e3, 30e3])
+    settings = steady.SteadySettings(seeds=2, workers=1)
+    reference = np.array([0.08, 1.6 * math.pi / 180, 0.15e-3])
+    found = np.array([0.07, 1.6 * math.pi / 180, 0.15e-3])
+    v = steady.verification(problem, settings, found, reference)
+    assert len(v["optimum"]["per_operating_point"]) == 2
+    assert v["mean_pv_lower_disjoint_per_operating_point"] == [False, True]
+    assert v["objective_lower_disjoint_per_operating_point"] == [False, True]
+    assert v["mean_pv_lower_disjoint"] is False and v["objective_lower_disjoint"] is False
+    assert v["optimum_corner_contacts"] is True  # R_end 70 mm touches the corner in the stand-in
