@@ -93,6 +93,12 @@ LEGACY_CHECKPOINT = "checkpoint.pkl"
 MEASUREMENT_VERSION = 3
 #: gradient estimators (module docstring)
 ESTIMATORS = ("frozen", "window")
+#: a point left out of the envelope's active set still runs while its corner margin is below
+#: this [m] (`next_active`): one step of the default search moved the limited-circle margin by
+#: up to 0.25 mm and the dynamic corner margin by up to 0.28 mm (results/optimise_steady_default_run.json),
+#: so a margin above it does not bind within a step. Without it, margins alike at every speed
+#: kept every point running (benchmarks/studies/bench_envelope_active_set.py, 2026-11-26)
+CORNER_WATCH = 0.3e-3
 #: the dynamic corner constraint's statistic (`SteadySettings.corner_constraint`)
 CORNER_CONSTRAINTS = ("prediction", "mean")
 
@@ -433,9 +439,10 @@ def next_active(problem: DesignProblem, settings: SteadySettings, ev: Evaluation
     simulated. With the smooth max (weights exp(J_k / T), docs/model.md 17) a point whose upper
     95 % bound J_k^hi is so far below the worst point's lower bound J_w^lo that its weight
     w_k exp((J_k^hi - J_w^lo) / T) stays below `settings.skip_weight` adds less than that share to
-    the objective and its gradient: it is left out, unless it holds (within `corner_margin`) the
-    smallest dynamic corner margin, or was last simulated `settings.recheck_every` iterations
-    ago. Every point is simulated with the weighted mean, or with `skip_weight` 0."""
+    the objective and its gradient: it is left out, unless its dynamic corner margin is within
+    `CORNER_WATCH` of zero and within `corner_margin` of the smallest (the constraint may bind
+    there within a step), or it was last simulated `settings.recheck_every` iterations ago.
+    Every point is simulated with the weighted mean, or with `skip_weight` 0."""
     n = problem.num_operating_points
     if problem.aggregate != "max" or settings.skip_weight <= 0 or n == 1 or len(ev.per_point) != n:
         return [True] * n
@@ -448,7 +455,7 @@ def next_active(problem: DesignProblem, settings: SteadySettings, ev: Evaluation
         return [True] * n
     worst = int(np.argmax(values))
     bound = w * np.exp(np.minimum((hi - lo[worst]) / problem.temperature, 0.0))
-    near_corner = margins <= margins.min() + settings.corner_margin
+    near_corner = (margins <= margins.min() + settings.corner_margin) & (margins < CORNER_WATCH)
     due = np.asarray(since) + 1 >= settings.recheck_every
     keep = (bound >= settings.skip_weight) | near_corner | due
     keep[worst] = True

@@ -518,6 +518,9 @@ def test_envelope_leaves_out_points_of_negligible_weight(monkeypatch):
     assert steady.next_active(problem, settings, ev0, [2, 0, 0]) == [True, False, True]  # recheck due
     wide = steady.SteadySettings(seeds=2, workers=1, corner_margin=0.3e-3)  # 20k within 0.3 mm of 30k's
     assert steady.next_active(problem, wide, ev0, [0, 0, 0]) == [False, True, True]
+    # 10,000 rpm's 0.48 mm is within 0.4 mm of the smallest but above CORNER_WATCH: cannot bind yet
+    wider = steady.SteadySettings(seeds=2, workers=1, corner_margin=0.4e-3)
+    assert steady.next_active(problem, wider, ev0, [0, 0, 0]) == [False, True, True]
     assert steady.next_active(problem, steady.SteadySettings(skip_weight=0.0), ev0, [0, 0, 0]) == [True] * 3
     mean = make_problem(
         jb.reference_bearing(),
