@@ -33,8 +33,8 @@ docs/model.md 17).
 
 The envelope's active set (`next_active`, smooth max only): an operating point whose weight in
 the objective stays below `skip_weight` even at its interval's bounds is not simulated in the
-next iteration (its last values are reused), unless it holds the smallest corner margin or was
-last simulated `recheck_every` iterations ago.
+next iteration (its last values are reused), unless its corner margin could bind within a step
+or it was last simulated `recheck_every` iterations ago.
 
 Resume. After every iteration the whole search state (iterates, optimiser and multiplier
 states, continuation states, history, best design) is written atomically to
