@@ -212,7 +212,7 @@ class Evaluation:
     """The steady objective, its gradient and the constraints of one design (scaled u)."""
 
     objective: float  # combined over the envelope [GPa m/s]
-    objective_ci: tuple  # (low, high) of the worst operating point's interval [GPa m/s]
+    objective_ci: tuple  # (low, high): its 95 % interval (`_combined_interval`) [GPa m/s]
     gradient: np.ndarray  # dJ/du (3,)
     gradient_stderr: np.ndarray  # (3,)
     per_point: list  # per operating point: value, ci, gradient, corner margin [m], share
@@ -418,10 +418,9 @@ def _evaluation(problem, settings, u, measured, previous, width, wall, gradient:
     weights = np.asarray(weights)
     grad = sum(w * p["gradient"] for w, p in zip(weights, per))
     grad_se = np.sqrt(sum((w * p["gradient_stderr"]) ** 2 for w, p in zip(weights, per)))
-    worst = int(np.argmax([p["value"] for p in per]))
     return Evaluation(
         objective=float(val),
-        objective_ci=per[worst]["ci"],
+        objective_ci=_combined_interval(float(val), weights, per),
         gradient=np.where(width > 0, grad, 0.0),
         gradient_stderr=grad_se,
         per_point=per,
@@ -460,6 +459,17 @@ def next_active(problem: DesignProblem, settings: SteadySettings, ev: Evaluation
     keep = (bound >= settings.skip_weight) | near_corner | due
     keep[worst] = True
     return [bool(v) for v in keep]
+
+
+def _combined_interval(value: float, weights, per: list) -> tuple[float, float]:
+    """The 95 % interval of the combined objective J = combine(J_1 .. J_K) by the delta method:
+    J -+ sqrt(sum_k (w_k h_k)^2), w_k = dJ/dJ_k and h_k the lower or upper half-width of point
+    k's interval (the points' ensembles independent). With one dominant point of the smooth max
+    it is that point's interval moved to J (the smooth max lies T ln K below the largest J_k
+    when the others weigh nothing)."""
+    lo = np.sqrt(sum((w * (p["value"] - p["ci"][0])) ** 2 for w, p in zip(weights, per)))
+    hi = np.sqrt(sum((w * (p["ci"][1] - p["value"])) ** 2 for w, p in zip(weights, per)))
+    return (float(value - lo), float(value + hi))
 
 
 def _num(v) -> float:

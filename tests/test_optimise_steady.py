@@ -542,6 +542,13 @@ def test_envelope_leaves_out_points_of_negligible_weight(monkeypatch):
         assert new["corner_margin"] == pytest.approx(old["corner_margin"] + moved, rel=1e-12)
     assert ev1.states[2][0][1] == 2  # the simulated point continued its chain
     assert ev1.objective == pytest.approx(ev0.objective, rel=1e-12)  # the worst point's value, unchanged here
+    # the combined objective's interval: the dominant point's half-widths (+-5 %) around J, which
+    # lies T ln 3 below the largest point (the others weigh nothing)
+    worst = ev0.per_point[2]["value"]
+    assert ev0.objective == pytest.approx(worst - 0.1 * math.log(3), rel=1e-9)
+    np.testing.assert_allclose(
+        ev0.objective_ci, (ev0.objective - 0.05 * worst, ev0.objective + 0.05 * worst), rtol=1e-9
+    )
     with pytest.raises(ValueError, match="previous evaluation"):
         steady.evaluate_starts(problem, settings, [u1], [ev0.states], active=[[False, False, True]])
     for bad, name in ((1.0, "skip_weight"), (-0.1, "skip_weight")):
