@@ -211,10 +211,11 @@ def test_roller_blocks_equal_the_diagonal_blocks_of_the_dense_jacobian():
     from jax.flatten_util import ravel_pytree
 
     from jaxbearing.dynamics import Functionals, Params, Scaling, state_scales
-    from jaxbearing.run import SolveArgs, initial_state, scaled_field
+    from jaxbearing.run import SolveArgs, scaled_field
+    from jaxbearing.run._initial import kinematic_start
 
     b, op = jb.reference_bearing(), jb.reference_operating_point()
-    y0 = initial_state(b, op, jb.Perturbation(seed=3))
+    y0 = kinematic_start(b, op, jb.Perturbation(seed=3))  # `initial_state`, compiled
     scaling = Scaling(
         nominal=y0,
         scale=state_scales(b.num_rollers, b.pitch_diameter / 2),
