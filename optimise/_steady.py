@@ -29,7 +29,10 @@ in the unit box, multiplier update).
 Continuation. Every start carries the settled states of its last design, per operating point;
 the next iterate (a step of a few per cent of the box) starts from them instead of from the skid
 start, and settles by the verdict (at least four revolutions; a fixed shorter settle is biased,
-docs/model.md 17).
+docs/model.md 17). `steady_search(initial_states=...)` gives a start's first evaluation such
+states too (e.g. the `final_states` of a settled ensemble of the start design that the caller
+already ran, as notebook 05 does): it then continues from them instead of running its own skid
+start.
 
 The envelope's active set (`next_active`, smooth max only): an operating point whose weight in
 the objective stays below `skip_weight` even at its interval's bounds is not simulated in the
@@ -552,18 +555,30 @@ def steady_search(
     directory: str | pathlib.Path | None = None,
     callback: Callable[[int, dict], None] | None = None,
     verify: bool = True,
+    initial_states: list | None = None,
 ) -> SteadySearchResult:
     """Minimise the steady objective inside the static and dynamic margins (module docstring)
     from `num_starts` starts (the bearing's own design, then Halton points), `num_iterations`
     projected Adam steps each. With `directory`, the state is checkpointed there after every
     iteration and a matching checkpoint is resumed. `callback(iteration, info)` reports
-    progress after every iteration."""
+    progress after every iteration. `initial_states`: None, or per start None or the states its
+    first evaluation continues from, per operating point one state per seed (e.g.
+    `[[metrics.final_states]]`: a settled ensemble of the start design with `settings.seeds`
+    seeds; module docstring, Continuation); a resumed checkpoint's own states win."""
     t_start = time.perf_counter()
     for name, v in (("starts", num_starts), ("iterations", num_iterations)):
         if int(v) < 1:
             raise UserInputError(f"{name} = {v}: must be >= 1")
     u = np.asarray(starts, dtype=float) if starts is not None else start_points(problem, num_starts)
     num_starts = u.shape[0]
+    chains = [None] * num_starts if initial_states is None else list(initial_states)
+    if len(chains) != num_starts or any(
+        c is not None and len(c) != problem.num_operating_points for c in chains
+    ):
+        raise UserInputError(
+            f"initial_states: {len(chains)} given, expected one per start ({num_starts}), each None or "
+            f"one list of states per operating point ({problem.num_operating_points})"
+        )
     x_start = np.asarray(problem.bounds.from_scaled(u[0]))
     hyper = _Hyper(float(learning_rate), int(num_iterations), float(rho))
     empty = dict(
@@ -598,7 +613,7 @@ def steady_search(
         u=u,
         opt=[optimiser.init(jnp.asarray(ui)) for ui in u],
         lam=np.zeros((num_starts, len(CONSTRAINT_NAMES))),
-        chains=[None] * num_starts,
+        chains=chains,
         history={k: [] for k in empty},
         best=(np.inf, -1, -1, None, None),
         evaluations=0,

@@ -24,7 +24,11 @@ jax.config.update("jax_enable_x64", True)
 #: its two-process run loads the stored one-device batch program instead of compiling a
 #: shard_map), skid 81 s, settle 78 s, misalignment 61 s, dynamics 59 s, cmd_simulate 59 s, sweep 48 s, design 43 s,
 #: program_cache 31 s, quasistatic 21 s; so engine starts with the notebooks and
-#: sweep_distributed follows steady_gradient.
+#: sweep_distributed follows steady_gradient. Cold, alone, 2026-11-26 (a third measurement, the
+#: other core busy with a two-worker benchmark, load 3-5): skid 98 s, cmd_simulate 95 s, dynamics
+#: 64-70 s, misalignment 52 s (113 s before its checks shared one compiled field), engine 217 s
+#: (266 s before its continuing seeds' starts were compiled): misalignment moves below dynamics and
+#: cmd_simulate above it.
 SLOWEST_FILES_FIRST = (
     "test_notebooks.py",
     "test_engine.py",
@@ -33,9 +37,9 @@ SLOWEST_FILES_FIRST = (
     "test_sweep_distributed.py",
     "test_skid.py",
     "test_settle.py",
-    "test_misalignment.py",
-    "test_dynamics.py",
     "test_cmd_simulate.py",
+    "test_dynamics.py",
+    "test_misalignment.py",
     "test_sweep.py",
     "test_design.py",
     "test_program_cache.py",

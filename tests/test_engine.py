@@ -14,6 +14,7 @@ import pytest
 
 import jaxbearing as jb
 from jaxbearing.run import Member, SteadyOptions, settle_members, summarise_steady
+from jaxbearing.run._initial import kinematic_start
 
 SPEC = """
 [sweep]
@@ -241,7 +242,9 @@ def test_continuing_seeds_share_their_case_time_constant(monkeypatch):
 
     bearing, op = _small()
     seeds = [jb.Perturbation(seed=k) for k in range(2)]
-    continuing = [Member(bearing, op, p, jb.run.initial_state(bearing, op, p)) for p in seeds]
+    # the quasi-static states through `initial_state`'s compiled program (the quasi-static starts of
+    # the batch-mates test built it; eagerly, each call compiles every operation again, 5-7 s)
+    continuing = [Member(bearing, op, p, kinematic_start(bearing, op, p)) for p in seeds]
     fresh = Member(bearing, op, jb.Perturbation(seed=5))
     assert settle._continuing_cases([fresh, *continuing], OPTIONS) == {1: 1, 2: 1}
     assert settle._continuing_cases(continuing, dataclasses.replace(OPTIONS, settle="off")) == {}

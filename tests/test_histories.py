@@ -11,7 +11,8 @@ import pytest
 
 import jaxbearing as jb
 from jaxbearing.dynamics import Params
-from jaxbearing.run import Perturbation, initial_state, prepare_from
+from jaxbearing.run import Perturbation, prepare_from
+from jaxbearing.run._initial import kinematic_start
 from jaxbearing.run._simulate import HISTORY_CHUNK, _histories, _save, _saved_state
 
 
@@ -19,7 +20,7 @@ from jaxbearing.run._simulate import HISTORY_CHUNK, _histories, _save, _saved_st
 def samples():
     """Args of a solve and 2 chunks + 3 scaled states near the start (random deviations)."""
     b, op = jb.reference_bearing(), jb.reference_operating_point()
-    y0 = initial_state(b, op, Perturbation(seed=3))
+    y0 = kinematic_start(b, op, Perturbation(seed=3))  # `initial_state`, compiled
     _, args, y0s, _ = prepare_from(Params(bearing=b, operating=op), y0, 1e-3, 1e-6)
     n = 2 * HISTORY_CHUNK + 3
     ts = jnp.linspace(0.0, 1e-4, n)

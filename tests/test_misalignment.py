@@ -18,9 +18,22 @@ from jaxbearing.flange import roller_flange_contact
 from jaxbearing.forces import crown_drop, raceway_contact, raceway_slice_geometry, slice_positions
 from jaxbearing.geometry import end_support, ring_axis, ring_tilt_angular_velocity
 from jaxbearing.io import validate_bearing
-from jaxbearing.run import initial_state
+from jaxbearing.run._initial import kinematic_start
 
 X = jnp.array([1.0, 0.0, 0.0])
+#: the field and the contact loads (`dynamics` jits both) with one argument signature in every
+#: static check below, so that they share one compiled program each: `_op` and the states' edits
+#: are float64 arrays, not weakly typed scalars, and every leaf is put on the device (a leaf fresh
+#: from `jnp.asarray` and one from a compiled program otherwise key a second compilation, 6 s each)
+_DEVICE = jax.devices()[0]
+
+
+def _rates(t, y, params):
+    return physical_rates(t, *jax.device_put((y, params), _DEVICE))
+
+
+def _loads(y, params):
+    return contact_loads(*jax.device_put((y, params), _DEVICE))
 
 
 def _rot_y(psi):
@@ -33,7 +46,7 @@ def _op(**kw):
     return eqx.tree_at(
         lambda o: tuple(getattr(o, k) for k in kw),
         jb.reference_operating_point(),
-        tuple(jnp.asarray(float(v)) for v in kw.values()),
+        tuple(jnp.asarray(float(v), dtype=float) for v in kw.values()),
     )
 
 
@@ -152,10 +165,10 @@ def test_zero_misalignment_reproduces_aligned_contacts():
     those of the aligned formulas (to rounding), and switching the new freedoms on changes no
     rate but those of the new coordinates."""
     b, op = jb.reference_bearing(), jb.reference_operating_point()
-    y = initial_state(b, op, jb.Perturbation(seed=5))
+    y = kinematic_start(b, op, jb.Perturbation(seed=5))
     y = eqx.tree_at(lambda s: s.rollers.axial, y, y.rollers.axial + 0.06e-3)  # into the +X flanges
     y = eqx.tree_at(lambda s: s.inner_ring.centre, y, y.inner_ring.centre + jnp.array([2e-6, -1e-6]))
-    loads = contact_loads(y, Params(bearing=b, operating=op))
+    loads = _loads(y, Params(bearing=b, operating=op))
     ring = inner_ring_pose(y.inner_ring, op)
     assert np.array_equal(np.asarray(ring.axis), [1.0, 0.0, 0.0])
     assert np.array_equal(np.asarray(ring.angular_velocity), np.asarray(op.inner_speed * X))
@@ -169,8 +182,8 @@ def test_zero_misalignment_reproduces_aligned_contacts():
             np.asarray(loads.flange.interference[:, k]), np.asarray(ref), rtol=0, atol=1e-17
         )
     assert float(jnp.max(loads.flange.normal_force[:, 1])) > 1.0  # a flange contact was tested
-    off = physical_rates(0.0, y, Params(bearing=b, operating=op))
-    on = physical_rates(0.0, y, Params(bearing=b, operating=_op(axial_freedom=1, tilt_freedom=1)))
+    off = _rates(0.0, y, Params(bearing=b, operating=op))
+    on = _rates(0.0, y, Params(bearing=b, operating=_op(axial_freedom=1, tilt_freedom=1)))
     for name in ("rollers", "cage", "accumulators"):
         for a, bb in zip(
             jax.tree_util.tree_leaves(getattr(off, name)), jax.tree_util.tree_leaves(getattr(on, name))
@@ -191,14 +204,11 @@ def test_axial_load_is_carried_by_the_inner_flanges():
     f_a = 300.0
     op = _op(axial_load=f_a, axial_freedom=1)
     params = Params(bearing=b, operating=op)
-    y = initial_state(b, op, None)
+    y = kinematic_start(b, op, jb.Perturbation(axial=0.0, skew=0.0))  # no scatter
 
-    @jax.jit
     def axial(x):
-        s = eqx.tree_at(lambda s: s.inner_ring.axial, y, x)
-        return physical_rates(0.0, s, params).inner_ring.axial_velocity * b.inner_ring_mass, contact_loads(
-            s, params
-        )
+        s = eqx.tree_at(lambda s: s.inner_ring.axial, y, jnp.asarray(x, dtype=float))
+        return _rates(0.0, s, params).inner_ring.axial_velocity * b.inner_ring_mass, _loads(s, params)
 
     lo, hi = 0.0, 0.3e-3
     assert float(axial(lo)[0]) > 0 and float(axial(hi)[0]) < 0
@@ -220,12 +230,12 @@ def test_axial_and_tilt_rates_follow_the_equations():
     b = jb.reference_bearing()
     op = _op(axial_freedom=1, tilt_freedom=1, misalignment=0.5e-3)
     params = Params(bearing=b, operating=op)
-    y = initial_state(b, op, jb.Perturbation(seed=1))
+    y = kinematic_start(b, op, jb.Perturbation(seed=1))
     rate = jnp.array([0.2, -0.1])
     y = eqx.tree_at(lambda s: s.inner_ring.tilt_rate, y, rate)
-    y = eqx.tree_at(lambda s: s.inner_ring.axial_velocity, y, jnp.asarray(0.003))
-    r = physical_rates(0.0, y, params).inner_ring
-    loads = contact_loads(y, params)
+    y = eqx.tree_at(lambda s: s.inner_ring.axial_velocity, y, jnp.asarray(0.003, dtype=float))
+    r = _rates(0.0, y, params).inner_ring
+    loads = _loads(y, params)
     fm = np.asarray(loads.flange.force_on_ring)[:, :2].sum(axis=(0, 1))
     mm = np.asarray(loads.flange.moment_on_ring)[:, :2].sum(axis=(0, 1))
     force = fm + np.asarray(loads.inner.force_on_ring).sum(axis=0)
@@ -245,13 +255,14 @@ def test_vector_field_finite_with_free_tilted_ring_at_unphysical_states():
     b = jb.reference_bearing()
     op = _op(axial_freedom=1, tilt_freedom=1, misalignment=10e-3, axial_load=-5000.0)
     params = Params(bearing=b, operating=op)
-    y = initial_state(b, op, jb.Perturbation())
-    bad = eqx.tree_at(lambda s: s.inner_ring.axial, y, jnp.asarray(0.4e-3))
+    y = kinematic_start(b, op, jb.Perturbation())
+    bad = eqx.tree_at(lambda s: s.inner_ring.axial, y, jnp.asarray(0.4e-3, dtype=float))
     bad = eqx.tree_at(lambda s: s.inner_ring.tilt, bad, jnp.array([0.1, -0.05]))
     bad = eqx.tree_at(lambda s: s.inner_ring.tilt_rate, bad, jnp.array([300.0, -200.0]))
-    f = jax.jit(lambda s: physical_rates(0.0, s, params))
     for state in (y, bad):
-        assert all(bool(jnp.all(jnp.isfinite(x))) for x in jax.tree_util.tree_leaves(f(state)))
+        assert all(
+            bool(jnp.all(jnp.isfinite(x))) for x in jax.tree_util.tree_leaves(_rates(0.0, state, params))
+        )
     jac = jax.jacfwd(
         lambda t: (
             physical_rates(0.0, eqx.tree_at(lambda s: s.inner_ring.tilt, bad, t), params).inner_ring.tilt_rate

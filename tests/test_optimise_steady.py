@@ -623,3 +623,36 @@ def test_verification_reports_every_operating_point(monkeypatch, capsys):
     assert v["objective_lower_disjoint_per_operating_point"] == [False, True]
     assert v["mean_pv_lower_disjoint"] is False and v["objective_lower_disjoint"] is False
     assert v["optimum_corner_contacts"] is True  # R_end 70 mm touches the corner in the stand-in
+
+
+def test_initial_states_continue_a_start_s_first_evaluation(config, monkeypatch):
+    """`steady_search(initial_states=...)`: a start given states (notebook 05: the settled
+    ensemble of its design that the notebook ran before) evaluates its first iterate from them,
+    a start given None from the skid start; a list that does not match the starts and operating
+    points is refused in one line before anything runs (a stand-in for the settled ensemble)."""
+    import jaxbearing as jb
+    from optimise import make_problem
+
+    seen = []
+
+    def evaluate_starts(problem, settings, us, chains, *, gradient=True, **kw):
+        seen.append(list(chains))
+        return _stand_in_starts(problem, settings, us, chains, gradient=gradient)
+
+    monkeypatch.setattr(steady, "evaluate_starts", evaluate_starts)
+    cfg = jb.load_config(config)
+    problem = make_problem(cfg.bearing(), cfg.operating_point())
+    settings = steady.SteadySettings(seeds=2, window_revs=2, settle=0.5, workers=1)
+    kw = dict(num_starts=2, num_iterations=1, verify=False)
+    given = steady.steady_search(problem, settings, initial_states=[[[4]], None], **kw)
+    # the stand-in's states count the evaluations along a chain (and add 0.01 each to J): the
+    # first start's chain went on from the 4 given, the second's from the skid start
+    assert seen == [[[[4]], None], [[[5]], [[1]]]]
+    u0 = np.asarray(given.history["x"])[0]
+    j0 = np.asarray(given.history["objective"])[0]
+    target = 1.0 + np.sum((np.asarray(problem.bounds.to_scaled(u0)) - [0.7, 0.6, 0.5]) ** 2, axis=-1)
+    np.testing.assert_allclose(j0 - target, [0.04, 0.0], atol=1e-9)
+    for bad in ([[[4]]], [[[4], [4]], None]):
+        with pytest.raises(UserInputError, match=r"^initial_states: \d given, expected one per start \(2\)"):
+            steady.steady_search(problem, settings, initial_states=bad, **kw)
+    assert len(seen) == 2

@@ -411,7 +411,9 @@ def test_the_field_takes_both_raceways_as_single_calls_do():
 
     b = jb.reference_bearing()
     op = eqx.tree_at(lambda o: o.misalignment, jb.reference_operating_point(), jnp.asarray(2e-3))
-    y = jb.run.initial_state(b, op, jb.Perturbation(seed=4))
+    from jaxbearing.run._initial import kinematic_start
+
+    y = kinematic_start(b, op, jb.Perturbation(seed=4))  # `initial_state`, compiled
     y = eqx.tree_at(lambda s: s.inner_ring.centre, y, y.inner_ring.centre + jnp.array([2e-6, -1e-6]))
     y = eqx.tree_at(lambda s: s.inner_ring.velocity, y, jnp.array([0.01, -0.02]))
     loads = contact_loads(y, Params(bearing=b, operating=op))

@@ -18,6 +18,7 @@ import jaxbearing as jb
 from jaxbearing.dynamics import Params, contact_loads, physical_rates
 from jaxbearing.geometry import kinematic_cage_speed
 from jaxbearing.run import Perturbation, skid_start
+from jaxbearing.run._initial import kinematic_start
 
 
 @pytest.fixture(scope="module")
@@ -56,7 +57,7 @@ def test_skid_equilibrium_balances_the_slow_equations(reference, reference_skid)
     b, op = reference
     eq = reference_skid.equilibrium
     params = Params(bearing=b, operating=op)
-    kin = jb.run.initial_state(b, op, Perturbation())
+    kin = kinematic_start(b, op, Perturbation())  # `initial_state`, compiled
     rates0 = jax.jit(physical_rates)(0.0, kin, params)
     spin_scale = float(jnp.max(jnp.abs(rates0.rollers.angular_velocity[:, 0])))
     assert float(jnp.max(jnp.abs(eq.spin_residual))) < 1e-6 * spin_scale

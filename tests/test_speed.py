@@ -25,6 +25,7 @@ from jaxbearing.run import (
     raceway_normal_norm,
 )
 from jaxbearing.run._compile_cache import cache_dir_from_environment, default_cache_dir
+from jaxbearing.run._initial import kinematic_start
 
 
 def _random_state(z=5):
@@ -133,10 +134,10 @@ def test_default_atol_means_10_nm_10_um_s_and_0_01_rad_s():
     """docs/model.md 13: the default atol = 1e-6 of the scaled deviation state is 10 nm, 10 um/s,
     0.01 rad/s and 1e-8 in an axis component: deviations of that size scale to exactly 1e-6."""
     from jaxbearing.dynamics import Scaling, state_scales
-    from jaxbearing.run._simulate import initial_state
 
     b, op = jb.reference_bearing(), jb.reference_operating_point()
-    y0 = initial_state(b, op, None)
+    # `initial_state` without scatter (a zero-amplitude one), as its compiled program
+    y0 = kinematic_start(b, op, jb.Perturbation(axial=0.0, skew=0.0))
     pitch_radius = b.pitch_diameter / 2
     scaling = Scaling(
         nominal=y0, scale=state_scales(b.num_rollers, pitch_radius), orbit_speed=jnp.asarray(0.0)
@@ -480,7 +481,7 @@ def test_start_up_transients_take_the_max_norm_and_settled_windows_the_per_rolle
                 if module is _simulate:
                     jax.eval_shape(lambda b: jb.run.solve(b, op, 1e-5, num_saves=2), bearing)
                 else:
-                    start = jb.run.initial_state(bearing, op, jb.Perturbation())
+                    start = kinematic_start(bearing, op, jb.Perturbation())
                     _settle.prepare_from(jb.dynamics.Params(bearing=bearing, operating=op), start, 1e-3, 1e-6)
         finally:
             module.raceway_normal_norm = original
