@@ -138,6 +138,8 @@ def test_killed_run_resumes_with_the_same_result(tmp_path, config, monkeypatch, 
         "0",
         "--recheck-every",
         "2",
+        "--corner-constraint",
+        "mean",
         *ARGS,
     ]
     args[args.index("--iterations") + 1] = "2"
@@ -153,6 +155,7 @@ def test_killed_run_resumes_with_the_same_result(tmp_path, config, monkeypatch, 
     assert r1["optimiser_settings"]["seeds"] == 2 and "units" in r1
     assert r1["settings"]["statistic"] == "peak"
     assert (r1["settings"]["skip_weight"], r1["settings"]["recheck_every"]) == (0.0, 2)
+    assert r1["settings"]["corner_constraint"] == "mean"
     assert r1["settings"]["estimator"] == "frozen" and r1["settings"]["corner_margin"] == pytest.approx(
         0.04e-3
     )

@@ -336,6 +336,9 @@ CLI_CHECKS = {
     ("optimise", "run", "--estimator"): [_STEADY_CLI],
     ("optimise", "run", "--corner-margin-mm"): [_STEADY_CLI],
     ("optimise", "run", "--clearance-step-mm"): [_STEADY_CLI],
+    ("optimise", "run", "--corner-constraint"): [_STEADY_CLI],
+    ("optimise", "run", "--skip-weight"): [_STEADY_CLI],
+    ("optimise", "run", "--recheck-every"): [_STEADY_CLI],
     ("optimise", "run", "--statistic"): [_STEADY_CLI],
     ("optimise", "run", "--verify-seeds"): [
         "test_optimise_steady.py::test_verify_seeds_option_reaches_the_verification"
