@@ -620,7 +620,9 @@ def run_steady(args, problem, options, settings, out, meta=None) -> int:
     if v:
         import numpy as np
 
-        speeds = np.asarray(problem.operating.inner_speed).ravel() * 30 / math.pi
+        from jaxbearing.geometry import rad_s_to_rpm
+
+        speeds = np.asarray(rad_s_to_rpm(np.asarray(problem.operating.inner_speed))).ravel()
         loads = np.asarray(problem.operating.radial_load).ravel()
         for k in range(problem.num_operating_points):
             where = f" at {speeds[k]:.0f} rpm, {loads[k]:.0f} N" if problem.num_operating_points > 1 else ""

@@ -446,7 +446,7 @@ def next_active(problem: DesignProblem, settings: SteadySettings, ev: Evaluation
     there within a step), or it was last simulated `settings.recheck_every` iterations ago.
     Every point is simulated with the weighted mean, or with `skip_weight` 0."""
     n = problem.num_operating_points
-    if problem.aggregate != "max" or settings.skip_weight <= 0 or n == 1 or len(ev.per_point) != n:
+    if problem.aggregate != "max" or settings.skip_weight <= 0 or n == 1:
         return [True] * n
     w = np.asarray(problem.weights, float) / float(np.sum(problem.weights))
     hi = np.array([p["ci"][1] for p in ev.per_point], float)

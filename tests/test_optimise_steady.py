@@ -100,12 +100,24 @@ def _stand_in(problem, settings, u, states=None, *, gradient=True):
     target = np.array([0.7, 0.6, 0.5])
     steps = 0 if states is None else int(states[0][0])
     value = 1.0 + float(np.sum((u - target) ** 2)) + 0.01 * steps
+    point = dict(  # every operating point alike: the envelope simulates them all
+        value=value,
+        ci=(value - 0.02, value + 0.02),
+        gradient=2.0 * (u - target),
+        gradient_stderr=np.full(3, 0.01),
+        corner_margin=1e-4,
+        measured_corner_margin=1e-4,
+        measured_at=u,
+        corner_contact_share=0.0,
+        settled=True,
+        simulated=True,
+    )
     return steady.Evaluation(
         objective=value,
         objective_ci=(value - 0.02, value + 0.02),
         gradient=2.0 * (u - target) if gradient else np.full(3, np.nan),
         gradient_stderr=np.full(3, 0.01),
-        per_point=[],
+        per_point=[point] * problem.num_operating_points,
         static_margins=np.asarray(problem.margins(jnp.asarray(u))),
         dynamic_margin=1e-4,
         states=[[steps + 1]],

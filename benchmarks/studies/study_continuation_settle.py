@@ -39,13 +39,13 @@ VARIANTS = (None, 1, 0)  # None: the settling verdict; n: a fixed n revolutions 
 
 
 def _difference(a, b) -> dict:
-    """mean, standard error and Student-t 95 % interval of a - b over paired seeds."""
-    import numpy as np
+    """mean, standard error and Student-t 95 % interval of a - b over paired seeds
+    (`design.paired_central_difference` with 2h = 1)."""
     from scipy import stats
 
-    d = np.asarray(a, float) - np.asarray(b, float)
-    n = d.size
-    mean, se = float(d.mean()), float(d.std(ddof=1) / math.sqrt(n))
+    from jaxbearing.design import paired_central_difference
+
+    mean, se, n = paired_central_difference(a, b, 0.5)
     half = float(stats.t.ppf(0.975, n - 1)) * se
     return {"mean": mean, "stderr": se, "ci95": [mean - half, mean + half], "seeds": n}
 
