@@ -205,10 +205,11 @@ def build_parser() -> argparse.ArgumentParser:
     )
     r.add_argument(
         "--clearance-step-mm",
-        type=float,
         help="steady: half-step of the common-random-number central difference in Delta_bf [mm], "
-        "extra members of every evaluation, 0: off (the frozen-load estimator cannot see the "
-        f"clearance) (default: {st.clearance_step * mm:g})",
+        "extra members of every evaluation (three times the members), 0: off (the frozen-load "
+        "estimator cannot see the clearance); auto: 0.01 where an operating point is misaligned "
+        "by more than 1 mrad, where the clearance study found the slope significant, else off "
+        f"(default: {st.clearance_step})",
     )
     r.add_argument(
         "--corner-constraint",
@@ -310,6 +311,12 @@ def _positive(s: dict, key: str, default, kind=float, strict=True):
     return v
 
 
+def _clearance_step(s: dict):
+    """`SteadySettings.clearance_step` from `clearance_step_mm`: "auto" (the default) or >= 0 mm."""
+    v = s.get("clearance_step_mm", "auto")
+    return "auto" if v == "auto" else _positive(s, "clearance_step_mm", 0.0, strict=False) * 1e-3
+
+
 def problem_from_settings(bearing, op, s: dict):
     """DesignProblem and search options from merged settings (engineering units)."""
     from ._problem import DEFAULT_DURATION, bounds_from_engineering, make_problem
@@ -367,7 +374,7 @@ def steady_settings_from(s: dict):
         rtol=_positive(s, "rtol", SEARCH_DEFAULTS["rtol"]),
         workers=int(_positive(s, "workers", st.workers, int, strict=False)),
         verify_seeds=int(_positive(s, "verify_seeds", st.verify_seeds, int)),
-        clearance_step=_positive(s, "clearance_step_mm", st.clearance_step * 1e3, strict=False) * 1e-3,
+        clearance_step=_clearance_step(s),
         statistic=s.get("statistic", st.statistic),
         corner_constraint=s.get("corner_constraint", st.corner_constraint),
         skip_weight=_positive(s, "skip_weight", st.skip_weight, strict=False),
@@ -678,9 +685,17 @@ def _steady_result_json(problem, options, settings, res) -> dict:
 
     import numpy as np
 
-    from ._steady import CLEARANCE_EFFECT, CONSTRAINT_NAMES, near_optimal_set
+    from ._steady import (
+        CLEARANCE_EFFECT,
+        CLEARANCE_MISALIGNMENT,
+        CLEARANCE_STEP,
+        CONSTRAINT_NAMES,
+        clearance_step_for,
+        near_optimal_set,
+    )
 
     h = res.history
+    clearance_step = clearance_step_for(problem, settings)
     x = np.asarray(h["x"]) if len(h["x"]) else np.zeros((0, 0, 3))
     margins = np.asarray(h["margins"]) if len(h["margins"]) else np.zeros((0, 0, 5))
     return {
@@ -716,12 +731,16 @@ def _steady_result_json(problem, options, settings, res) -> dict:
                 {
                     "estimator_sees_it": True,
                     "why": "common-random-number central differences of the settled objective in "
-                    f"Delta_bf (half-step {settings.clearance_step * 1e3:g} mm, the same seeds from the same "
+                    f"Delta_bf (half-step {clearance_step * 1e3:g} mm, the same seeds from the same "
                     "states, extra members of every evaluation): history gradient and gradient_stderr",
                 }
-                if settings.clearance_step > 0
+                if clearance_step > 0
                 else {}
             ),
+            "step_mm": clearance_step * 1e3,
+            "step_rule": f"clearance_step = {settings.clearance_step!r}: 'auto' takes "
+            f"{CLEARANCE_STEP * 1e3:g} mm where an operating point is misaligned by more than "
+            f"{CLEARANCE_MISALIGNMENT * 1e3:g} mrad, else 0 (off)",
             "moved": bool(
                 res.design is not None and abs(float(res.design[2]) - float(res.start_design[2])) > 1e-12
             ),

@@ -281,6 +281,9 @@ def _checked_toml_value(path, name: str, key: str, value):
     elif key == "settle":
         if value != "auto" and not _is_number(value):
             raise bad('"auto" or a settling time in ms')
+    elif key == "clearance_step_mm":
+        if value != "auto" and not _is_number(value):
+            raise bad('"auto" or a half-step in mm')
     elif not _is_number(value):
         raise bad("a number")
     return value

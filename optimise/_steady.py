@@ -106,6 +106,26 @@ CORNER_WATCH = 0.3e-3
 CORNER_CONSTRAINTS = ("prediction", "mean")
 
 
+#: `clearance_step="auto"` gives the search a signal for Delta_bf where an operating point is
+#: misaligned by more than this [rad]: the clearance study (`CLEARANCE_EFFECT`) found dJ/dDelta_bf
+#: clearly significant at 2 mrad (+2.5 % of J per 10 um at 100 mm / 1.4 deg) and bounded near 0
+#: at 1 mrad at both designs (within -0.4 .. +0.4 % of J per 10 um)
+CLEARANCE_MISALIGNMENT = 1.0e-3
+#: ... with this half-step [m] (the study's h)
+CLEARANCE_STEP = 0.01e-3
+
+
+def clearance_step_for(problem: DesignProblem, settings: SteadySettings) -> float:
+    """The half-step h [m] of the search's Delta_bf difference: `settings.clearance_step`, or
+    with "auto", `CLEARANCE_STEP` where any operating point of `problem` is misaligned by more
+    than `CLEARANCE_MISALIGNMENT` and 0 (off: three times the members for a slope the study
+    bounds near 0) elsewhere."""
+    if not isinstance(settings.clearance_step, str):
+        return float(settings.clearance_step)
+    tilt = np.max(np.abs(np.asarray(problem.operating.misalignment, dtype=float)))
+    return CLEARANCE_STEP if tilt > CLEARANCE_MISALIGNMENT * (1 + 1e-9) else 0.0
+
+
 @dataclasses.dataclass(frozen=True)
 class SteadySettings:
     """How the steady objective is measured (module docstring). Times in seconds."""
@@ -124,9 +144,11 @@ class SteadySettings:
     #: the statistic of flange PV minimised: "mean" (over contact time) or "peak" (its p-mean,
     #: `jaxbearing.design.STATISTICS`)
     statistic: str = "mean"
-    #: half-step of the common-random-number central difference in Delta_bf [m] (0: off); the
-    #: frozen-load estimator cannot see the clearance (`evaluate_starts`)
-    clearance_step: float = 0.0
+    #: half-step of the common-random-number central difference in Delta_bf [m] (0: off), or
+    #: "auto": `CLEARANCE_STEP` where the envelope is misaligned by more than
+    #: `CLEARANCE_MISALIGNMENT`, else off (`clearance_step_for`); the frozen-load estimator
+    #: cannot see the clearance (`evaluate_starts`)
+    clearance_step: float | str = "auto"
     #: the dynamic corner constraint: "prediction" (the margin on the upper 95 % prediction bound
     #: of one revolution's largest contact radius: it holds for a further revolution with 95 %
     #: probability) or "mean" (on its expectation per revolution: holds on average)
@@ -176,12 +198,17 @@ class SteadySettings:
         require("corner_margin", self.corner_margin, lambda v: np.isfinite(v) & (v >= 0), ">= 0 m")
         require("rtol", self.rtol, lambda v: np.isfinite(v) & (v > 0) & (v < 1), "in (0, 1)")
         require("workers", self.workers, lambda v: (v >= 0) & (v == np.round(v)), "an integer >= 0")
-        require(
-            "clearance_step",
-            self.clearance_step,
-            lambda v: np.isfinite(v) & (v >= 0) & (v < 1e-3),
-            "in [0, 1e-3) m",
-        )
+        if not (isinstance(self.clearance_step, str) and self.clearance_step == "auto"):
+            if isinstance(self.clearance_step, str):
+                raise UserInputError(
+                    f"clearance_step = {self.clearance_step!r}: must be 'auto' or a number in [0, 1e-3) m"
+                )
+            require(
+                "clearance_step",
+                self.clearance_step,
+                lambda v: np.isfinite(v) & (v >= 0) & (v < 1e-3),
+                "'auto' or in [0, 1e-3) m",
+            )
 
     @property
     def num_workers(self) -> int:
@@ -268,7 +295,7 @@ def evaluate_starts(
     width = np.asarray(problem.bounds.upper - problem.bounds.lower)
     ops = [_operating_point(problem, k) for k in range(problem.num_operating_points)]
     n = len(ops)
-    h = float(settings.clearance_step)
+    h = clearance_step_for(problem, settings)
     shifts = (0.0, h, -h) if gradient and h > 0 and width[2] > 0 else (0.0,)
     designs = [problem.design(jnp.asarray(u)) for u in us]
     chains = [None] * len(designs) if chains is None else list(chains)

@@ -68,6 +68,7 @@ def test_bad_steady_settings_are_one_line(kw, text):
         (["--statistic", "max"], "statistic = 'max': must be one of 'mean', 'peak'"),
         (["--statistic", "peak", "--estimator", "window"], "statistic = 'peak' needs estimator = 'frozen'"),
         (["--clearance-step-mm", "-0.01"], "clearance_step_mm = -0.01: must be >= 0"),
+        (["--clearance-step-mm", "soon"], "clearance_step_mm = 'soon': expected a float"),
         (["--skip-weight", "1.5"], "skip_weight = 1.5: must be in [0, 1)"),
         (["--corner-constraint", "p99"], "corner_constraint = 'p99': must be one of prediction, mean"),
         (["--recheck-every", "0"], "recheck_every = 0: must be > 0"),
@@ -446,9 +447,32 @@ def test_clearance_gradient_is_a_paired_crn_difference_in_the_same_engine_call(m
     # off without a gradient (and by default): one design per start
     seen.clear()
     steady.evaluate_starts(problem, settings, [u], [chain], gradient=False)
-    assert len(seen[0][0]) == 1 and steady.SteadySettings().clearance_step == 0.0
+    assert len(seen[0][0]) == 1
     with pytest.raises(UserInputError, match=r"^clearance_step = -1"):
         steady.SteadySettings(clearance_step=-1.0)
+    with pytest.raises(UserInputError, match=r"^clearance_step = 'soon': must be 'auto'"):
+        steady.SteadySettings(clearance_step="soon")
+
+
+def test_auto_clearance_step_is_on_where_the_envelope_is_misaligned_beyond_1_mrad():
+    """The default `clearance_step="auto"`: the Delta_bf difference runs (h = 0.01 mm, the
+    clearance study's step) where any operating point is tilted by more than 1 mrad, where the
+    study found dJ/dDelta_bf significant, and not for an aligned or 1 mrad envelope, where it
+    bounded the slope near 0; a number overrides it."""
+    import dataclasses
+
+    import jaxbearing as jb
+    from optimise import make_problem
+
+    auto = steady.SteadySettings()
+    assert auto.clearance_step == "auto"
+    op = jb.reference_operating_point()
+    for tilt, step in ((0.0, 0.0), (1e-3, 0.0), (-2e-3, steady.CLEARANCE_STEP), (1.5e-3, 0.01e-3)):
+        problem = make_problem(jb.reference_bearing(), dataclasses.replace(op, misalignment=tilt))
+        assert steady.clearance_step_for(problem, auto) == pytest.approx(step, abs=1e-15), tilt
+    aligned = make_problem(jb.reference_bearing(), op, speeds_rpm=[10000.0, 30000.0])
+    assert steady.clearance_step_for(aligned, auto) == 0.0
+    assert steady.clearance_step_for(aligned, steady.SteadySettings(clearance_step=2e-5)) == 2e-5
 
 
 def _envelope_engine(seen):
