@@ -64,3 +64,4 @@ def test_optimise_example_builds_the_steady_settings():
     assert (s.seeds, s.window_revs, s.settle, s.estimator) == (4, 2, "auto", "frozen")
     assert s.gradient_window == 1e-3 and s.corner_margin == 0.05e-3
     assert (s.skip_weight, s.recheck_every) == (1e-3, 3) and settings["speeds_rpm"] == [10e3, 20e3, 30e3]
+    assert s.clearance_step == "auto" and settings["iterations"] == 4
