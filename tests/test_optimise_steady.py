@@ -454,6 +454,27 @@ def test_clearance_gradient_is_a_paired_crn_difference_in_the_same_engine_call(m
         steady.SteadySettings(clearance_step="soon")
 
 
+def test_clearance_signal_is_the_paired_difference_where_significant():
+    """The search's Delta_bf component: the paired difference where |d| exceeds the two-sided
+    5 % Student-t bound of its standard error, else 0 (Adam would take a full step on noise);
+    the standard error is kept either way."""
+    h = 1e-5
+    minus = np.array([1.0, 2.0, 3.0, 4.0])
+    clear = minus + 2 * h * np.array([1.0, 1.1, 0.9, 1.05])  # d about 1, SE 0.04
+    d, se = steady.clearance_signal(clear, minus, h)
+    assert d == pytest.approx(1.0125) and se == pytest.approx(np.std([1, 1.1, 0.9, 1.05], ddof=1) / 2)
+    noisy = minus + 2 * h * np.array([1.0, -1.2, 0.8, -0.4])  # d 0.05, SE 0.5
+    d, se = steady.clearance_signal(noisy, minus, h)
+    assert d == 0.0 and se > 0.4
+    # at the bound: t_{0.975, 3} = 3.182; d = 3.0 SE is not significant, 3.3 SE is
+    for z, expected in ((3.0, 0.0), (3.3, None)):
+        per = np.array([1.0, -1.0, 1.0, -1.0])  # std 1.1547, SE 0.5774
+        steps = per + z * np.std(per, ddof=1) / 2
+        d, _ = steady.clearance_signal(minus + 2 * h * steps, minus, h)
+        assert d == (pytest.approx(np.mean(steps)) if expected is None else expected), z
+    assert steady.clearance_signal(minus[:1] + h, minus[:1], h) == (0.0, pytest.approx(np.nan, nan_ok=True))
+
+
 def test_auto_clearance_step_is_on_where_the_envelope_is_misaligned_beyond_1_mrad():
     """The default `clearance_step="auto"`: the Delta_bf difference runs (h = 0.01 mm, the
     clearance study's step) where any operating point is tilted by more than 1 mrad, where the
@@ -738,7 +759,9 @@ def test_clearance_signal_at_2_mrad_is_the_paired_difference_and_positive(monkey
     np.testing.assert_allclose(clearances, [0.15e-3, 0.15e-3 + h, 0.15e-3 - h], rtol=1e-9)
     fd, se, n = paired_central_difference(members[1].objective_per_seed, members[2].objective_per_seed, h)
     assert n == 4
+    signal, _ = steady.clearance_signal(members[1].objective_per_seed, members[2].objective_per_seed, h)
+    assert signal in (0.0, fd)  # the difference where significant at 5 %, else 0
     scale = (upper[2] - lower[2]) / steady.PV_SCALE
-    assert ev.gradient[2] == pytest.approx(fd * scale, rel=1e-9)
+    assert ev.gradient[2] == pytest.approx(signal * scale, rel=1e-9, abs=1e-300)
     assert ev.gradient_stderr[2] == pytest.approx(se * scale, rel=1e-9)
     assert fd > 0, (fd, se)
