@@ -93,8 +93,8 @@ LEGACY_CHECKPOINT = "checkpoint.pkl"
 #: version of the measured objective and margins, part of a checkpoint's fingerprint: a
 #: checkpoint of an older definition (2: the dynamic corner margin on the largest contact
 #: radius instead of the p99; 3: the envelope's active set, the corner constraint's prediction
-#: bound) is refused, not resumed
-MEASUREMENT_VERSION = 3
+#: bound; 4: the clearance difference only where significant) is refused, not resumed
+MEASUREMENT_VERSION = 4
 #: gradient estimators (module docstring)
 ESTIMATORS = ("frozen", "window")
 #: a point left out of the envelope's active set still runs while its corner margin is below
