@@ -199,7 +199,7 @@ class SteadySettings:
         require("corner_margin", self.corner_margin, lambda v: np.isfinite(v) & (v >= 0), ">= 0 m")
         require("rtol", self.rtol, lambda v: np.isfinite(v) & (v > 0) & (v < 1), "in (0, 1)")
         require("workers", self.workers, lambda v: (v >= 0) & (v == np.round(v)), "an integer >= 0")
-        if not (isinstance(self.clearance_step, str) and self.clearance_step == "auto"):
+        if self.clearance_step != "auto":
             if isinstance(self.clearance_step, str):
                 raise UserInputError(
                     f"clearance_step = {self.clearance_step!r}: must be 'auto' or a number in [0, 1e-3) m"

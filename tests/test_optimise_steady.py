@@ -726,7 +726,8 @@ def test_clearance_signal_at_2_mrad_is_the_paired_difference_and_positive(monkey
     default `clearance_step="auto"` the evaluation continuing from a settled ensemble runs the
     design at Delta_bf +- 0.01 mm from the same states with the same seeds in its engine call;
     the gradient's Delta_bf component is the paired central difference of those members'
-    per-seed objectives (scaled to the box), and it is positive: a larger clearance lets the
+    per-seed objectives where significant at 5 % (`clearance_signal`; scaled to the box), and
+    the difference is positive: a larger clearance lets the
     tilted ring's rollers skew further (the clearance study measured +2.5 % of J per 10 um
     here, 7.5 standard errors at 16 seeds; at 4 seeds the expected difference lies about 3.7
     standard errors above 0)."""
