@@ -23,8 +23,8 @@ design the default search found). Defaults: K = 16, h = 0.01 mm, window 2, 31 sl
 members per hour at 11 slices on an H200), hours on the 2-core CPU.
 
 Options: `--seeds K`, `--step-mm H`, `--slices N`, `--window W`, `--points
-speed|others|all|ref` (the speed factor, the misalignment and load factors, all seven points,
-or the reference point alone), `--designs 1|2`,
+speed|others|all|ref|misaligned` (the speed factor, the misalignment and load factors, all seven
+points, the reference point alone, or 2 mrad alone and combined with 30,000 rpm and with 500 N), `--designs 1|2`,
 `--results-dir DIR`. `--quick`: the reference point, one design, 4 seeds, 11 slices (a check of
 the script, minutes on the CPU). Results: results/study_clearance_effect[_quick].json.
 `--plot [RESULTS.json]` draws a results file (default results/study_clearance_effect.json) as
@@ -53,9 +53,14 @@ def operating_points(which: str) -> list[tuple[float, float, float]]:
     speed, mis, load = REFERENCE_POINT
     speeds = [(v, mis, load) for v in (10000.0, 20000.0, 30000.0)]
     others = [(speed, m, load) for m in (1.0, 2.0)] + [(speed, mis, f) for f in (500.0, 4000.0)]
-    if which not in ("ref", "speed", "others", "all"):
-        raise SystemExit(f"--points {which!r}: must be one of ref, speed, others, all")
-    return {"ref": [REFERENCE_POINT], "speed": speeds, "others": others, "all": speeds + others}[which]
+    # 2 mrad alone (where the one-factor study found the effect) and combined with the highest
+    # speed and with the lightest load: does the effect hold at full slices and in combination?
+    misaligned = [(speed, 2.0, load), (30000.0, 2.0, load), (speed, 2.0, 500.0)]
+    groups = {"ref": [REFERENCE_POINT], "speed": speeds, "others": others, "all": speeds + others}
+    groups["misaligned"] = misaligned
+    if which not in groups:
+        raise SystemExit(f"--points {which!r}: must be one of {', '.join(groups)}")
+    return groups[which]
 
 
 def _op(point):
