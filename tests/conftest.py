@@ -1,4 +1,24 @@
-import jax
+import os
+
+# One CPU per test process (`make test` runs two, `-n 2`): each pytest-xdist worker runs on its
+# own CPU with single-threaded XLA, as the engine's own worker processes do
+# (`jaxbearing.run._ensemble`), instead of two processes each spreading XLA's threads over both
+# CPUs. JAXBEARING_TEST_PIN=0 switches it off.
+_WORKER = os.environ.get("PYTEST_XDIST_WORKER", "")
+if (
+    _WORKER.startswith("gw")
+    and os.environ.get("JAXBEARING_TEST_PIN", "1") != "0"
+    and hasattr(os, "sched_setaffinity")
+):
+    _cpus = sorted(os.sched_getaffinity(0))
+    if len(_cpus) > 1:
+        os.sched_setaffinity(0, {_cpus[int(_WORKER[2:]) % len(_cpus)]})
+        os.environ["XLA_FLAGS"] = (
+            os.environ.get("XLA_FLAGS", "")
+            + " --xla_cpu_multi_thread_eigen=false intra_op_parallelism_threads=1"
+        ).strip()
+
+import jax  # noqa: E402
 
 jax.config.update("jax_enable_x64", True)
 
@@ -39,3 +59,36 @@ SLOWEST_FILES_FIRST = (
 def pytest_collection_modifyitems(config, items):
     rank = {name: i for i, name in enumerate(SLOWEST_FILES_FIRST)}
     items.sort(key=lambda item: rank.get(item.path.name, len(rank)))  # stable: order within a file kept
+
+
+# --- compile-time profile (opt-in): JAXBEARING_TEST_COMPILE_LOG=path.json records, per test, the
+# seconds JAX spent tracing, lowering and compiling (jax.monitoring duration events), to see
+# which tests pay for programs and which reuse them (docs/performance.md, issue 37).
+_COMPILE_LOG = __import__("os").environ.get("JAXBEARING_TEST_COMPILE_LOG")
+_compile_seconds: dict = {}
+_current_test = ["(collection)"]
+
+if _COMPILE_LOG:
+    import jax.monitoring
+
+    def _on_duration(event, seconds, **_):
+        if event.startswith("/jax/core/compile/"):
+            per = _compile_seconds.setdefault(_current_test[0], {})
+            key = event.rsplit("/", 1)[-1]
+            per[key] = per.get(key, 0.0) + seconds
+
+    jax.monitoring.register_event_duration_secs_listener(_on_duration)
+
+
+def pytest_runtest_setup(item):
+    _current_test[0] = item.nodeid
+
+
+def pytest_sessionfinish(session):
+    if _COMPILE_LOG:
+        import json
+        import os
+
+        path = f"{_COMPILE_LOG}.{os.environ.get('PYTEST_XDIST_WORKER', 'main')}.json"
+        with open(path, "w") as f:
+            json.dump(_compile_seconds, f, indent=1)

@@ -2,7 +2,7 @@
 multi-start projected augmented-Lagrangian search against a brute-force grid, infeasible starts
 and bounds that exclude the design zone, and the `optimise run` command line.
 
-The search and the grid share one small problem (reference bearing at 20,000 rpm and 1000 N,
+The search and the grid share one small problem (reference bearing at 11 slices, 20,000 rpm and 1000 N,
 Delta_bf fixed at 0.2 mm, R_end x theta_f over the default bounds, 0.3 ms per evaluation), so
 every model evaluation reuses one compilation. The grid here is 5 x 5; the full >= 15 x 15
 comparison is benchmarks/studies/bench_optimise_grid.py (benchmarks/results/optimise_vs_grid.json)."""
@@ -19,7 +19,10 @@ import jaxbearing as jb
 import optimise as opt
 from optimise._cli import EXIT_INFEASIBLE, main
 
-REF = jb.reference_bearing()
+#: the reference bearing at 11 raceway slices (the reduced size of every dynamic test; the command
+#: line reads it from SMALL_CONFIG, so that its search is the same compiled program)
+REF = __import__("dataclasses").replace(jb.reference_bearing(), num_slices=11)
+SMALL_CONFIG = "[bearing]\nnum_slices = 11\n"
 OP = jb.reference_operating_point()
 DURATION_MS = 0.3
 CLEARANCE_MM = 0.2
@@ -170,8 +173,12 @@ def test_search_no_worse_than_grid(searched):
 
 # -- command line -------------------------------------------------------------------------------
 def _cli_args(out):
+    config = out.parent / "small.toml"
+    config.write_text(SMALL_CONFIG)
     return [
         "run",
+        "--config",
+        str(config),
         "--objective",
         "startup",
         "--starts",

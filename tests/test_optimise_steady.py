@@ -345,65 +345,22 @@ def test_grid_picks_the_best_point_inside_every_margin_and_resumes(tmp_path, con
     assert seen == [] and again["best_objective"] == grid["best_objective"]
 
 
-def test_an_iteration_evaluates_every_start_in_one_engine_call(monkeypatch):
-    """`evaluate_starts` on real settled running (11 slices, 2 starts, 2 seeds, a 0.005 ms
-    settle: the skid start lands on the plateau, two-revolution windows, 0.1 ms frozen-load
-    windows): every start's seeds are members of one call of the steady-running engine and
-    every start's gradient trajectories of one `frozen_load_gradients` call, and each start
-    gets its own design's objective (its interval around it), gradient, static margins and
-    continuation states."""
-    import dataclasses
-
-    import jaxbearing as jb
-    from optimise import make_problem
-
-    calls = {"engine": 0, "gradients": []}
-    engine, gradients = steady.steady_design_metrics_points, steady.frozen_load_gradients
-
-    def counted_engine(*a, **k):
-        calls["engine"] += 1
-        return engine(*a, **k)
-
-    def counted_gradients(cases, **k):
-        calls["gradients"].append(len(cases))
-        return gradients(cases, **k)
-
-    monkeypatch.setattr(steady, "steady_design_metrics_points", counted_engine)
-    monkeypatch.setattr(steady, "frozen_load_gradients", counted_gradients)
-    bearing = dataclasses.replace(jb.reference_bearing(), num_slices=11)
-    problem = make_problem(bearing, jb.reference_operating_point())
-    settings = steady.SteadySettings(seeds=2, window_revs=2, settle=0.005, gradient_window=0.1e-3, workers=1)
-    us = [np.array([0.5, 0.5, 0.25]), np.array([0.8, 0.3, 0.25])]
-    evaluations = steady.evaluate_starts(problem, settings, us, [None, None])
-    assert calls == {"engine": 1, "gradients": [2]}
-    for u, ev in zip(us, evaluations):
-        lo, hi = ev.objective_ci
-        assert np.isfinite(ev.objective) and lo <= ev.objective <= hi
-        assert np.all(np.isfinite(ev.gradient[:2])) and np.any(ev.gradient[:2] != 0)
-        np.testing.assert_array_equal(ev.static_margins, np.asarray(problem.margins(jnp.asarray(u))))
-        assert len(ev.states) == 1 and len(ev.states[0]) == 2  # one operating point, two seeds
-    assert evaluations[0].objective != evaluations[1].objective
-
-
-def test_clearance_gradient_is_a_paired_crn_difference_in_the_same_engine_call(monkeypatch):
-    """`clearance_step` h: every start's design also runs at Delta_bf +- h, with the same seeds
-    from the same continuation states, as members of the same engine call, and the Delta_bf
-    component of the gradient is the mean over seeds of (J+ - J-) / 2h with its paired standard
-    error; the frozen-load estimate keeps the other two (stand-ins for the engine and the
-    estimator: J_seed = 1e9 (1 + 2000 Delta_bf / m) + 1e8 seed, so the seed term cancels)."""
+def _engine_stand_in(seen, samples=False):
+    """A stand-in for the steady-running engine (`steady_design_metrics_points`): per seed
+    J = 1e9 (1 + 2000 Delta_bf / m + R_end / m) + 1e8 seed, so every design gets its own value
+    and a paired difference in Delta_bf cancels the seed term; `seen` records each call's
+    clearances and initial states. The real engine's members, each exactly its own single run,
+    are tests/test_engine.py's (`test_several_operating_points_in_one_engine_call_equal_their_
+    single_runs`); the search on real output is notebook 05's (tests/test_notebooks.py). With
+    `samples`, each design has one stand-in sample state for the gradient estimator."""
     import types
-
-    import jaxbearing as jb
-    from jaxbearing.design import SteadyGradient
-    from optimise import make_problem
-
-    seen = []
 
     def engine(bearing, ops, designs, *, seeds, initial_states, **kw):
         seen.append(([float(d.axial_clearance) for d in designs], initial_states))
         out = []
         for d in designs:
-            per_seed = [1e9 * (1 + 2000 * float(d.axial_clearance)) + 1e8 * k for k in range(seeds)]
+            x = 1 + 2000 * float(d.axial_clearance) + float(d.end_radius)
+            per_seed = [1e9 * x + 1e8 * k for k in range(seeds)]
             est = {"value": float(np.mean(per_seed)), "ci95_low": 0.0, "ci95_high": 1e10, "n": seeds}
             out.append(
                 types.SimpleNamespace(
@@ -417,19 +374,73 @@ def test_clearance_gradient_is_a_paired_crn_difference_in_the_same_engine_call(m
                     seeds=list(range(seeds)),
                     summary={"per_seed": [{"settle_time_ms": 1.0}] * seeds, "window_ms": 2.0},
                     final_states=[("state", float(d.axial_clearance))] * seeds,
-                    sample_states=[],
+                    sample_states=[("sample", float(d.end_radius))] if samples else [],
                 )
             )
         return out
 
+    return engine
+
+
+def _frozen_stand_in(calls=None):
+    """A stand-in for `frozen_load_gradients`: dJ/dx = (3e9, -4e9, 0) per case (the estimator
+    cannot see Delta_bf); `calls` records each call's cases."""
+    from jaxbearing.design import SteadyGradient
+
     def frozen(cases, **kw):
+        if calls is not None:
+            calls.append(cases)
         return [
             SteadyGradient(1e9, np.array([3e9, -4e9, 0.0]), np.full(3, 1e7), 1e6, 1e-4, 4, None, None, None)
             for _ in cases
         ]
 
-    monkeypatch.setattr(steady, "steady_design_metrics_points", engine)
-    monkeypatch.setattr(steady, "frozen_load_gradients", frozen)
+    return frozen
+
+
+def test_an_iteration_evaluates_every_start_in_one_engine_call(monkeypatch):
+    """`evaluate_starts` with two starts (stand-ins for the engine and the estimator,
+    `_engine_stand_in`): every start's seeds are members of one call of the steady-running
+    engine and every start's gradient trajectories of one `frozen_load_gradients` call, each
+    from its own start's settled states, and each start gets its own design's objective (its
+    interval around it), gradient, static margins and continuation states."""
+    import jaxbearing as jb
+    from optimise import make_problem
+
+    seen, cases = [], []
+    monkeypatch.setattr(steady, "steady_design_metrics_points", _engine_stand_in(seen, samples=True))
+    monkeypatch.setattr(steady, "frozen_load_gradients", _frozen_stand_in(cases))
+    problem = make_problem(jb.reference_bearing(), jb.reference_operating_point())
+    settings = steady.SteadySettings(seeds=2, window_revs=2, settle=0.005, gradient_window=0.1e-3, workers=1)
+    us = [np.array([0.5, 0.5, 0.25]), np.array([0.8, 0.3, 0.25])]
+    evaluations = steady.evaluate_starts(problem, settings, us, [None, None])
+    assert len(seen) == 1 and len(seen[0][0]) == 2 and len(cases) == 1 and len(cases[0]) == 2
+    width = np.asarray(problem.bounds.upper - problem.bounds.lower)
+    for u, ev, case in zip(us, evaluations, cases[0]):
+        d = problem.design(jnp.asarray(u))
+        assert case[2] == d and case[3] == [("sample", float(d.end_radius))]  # its own states
+        expected = 1 + 2000 * float(d.axial_clearance) + float(d.end_radius) + 0.05  # GPa m/s
+        assert ev.objective == pytest.approx(expected, rel=1e-12)
+        lo, hi = ev.objective_ci
+        assert lo <= ev.objective <= hi
+        np.testing.assert_allclose(ev.gradient[:2], np.array([3e9, -4e9])[:2] * width[:2] / 1e9, rtol=1e-9)
+        np.testing.assert_array_equal(ev.static_margins, np.asarray(problem.margins(jnp.asarray(u))))
+        assert len(ev.states) == 1 and len(ev.states[0]) == 2  # one operating point, two seeds
+    assert evaluations[0].objective != evaluations[1].objective
+
+
+def test_clearance_gradient_is_a_paired_crn_difference_in_the_same_engine_call(monkeypatch):
+    """`clearance_step` h: every start's design also runs at Delta_bf +- h, with the same seeds
+    from the same continuation states, as members of the same engine call, and the Delta_bf
+    component of the gradient is the mean over seeds of (J+ - J-) / 2h with its paired standard
+    error; the frozen-load estimate keeps the other two (stand-ins for the engine and the
+    estimator, `_engine_stand_in` and `_frozen_stand_in`: the seed term cancels)."""
+    import jaxbearing as jb
+    from optimise import make_problem
+
+    seen = []
+    monkeypatch.setattr(steady, "steady_design_metrics_points", _engine_stand_in(seen))
+    monkeypatch.setattr(steady, "frozen_load_gradients", _frozen_stand_in())
     problem = make_problem(jb.reference_bearing(), jb.reference_operating_point())
     h = 0.01e-3
     settings = steady.SteadySettings(seeds=3, workers=1, clearance_step=h)
