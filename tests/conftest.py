@@ -23,35 +23,38 @@ import jax  # noqa: E402
 jax.config.update("jax_enable_x64", True)
 
 #: test files slowest first. Seconds of test time per file in a cold-cache `make test` from a
-#: fresh clone on the 2-core machine, nothing else running (2026-11-26, 07e31e8, junit; 2233 s
-#: in all, 19 min 05 s of pytest; docs/performance.md): engine 273, notebooks 212,
-#: steady_gradient 208, optimise_steady 205, optimise 142, rosenbrock 118, validate 97, outputs
-#: 72, speed 71, design 70, cmd_simulate 69, sweep_distributed 63, sweep 60, dynamics 52,
-#: flange_contact 49, settle 45, flange_lubrication 44, skid 43, misalignment 39, program_cache
-#: 37, quasistatic 30. `make test` runs `-n 2 --dist loadfile`: the two processes take whole
-#: files in collection order, so the longest start first and the short files fill in at the
-#: end (longest-processing-time-first scheduling). Unlisted files follow in their usual order.
+#: fresh clone on the 2-core machine, nothing else running (2026-11-26, cb481c4, junit; 1881 s
+#: in all, 15 min 58 s of pytest; docs/performance.md): notebooks 173, engine 165,
+#: steady_gradient 137, rosenbrock 136, optimise 113, optimise_steady 79, speed 78, sweep 73,
+#: settle 72, cmd_simulate 72, design 71, sweep_distributed 68, outputs 65, validate 52,
+#: flange_lubrication 49, flange_contact 48, dynamics 47, misalignment 42, contact_hertz 40,
+#: program_cache 35, raceway 33, skid 33, quasistatic 33. `make test` runs `-n 2 --dist
+#: loadfile`: the two processes take whole files in collection order, so the longest start
+#: first and the short files fill in at the end (longest-processing-time-first scheduling).
+#: Unlisted files follow in their usual order.
 SLOWEST_FILES_FIRST = (
-    "test_engine.py",
     "test_notebooks.py",
+    "test_engine.py",
     "test_steady_gradient.py",
-    "test_optimise_steady.py",
-    "test_optimise.py",
     "test_rosenbrock.py",
-    "test_validate.py",
-    "test_outputs.py",
+    "test_optimise.py",
+    "test_optimise_steady.py",
     "test_speed.py",
-    "test_design.py",
-    "test_cmd_simulate.py",
-    "test_sweep_distributed.py",
     "test_sweep.py",
-    "test_dynamics.py",
-    "test_flange_contact.py",
     "test_settle.py",
+    "test_cmd_simulate.py",
+    "test_design.py",
+    "test_sweep_distributed.py",
+    "test_outputs.py",
+    "test_validate.py",
     "test_flange_lubrication.py",
-    "test_skid.py",
+    "test_flange_contact.py",
+    "test_dynamics.py",
     "test_misalignment.py",
+    "test_contact_hertz.py",
     "test_program_cache.py",
+    "test_raceway.py",
+    "test_skid.py",
     "test_quasistatic.py",
 )
 
