@@ -9,7 +9,8 @@ The sweep and the vmapped members settle for a fixed 0.5 ms from the skid start 
 the plateau, tests/test_skid.py) and are declared settled: what is tested here is the engine's
 two paths and the sweep around them, not the settling verdict, whose success on real output is
 tests/test_settle.py's (`test_auto_settle_succeeds_and_reports_intervals`). The verdict takes at
-least four revolutions before the two measured; a fixed settle does a third of that work."""
+least four revolutions before the two measured: with it the sweep took 93 s, with the fixed
+settle 63 s (warm, 2026-11-26)."""
 
 import dataclasses
 import json

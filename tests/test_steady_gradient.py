@@ -153,8 +153,8 @@ def test_tangent_growth_is_finite_and_starts_at_zero(running):
 
 @pytest.fixture(scope="module")
 def settled():
-    """The reduced-size settled ensemble of the CRN check (11 slices, 3 seeds, 2-revolution
-    windows, measured 5 us after the skid start, which lands on the plateau)."""
+    """The reduced-size settled ensemble of the CRN checks of both statistics (11 slices, 3 seeds,
+    2-revolution windows, measured 5 us after the skid start, which lands on the plateau)."""
     from jaxbearing.design import steady_design_metrics
 
     b = dataclasses.replace(jb.reference_bearing(), num_slices=11)
