@@ -1,7 +1,8 @@
 """Whole-bearing dynamics: the docs/validation.md checks that concern the integration.
 
-All runs share one compilation (same structure, `num_saves` and `max_steps`): about 10 s to
-compile, a few seconds per 4 ms of simulated time on 2 cores.
+All runs share one compilation (same structure, `num_saves` and `max_steps`), which is also
+the program of tests/test_cmd_simulate.py's reference-bearing runs (20-27 s of compiling on the
+2-core machine, paid once per suite); a few seconds per 4 ms of simulated time.
 """
 
 import equinox as eqx
@@ -16,7 +17,7 @@ from jaxbearing.run import Perturbation, simulate, summarise
 from jaxbearing.run._initial import kinematic_start
 
 DURATION = 0.004  # s: 0.6 cage revolutions at the reference point
-SAVES = 800
+SAVES = 4000  # as `jaxbearing simulate` saves: the program of tests/test_cmd_simulate.py's runs
 
 
 def _run(bearing=None, op=None, **kw):

@@ -53,9 +53,11 @@ def test_free_ring_under_axial_load_integrates_and_loads_the_opposite_flanges():
     assert f[1] == 0.0 and f[2] == 0.0  # inner +X, outer -X
 
 
-def _flange_totals(cfg_text: str, duration: float = 1e-3, num_saves: int = 100):
+def _flange_totals(cfg_text: str, duration: float = 1e-3, num_saves: int = 4000):
     """Total force on each flange (inner -X, inner +X, outer -X, outer +X), mean over the last
-    fifth of a run of the 11-slice bearing from the quasi-static start, and the run's status."""
+    fifth of a run of the 11-slice bearing from the quasi-static start, and the run's status.
+    4000 saves, as `jaxbearing simulate` saves: one compiled program with tests/test_outputs.py's
+    reduced-size run (about 25 s of compiling on the 2-core machine)."""
     import numpy as np
 
     import jaxbearing as jb
