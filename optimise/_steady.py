@@ -142,8 +142,8 @@ class SteadySettings:
     verify_seeds: int = 4
     verify_first_seed: int = 1000
     verify_window_revs: int = 4
-    #: the statistic of flange PV minimised: "mean" (over contact time) or "peak" (its p-mean,
-    #: `jaxbearing.design.STATISTICS`)
+    #: the statistic of flange PV minimised: "mean" (over contact time), "peak" (its p-mean) or
+    #: "tail" (the mean of its worst 5 %, `jaxbearing.design.STATISTICS`)
     statistic: str = "mean"
     #: half-step of the common-random-number central difference in Delta_bf [m] (0: off), or
     #: "auto": `CLEARANCE_STEP` where the envelope is misaligned by more than
@@ -969,6 +969,8 @@ def _estimates(m) -> dict:
         "objective_GPa_m_s": _scaled(m.objective),
         # the expected largest PV of a cage revolution (what the "peak" statistic aims at)
         "peak_pv_GPa_m_s": _scaled(m.summary.get("flange_pv_Pa_m_s", {}).get("max", {})),
+        # the mean of the worst 5 % of PV over contact time (the "tail" statistic)
+        "tail_pv_GPa_m_s": _scaled(m.summary.get("flange_pv_contact_time_Pa_m_s", {}).get("tail95", {})),
         "corner_contact_share": dict(m.corner_contact_share),
         "corner_margin_mm": _scaled(m.corner_margin, 1e-3),
         # the margin on the upper 95 % prediction bound of one revolution's largest contact radius

@@ -113,6 +113,11 @@ def test_revolution_statistics_closed_form():
     np.testing.assert_allclose(s["corner_contact_share.time"], [0.0, 1.0])
     np.testing.assert_allclose(s["contact_radius_m.p99"], [3.0e-3, 3.5e-3])
     np.testing.assert_allclose(s["contact_radius_m.max_in_contact"], [3.0e-3, 3.5e-3])
+    # PV over contact time: the five samples (0.2, 0.6, 1, 0.6, 0.2) x 2e7 x peak; p95 by linear
+    # interpolation 1.2e8 + 0.8 x 0.8e8 (x 2 in revolution 1); the tail mean: the one sample above
+    np.testing.assert_allclose(s["flange_pv_contact_time_Pa_m_s.mean"], [1.04e8, 2.08e8])
+    np.testing.assert_allclose(s["flange_pv_contact_time_Pa_m_s.p95"], [1.84e8, 3.68e8])
+    np.testing.assert_allclose(s["flange_pv_contact_time_Pa_m_s.tail95"], [2e8, 4e8])
     rpm = 60 / (2 * np.pi)
     np.testing.assert_allclose(s["cage_speed_rpm"], [100 * rpm, 110 * rpm])
     np.testing.assert_allclose(s["cage_slip"], [1 - 100 / 120, 1 - 110 / 120])

@@ -30,7 +30,8 @@ limited circle, clearance; positive when satisfied) and the full settled summary
   the optimiser minimises and whose gradient `steady_gradient` estimates (`mean_pv` is the same
   average over the saved samples with the hard 1 N threshold); with `statistic="peak"` the
   p-mean PV_ref (int w (PV/PV_ref)^p dt / int w dt)^(1/p), p = `PEAK_EXPONENT`, which weights
-  the peaks (`STATISTICS`);
+  the peaks; with `statistic="tail"` the tail mean of PV over contact time per revolution, the
+  mean of its worst 5 % of the saved touching samples (`run.tail_mean`) (`STATISTICS`);
 
 It is a measurement, not a differentiable function: the gradient of a long impacting trajectory
 is not a design signal (`_design`, docs/model.md 14); `steady_gradient` estimates the gradient
@@ -59,7 +60,13 @@ from ..flange import (
 )
 from ..geometry import Bearing, OperatingPoint
 from ..io import require
-from ..run import Perturbation, simulate_steady_points, student_t_interval, summarise_steady
+from ..run import (
+    Perturbation,
+    simulate_steady_points,
+    student_t_interval,
+    summarise_steady,
+    window_statistics,
+)
 from ._steady_gradient import _functionals
 
 #: default dynamic corner margin [m]: the largest contact radius this far inside the limited circle
@@ -173,13 +180,29 @@ def steady_design_metrics_points(
     )
     fn = steady_kwargs["functionals"]
     return [
-        _metrics(result, d, np.asarray(zone_margins(b, d, flange_load=flange_load)), corner_margin, fn)
+        _metrics(
+            result, d, np.asarray(zone_margins(b, d, flange_load=flange_load)), corner_margin, fn, statistic
+        )
         for result, b, d in zip(results, bearings, designs)
     ]
 
 
+def _tail_per_seed(result, run) -> float:
+    """One seed's tail statistic: the mean over its window's revolutions of the tail mean of PV
+    over contact time (`run.tail_mean` of the touching samples, per revolution); NaN without a
+    measured window or contact."""
+    if not run.measured:
+        return float("nan")
+    per_rev = run.per_revolution
+    if per_rev is None:
+        per_rev = window_statistics(run.window, run.edges, result.bearing, result.operating)
+    values = np.asarray(per_rev["flange_pv_contact_time_Pa_m_s.tail95"], dtype=float)
+    values = values[np.isfinite(values)]
+    return float(np.mean(values)) if values.size else float("nan")
+
+
 def _metrics(
-    result, design: DesignVariables, margins, corner_margin: float, functionals
+    result, design: DesignVariables, margins, corner_margin: float, functionals, statistic: str = "mean"
 ) -> SteadyDesignMetrics:
     """The design metrics of one operating point's settled run (module docstring)."""
     s = summarise_steady(result)
@@ -202,12 +225,16 @@ def _metrics(
 
     bound = float(s.get("max_contact_radius_bound", {}).get("value", np.nan))  # NaN stays NaN
     pv_ref, p = float(functionals.pv_reference), float(functionals.pv_exponent)
-    per_seed = [
-        pv_ref * (sum(a for a, _ in r.window_integrals) / sum(c for _, c in r.window_integrals)) ** (1.0 / p)
-        if r.status == "ok" and r.window_integrals and sum(c for _, c in r.window_integrals) > 0
-        else np.nan
-        for r in result.runs
-    ]
+    if statistic == "tail":
+        per_seed = [_tail_per_seed(result, r) for r in result.runs]
+    else:
+        per_seed = [
+            pv_ref
+            * (sum(a for a, _ in r.window_integrals) / sum(c for _, c in r.window_integrals)) ** (1.0 / p)
+            if r.status == "ok" and r.window_integrals and sum(c for _, c in r.window_integrals) > 0
+            else np.nan
+            for r in result.runs
+        ]
     return SteadyDesignMetrics(
         design={
             "end_radius_m": float(design.end_radius),

@@ -33,6 +33,21 @@ design, e.g. the cage speed or the skew amplitude): its bias against the derivat
 settled mean is measured against common-random-number central differences of settled runs
 in benchmarks/studies/bench_steady_gradient.py, with the window length T and ensemble size K it
 was measured at (docs/how-to/design-search.md).
+
+The tail statistic. The tail mean of PV over contact time, the mean of its worst
+1 - alpha = 5 % (the superquantile or conditional value at risk, `run.tail_mean`; the settled
+objective is its expectation per cage revolution), has the Rockafellar-Uryasev form
+(Rockafellar & Uryasev 2000, J. Risk 2:21)
+
+    T(d) = min_q  q + E[(PV - q)^+] / (1 - alpha),
+
+whose minimiser is the alpha-quantile q*. The derivative at fixed q = q* is the derivative of T
+(envelope theorem: the q-derivative vanishes at q*), so the frozen-load estimator applies with
+the integrand (PV / PV_ref - q / PV_ref)^+ and the statistics' hard contact indicator
+1(Q0 > 1 N) for w: J = q + PV_ref R / (1 - alpha), dJ = PV_ref dR / (1 - alpha), with q the
+95th percentile of the touching samples of the estimator's own trajectories (`tail_integrals`),
+so that 5 % of them lie above it. An error dq in q changes J by O(dq^2) only. Unlike the quantile itself, whose derivative E[dPV | PV = q] needs a kernel
+around q and the few samples inside it, every sample of the worst 5 % carries the signal.
 """
 
 from __future__ import annotations
@@ -52,6 +67,7 @@ from ..geometry import Bearing, OperatingPoint
 from ..io import require
 from ..run import (
     STRATEGIES,
+    TAIL_LEVEL,
     checks_without_host_callbacks,
     choose_strategy,
     compiled_program,
@@ -72,11 +88,17 @@ STEADY_FUNCTIONALS = Functionals(pv_exponent=1.0, contact_load=CONTACT_LOAD)
 #: p of the peak statistic: the p-mean of PV over contact time, PV_ref (sum A_p / sum C)^(1/p),
 #: which weights the tail (p = 8: a sample at twice the mean counts 256 times as much)
 PEAK_EXPONENT = 8.0
-#: the steady objective's statistics: "mean" (p = 1) and "peak" (p = `PEAK_EXPONENT`)
+#: the steady objective's statistics and the accumulators their runs integrate: "mean" (p = 1),
+#: "peak" (p = `PEAK_EXPONENT`) and "tail" (the tail mean of PV over contact time, the mean of its
+#: worst 1 - `TAIL_LEVEL` = 5 %, taken from the saved samples: module docstring, the tail statistic)
 STATISTICS = {
     "mean": STEADY_FUNCTIONALS,
     "peak": Functionals(pv_exponent=PEAK_EXPONENT, contact_load=CONTACT_LOAD),
+    "tail": STEADY_FUNCTIONALS,
 }
+#: the contact force above which a saved flange sample counts as contact time in the statistics
+#: (`run.summarise_steady`'s threshold) [N]: the tail statistic's hard indicator
+TOUCHING_FORCE = 1.0
 #: default window of the short-window sensitivities [s] (benchmarks/studies/bench_steady_gradient.py)
 GRADIENT_WINDOW = 1.0e-3
 
@@ -222,11 +244,16 @@ def steady_gradient(
     return _combine([(v[:2] if v[2] > 0.5 else np.full(2, np.nan), j[:, :2]) for v, j in outs], window)
 
 
-def _combine(outs, window, exponent: float = 1.0) -> SteadyGradient:
+def _combine(outs, window, exponent: float = 1.0, tail_threshold: float | None = None) -> SteadyGradient:
     """The ratio estimator and its jackknife from per-sample ((A, C), Jacobian (3, 2)); a
     failed sample carries NaN and is left out. With `exponent` p (A the integral of
     (PV/PV_ref)^p): J = PV_ref R^(1/p) with R = sum A / sum C, dJ = J dR / (p R), and the
-    standard errors by the same factor (delta method)."""
+    standard errors by the same factor (delta method). With `tail_threshold` q [Pa m/s] (A the
+    integral of (PV/PV_ref - q/PV_ref)^+): the tail mean's Rockafellar-Uryasev form
+    J = q + PV_ref R / (1 - alpha), dJ = PV_ref dR / (1 - alpha) at fixed q, alpha = `TAIL_LEVEL`
+    (module docstring, the tail statistic)."""
+    if not outs:  # no states given
+        return dataclasses.replace(SteadyGradient.missing(), window_s=float(window))
     vals = np.stack([v for v, _ in outs])  # (K, 2): A, C
     jacs = np.stack([j for _, j in outs])  # (K, 3 variables, 2 outputs)
     ok = np.all(np.isfinite(vals), axis=1) & np.all(np.isfinite(jacs), axis=(1, 2))
@@ -240,7 +267,11 @@ def _combine(outs, window, exponent: float = 1.0) -> SteadyGradient:
         )
     value, grad = ratio_gradient(a, c, da, dc, pv_ref)
     value_se, grad_se = _jackknife_stderr(a, c, da, dc, pv_ref)
-    if exponent != 1.0:  # value = PV_ref R above
+    if tail_threshold is not None:  # value = PV_ref R above
+        scale = 1.0 / (1.0 - TAIL_LEVEL)
+        value, grad = tail_threshold + scale * value, scale * grad
+        value_se, grad_se = scale * value_se, scale * grad_se
+    elif exponent != 1.0:  # value = PV_ref R above
         j = pv_ref * (value / pv_ref) ** (1.0 / exponent)
         factor = j / (exponent * value)
         value, grad, value_se, grad_se = j, grad * factor, value_se * factor, grad_se * factor
@@ -324,20 +355,61 @@ def trajectory_states(
     return sol.ys, result_code(sol.result)
 
 
-def frozen_load_integrands(bearing, op, x, state: State, reference_load, exponent=1.0):
-    """(sum_c w(Q0_c) PV_c(x) (Q0_c / Q_c(x))^(1/3), sum_c w(Q0_c)) over the flange contacts of
+def frozen_pv(bearing, op, x, state: State, reference_load):
+    """(w(Q0_c), PV_c(x) (Q0_c / Q_c(x))^(1/3) / PV_ref), each (Z, 4), over the flange contacts of
     one state: the flange PV with design x at the loads Q0 = `reference_load` (Z, 4) the
-    dynamics gave (module docstring, frozen-load estimator). Hertz: p_max = c(radii) Q^(1/3),
-    so PV (Q0/Q)^(1/3) is the PV at load Q0 with the contact point, curvatures and sliding
-    velocity of design x."""
+    dynamics gave (module docstring, frozen-load estimator), and the smooth contact indicator.
+    Hertz: p_max = c(radii) Q^(1/3), so PV (Q0/Q)^(1/3) is the PV at load Q0 with the contact
+    point, curvatures and sliding velocity of design x."""
     fl = contact_loads(state, _design_params(bearing, op, x)).flange
     q0 = reference_load
     on = (q0 > LOAD_FLOOR) & (fl.normal_force > LOAD_FLOOR)
     safe_q = jnp.where(on, fl.normal_force, 1.0)
     ratio = jnp.where(on, (jnp.where(on, q0, 1.0) / safe_q) ** (1.0 / 3.0), 0.0)
     w = q0 / (q0 + STEADY_FUNCTIONALS.contact_load)
-    frozen = fl.pv * ratio / STEADY_FUNCTIONALS.pv_reference
+    return w, fl.pv * ratio / STEADY_FUNCTIONALS.pv_reference
+
+
+def frozen_load_integrands(bearing, op, x, state: State, reference_load, exponent=1.0):
+    """(sum_c w(Q0_c) (PV_c(x) (Q0_c / Q_c(x))^(1/3) / PV_ref)^p, sum_c w(Q0_c)) over the flange
+    contacts of one state, p = `exponent` (`frozen_pv`)."""
+    w, frozen = frozen_pv(bearing, op, x, state, reference_load)
     return jnp.stack([jnp.sum(w * frozen**exponent), jnp.sum(w)])
+
+
+def frozen_tail_samples(bearing, op, x, states):
+    """The tail statistic's samples along one trajectory (`states`: a leading time axis): per
+    saved state and flange contact, the statistics' hard contact indicator 1(Q0 > 1 N), the
+    frozen PV / PV_ref at x (`frozen_pv`) and its Jacobian in x (leading axis 3)."""
+    q0 = jax.vmap(lambda s: contact_loads(s, _design_params(bearing, op, x)).flange.normal_force)(states)
+    pv, dpv = forward_jacobian(
+        lambda v: jax.vmap(lambda s, q: frozen_pv(bearing, op, v, s, q)[1])(states, q0), x
+    )
+    return (q0 > TOUCHING_FORCE).astype(float), pv, dpv
+
+
+def tail_integrals(samples) -> tuple[list, float]:
+    """The tail statistic's per-trajectory integrals from `frozen_tail_samples` of every
+    trajectory of one design ((w, pv, dpv) each, or None for a failed one): q, the 95th
+    percentile of the frozen PV / PV_ref over every touching sample, and per trajectory
+    ((A, C), Jacobian (3, 2)) with A = sum w (pv - q)^+, C = sum w, dA = sum w 1(pv > q) dpv
+    (the Rockafellar-Uryasev form at fixed q, module docstring). Returns (outs, q)."""
+    touching = [np.asarray(pv)[np.asarray(w) > 0.5] for w, pv, _ in filter(None, samples)]
+    pooled = np.concatenate(touching) if touching else np.zeros(0)
+    if pooled.size == 0:
+        return [(np.full(2, np.nan), np.full((3, 2), np.nan)) for _ in samples], float("nan")
+    q = float(np.percentile(pooled, 100.0 * TAIL_LEVEL))
+    outs = []
+    for sample in samples:
+        if sample is None:
+            outs.append((np.full(2, np.nan), np.full((3, 2), np.nan)))
+            continue
+        w, pv, dpv = (np.asarray(a) for a in sample)
+        above = w * (pv > q)
+        a = float(np.sum(w * np.maximum(pv - q, 0.0)))
+        da = np.sum(above[None] * dpv, axis=tuple(range(1, dpv.ndim)))
+        outs.append((np.array([a, float(np.sum(w))]), np.stack([da, np.zeros(3)], axis=1)))
+    return outs, q
 
 
 @dataclasses.dataclass(frozen=True)
@@ -351,6 +423,7 @@ class _FrozenSample:
     num_saves: int
     rtol: float
     exponent: float = 1.0
+    tail: bool = False  # the tail statistic's samples (`frozen_tail_samples`) instead of sums
 
     def __call__(self, state):
         x = jnp.asarray(self.x)
@@ -359,6 +432,13 @@ class _FrozenSample:
         args = (self.bearing, self.op, state, jnp.asarray(self.duration), jnp.asarray(self.rtol))
         trajectory = lambda b, o, s, d, r: trajectory_states(b, o, s, d, num_saves, rtol=r)
         states, code = compiled_program("trajectory_states", trajectory, args, num_saves)(*args)
+        if self.tail:
+            if int(code) != 0:
+                return None
+            args = (self.bearing, self.op, x, states)
+            return tuple(
+                map(np.asarray, compiled_program("frozen_tail_samples", frozen_tail_samples, args)(*args))
+            )
         if int(code) != 0:
             return np.full(2, np.nan), np.full((3, 2), np.nan)
         args = (self.bearing, self.op, x, states, np.float64(self.exponent))
@@ -367,7 +447,7 @@ class _FrozenSample:
 
 
 def _frozen_jacobian(bearing, op, x, states, exponent=1.0):
-    """Sum over the saved states of the frozen-load integrands (PV to the power `exponent`) and
+    """Sum over the saved states of the frozen-load integrands (`frozen_load_integrands`) and
     their Jacobian in x."""
     q0 = jax.vmap(lambda s: contact_loads(s, _design_params(bearing, op, x)).flange.normal_force)(states)
 
@@ -396,7 +476,9 @@ def frozen_load_gradient(
     1 / `saves_per_ms` ms; at every saved state the flange PV is differentiated in the design at
     the loads the dynamics gave (`frozen_load_integrands`), summed, and combined through the
     ratio estimator; jackknife over the trajectories. `statistic`: "mean" (PV over contact
-    time) or "peak" (its p-mean, `STATISTICS`); `strategy`: as `frozen_load_gradients`."""
+    time), "peak" (its p-mean) or "tail" (the mean of its worst 5 %, at the 95th percentile of the
+    trajectories' own touching samples: `tail_integrals`; `STATISTICS`); `strategy`: as
+    `frozen_load_gradients`."""
     forwarded = {k: v for k, v in locals().items() if k not in ("bearing", "op", "design", "states")}
     (gradient,) = frozen_load_gradients([(bearing, op, design, states)], **forwarded)
     return gradient
@@ -423,11 +505,13 @@ def frozen_load_gradients(
     if strategy not in STRATEGIES:
         raise UserInputError(f"strategy = {strategy!r}: must be one of {', '.join(map(repr, STRATEGIES))}")
     exponent = float(_functionals(statistic).pv_exponent)
+    tail = statistic == "tail"
+    cases = list(cases)
     n = max(1, int(round(window * 1e3 * saves_per_ms)))
     jobs, owner = [], []
     for k, (bearing, op, design, states) in enumerate(cases):
         x = np.asarray(design.as_array(), dtype=float)
-        job = _FrozenSample(bearing, op, x, float(window), n, float(rtol), exponent)
+        job = _FrozenSample(bearing, op, x, float(window), n, float(rtol), exponent, tail)
         jobs += [(job, s) for s in states]
         owner += [k] * len(states)
     chosen = choose_strategy(strategy, min(int(workers), max(1, len(jobs))))
@@ -437,7 +521,14 @@ def frozen_load_gradients(
         outs = _frozen_samples_batched(jobs)
     else:
         outs = parallel_map(_frozen_job, jobs, workers=workers if chosen == "processes" else 1)
-    return [_combine([o for o, j in zip(outs, owner) if j == k], window, exponent) for k in range(len(cases))]
+    per_case = [[o for o, j in zip(outs, owner) if j == k] for k in range(len(cases))]
+    if not tail:
+        return [_combine(o, window, exponent) for o in per_case]
+    found = []
+    for o in per_case:
+        integrals, q = tail_integrals(o)
+        found.append(_combine(integrals, window, 1.0, q * STEADY_FUNCTIONALS.pv_reference))
+    return found
 
 
 def _functionals(statistic: str) -> Functionals:
@@ -458,10 +549,13 @@ def _frozen_samples_batched(jobs) -> list:
     trajectory and the frozen-load integrals and Jacobian along it."""
     num_saves = jobs[0][0].num_saves
 
+    tail = jobs[0][0].tail
+
     def one(b, o, x, s, d, r, p):
         states, code = trajectory_states(b, o, s, d, num_saves, rtol=r)
-        val, jac = _frozen_jacobian(b, o, x, states, p)
-        return val, jac, code
+        if tail:
+            return frozen_tail_samples(b, o, x, states), code
+        return _frozen_jacobian(b, o, x, states, p), code
 
     args = stack_trees(
         [
@@ -477,9 +571,11 @@ def _frozen_samples_batched(jobs) -> list:
             for job, state in jobs
         ]
     )
-    vals, jacs, codes = jax.device_get(
-        compiled_program("frozen_load_members", jax.vmap(one), args, num_saves)(*args)
-    )
+    name = "frozen_tail_members" if tail else "frozen_load_members"
+    outs, codes = jax.device_get(compiled_program(name, jax.vmap(one), args, num_saves)(*args))
+    if tail:
+        return [tuple(a[i] for a in outs) if int(codes[i]) == 0 else None for i in range(len(jobs))]
+    vals, jacs = outs
     return [
         (vals[i], jacs[i]) if int(codes[i]) == 0 else (np.full(2, np.nan), np.full((3, 2), np.nan))
         for i in range(len(jobs))

@@ -10,7 +10,8 @@
 - statistics: `contact_events`, `summarise`, `film_statistics` (film over contact time,
   `FILM_KEYS`); of settled running with 95 % confidence
   intervals: `steady_statistics`, `revolution_statistics`, `confidence_intervals`,
-  `batch_means`, `student_t_interval`, `Estimate`; how often the contact reached the corner,
+  `batch_means`, `student_t_interval`, `Estimate`, `tail_mean` (the mean above the
+  `TAIL_LEVEL` quantile); how often the contact reached the corner,
   with upper bounds: `corner_contact_bound`, `upper_probability_bound`; the prediction bound
   of one revolution's largest contact radius: `max_contact_radius_bound`;
 - settled running: `simulate_steady` (settling detection over cage revolutions, a window,
@@ -83,6 +84,7 @@ from ._settle import (
 )
 from ._simulate import SolveArgs, flange_functionals, scaled_diffeqsolve, scaled_field, solve
 from ._statistics import (
+    TAIL_LEVEL,
     Estimate,
     batch_means,
     confidence_intervals,
@@ -92,6 +94,7 @@ from ._statistics import (
     revolution_statistics,
     steady_statistics,
     student_t_interval,
+    tail_mean,
     upper_probability_bound,
     window_statistics,
 )
@@ -167,6 +170,8 @@ __all__ = [
     "solve_from",
     "steady_statistics",
     "student_t_interval",
+    "tail_mean",
+    "TAIL_LEVEL",
     "corner_contact_bound",
     "max_contact_radius_bound",
     "upper_probability_bound",

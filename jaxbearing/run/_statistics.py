@@ -122,7 +122,21 @@ _REVOLUTION_SCALARS = (
     "flange_contact_events_per_rev",
     "flange_pv_contact_time_Pa_m_s.mean",
     "flange_pv_contact_time_Pa_m_s.p95",
+    "flange_pv_contact_time_Pa_m_s.tail95",
 )
+
+#: the level of the tail statistic "tail95": the mean of the values at or above the 95th
+#: percentile (the superquantile, or conditional value at risk, at 0.95)
+TAIL_LEVEL = 0.95
+
+
+def tail_mean(values, level: float = TAIL_LEVEL) -> float:
+    """The mean of the values at or above their `level` quantile (linear interpolation, as
+    `np.percentile`): the superquantile, or conditional value at risk (Rockafellar & Uryasev
+    2000, "Optimization of conditional value-at-risk", J. Risk 2:21). Unlike the quantile it
+    responds to every value in the tail, and it bounds the quantile from above."""
+    v = np.asarray(values, dtype=float).ravel()
+    return float(np.mean(v[v >= np.percentile(v, 100.0 * level)]))
 
 
 def revolution_statistic_keys() -> tuple[str, ...]:
@@ -170,6 +184,7 @@ def revolution_statistics(
             pv = np.asarray(w["flange_pv"])[touching]
             out["flange_pv_contact_time_Pa_m_s.mean"][i] = np.mean(pv)
             out["flange_pv_contact_time_Pa_m_s.p95"][i] = np.percentile(pv, 95.0)
+            out["flange_pv_contact_time_Pa_m_s.tail95"][i] = tail_mean(pv)
             rho = np.asarray(w["contact_radius"])[touching]
             out["contact_radius_m.p99"][i] = np.percentile(rho, 99.0)
             # the largest contact radius of any touching sample: the corner is reached iff > rho_lim
