@@ -614,7 +614,8 @@ def run_steady(args, problem, options, settings, out, meta=None) -> int:
     print(
         f"final design: {_design_text(res.design)}  (start {res.best_start}, iteration {res.best_iteration})"
     )
-    print(f"  steady mean PV {res.objective:.4f} [{lo:.4f}, {hi:.4f}] GPa m/s (search seeds)")
+    what = {"mean": "mean PV", "peak": "peak PV (p-mean)", "tail": "tail PV"}.get(settings.statistic, "PV")
+    print(f"  steady {what} {res.objective:.4f} [{lo:.4f}, {hi:.4f}] GPa m/s (search seeds)")
     from ._steady import near_optimal_set
 
     near = near_optimal_set(res)
