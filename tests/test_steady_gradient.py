@@ -355,14 +355,17 @@ def test_frozen_load_estimator_agrees_with_crn_differences_on_settled_running(se
     assert abs(g.gradient[1] - fd) <= 0.3 * abs(fd)
 
 
-def test_frozen_load_gradients_batched_equal_one_at_a_time(settled):
+@pytest.mark.parametrize("statistic", ["mean", "tail"])
+def test_frozen_load_gradients_batched_equal_one_at_a_time(settled, statistic):
     """`frozen_load_gradients` on two cases (two designs, two and three settled states): every
     trajectory a member of one vmapped program gives each case's estimate and gradient as the
     cases run one trajectory at a time do, each case only from its own states. Not bitwise: the
     vmapped solve is another program, its roundings flip a step's acceptance now and then, and
     over the 1 ms window the impacting dynamics grow such a difference (module docstring of
     `_steady_gradient`; measured 2026-11-26: values 0.1-1.1 % apart, depending on the batch's
-    size). So the two must agree within the estimator's own standard error."""
+    size). So the two must agree within the estimator's own standard error. The tail statistic
+    too: its vmapped program returns every sample's frozen PV and Jacobian, the accelerator's
+    path (`frozen_tail_members`)."""
     from jaxbearing.design import frozen_load_gradients
 
     b, op, x, base = settled
@@ -372,8 +375,8 @@ def test_frozen_load_gradients_batched_equal_one_at_a_time(settled):
         (b, op, DesignVariables.from_array(x), base.sample_states[:2]),
         (b, op, DesignVariables.from_array(x2), base.sample_states[:3]),
     ]
-    one = frozen_load_gradients(cases, strategy="sequential")
-    batched = frozen_load_gradients(cases, strategy="vmap")
+    one = frozen_load_gradients(cases, strategy="sequential", statistic=statistic)
+    batched = frozen_load_gradients(cases, strategy="vmap", statistic=statistic)
     for a, v in zip(one, batched):
         assert a.num_samples == v.num_samples and np.isfinite(a.value)
         print(

@@ -46,8 +46,9 @@ whose minimiser is the alpha-quantile q*. The derivative at fixed q = q* is the 
 the integrand (PV / PV_ref - q / PV_ref)^+ and the statistics' hard contact indicator
 1(Q0 > 1 N) for w: J = q + PV_ref R / (1 - alpha), dJ = PV_ref dR / (1 - alpha), with q the
 95th percentile of the touching samples of the estimator's own trajectories (`tail_integrals`),
-so that 5 % of them lie above it. An error dq in q changes J by O(dq^2) only. Unlike the quantile itself, whose derivative E[dPV | PV = q] needs a kernel
-around q and the few samples inside it, every sample of the worst 5 % carries the signal.
+so that 5 % of them lie above it. An error dq in q changes J by O(dq^2) only. Unlike the
+quantile itself, whose derivative E[dPV | PV = q] needs a kernel around q and the few samples
+inside it, every sample of the worst 5 % carries the signal.
 """
 
 from __future__ import annotations
@@ -547,9 +548,7 @@ def _frozen_job(item):
 def _frozen_samples_batched(jobs) -> list:
     """Every (`_FrozenSample`, state) of `jobs` as one member of one vmapped program: its
     trajectory and the frozen-load integrals and Jacobian along it."""
-    num_saves = jobs[0][0].num_saves
-
-    tail = jobs[0][0].tail
+    num_saves, tail = jobs[0][0].num_saves, jobs[0][0].tail
 
     def one(b, o, x, s, d, r, p):
         states, code = trajectory_states(b, o, s, d, num_saves, rtol=r)
