@@ -389,6 +389,27 @@ def test_frozen_load_gradients_batched_equal_one_at_a_time(settled, statistic):
     assert [g.num_samples for g in batched] == [2, 3] and one[0].value != one[1].value
 
 
+def test_frozen_load_trajectories_run_with_the_design(settled):
+    """`frozen_load_gradients` runs each case's trajectories with the case's design applied to its
+    bearing: the reference bearing with design x2 gives what x2's own bearing gives. Before it
+    did, a case at another design ran its windows with the bearing's own end arc, off the
+    contacts of its settled states (at R_end + 5 % about 1 touching sample per trajectory
+    instead of hundreds)."""
+    from jaxbearing.design import frozen_load_gradients
+
+    b, op, x, base = settled
+    x2 = x.copy()
+    x2[0] *= 1.05
+    d2 = DesignVariables.from_array(x2)
+    states = base.sample_states[:1]
+    given, applied = (
+        frozen_load_gradients([(bearing, op, d2, states)], strategy="sequential")[0]
+        for bearing in (b, d2.apply(b))
+    )
+    assert np.isfinite(given.value) and given.value == applied.value
+    assert np.array_equal(given.gradient, applied.gradient)
+
+
 def test_paired_central_difference():
     """Mean and standard error of (J+ - J-) / 2h over the seeds with both values finite."""
     from jaxbearing.design import paired_central_difference

@@ -24,8 +24,8 @@ members per hour at 11 slices on an H200), hours on the 2-core CPU.
 
 Options: `--seeds K`, `--step-mm H`, `--slices N`, `--window W`, `--points
 speed|others|all|ref|misaligned` (the speed factor, the misalignment and load factors, all seven
-points, the reference point alone, or 2 mrad alone and combined with 30,000 rpm and with 500 N), `--designs 1|2`,
-`--results-dir DIR`. `--quick`: the reference point, one design, 4 seeds, 11 slices (a check of
+points, the reference point alone, or 2 mrad alone and combined with 30,000 rpm and with 500 N), `--designs 1|2`
+(the first design, or both), `--design 2` (the second alone), `--results-dir DIR`. `--quick`: the reference point, one design, 4 seeds, 11 slices (a check of
 the script, minutes on the CPU). Results: results/study_clearance_effect[_quick].json.
 `--plot [RESULTS.json]` draws a results file (default results/study_clearance_effect.json) as
 docs/figures/clearance_effect/clearance_effect.png: dJ/dDelta_bf as a share of J per 10 um at
@@ -102,6 +102,7 @@ def main(
     points: str = "all",
     designs: int = 2,
     results_dir: str | None = None,
+    design: int | None = None,
 ) -> dict:
     import numpy as np
 
@@ -115,7 +116,7 @@ def main(
     bearing = dataclasses.replace(jb.reference_bearing(), num_slices=slices)
     chosen = [
         DesignVariables.from_array(np.array([r * 1e-3, math.radians(t), c * 1e-3]))
-        for r, t, c in DESIGNS[:designs]
+        for r, t, c in (DESIGNS[:designs] if design is None else [DESIGNS[design - 1]])
     ]
     h = step_mm * 1e-3
     kw = dict(seeds=seeds, window_revs=window, settle="auto", workers=_common_workers())
@@ -289,5 +290,6 @@ if __name__ == "__main__":
         window=opt("--window", int, 2),
         points=opt("--points", str, "all"),
         designs=opt("--designs", int, 2),
+        design=opt("--design", int, None),
         results_dir=_common.option_value(argv, "--results-dir"),
     )

@@ -497,7 +497,8 @@ def frozen_load_gradients(
 ) -> list[SteadyGradient]:
     """`frozen_load_gradient` of every case (bearing, op, design, states), e.g. every start and
     operating point of one iteration of the design search; one `SteadyGradient` per case, in
-    order. Every trajectory of every case is one member of one call (`strategy`, as the
+    order. Each case's trajectories run with `design` applied to `bearing` (its other parameters
+    kept) from `states`, states of settled running of that design. Every trajectory of every case is one member of one call (`strategy`, as the
     steady-running engine's `choose_strategy`): "vmap" (the default on an accelerator) integrates
     and differentiates them all in one vmapped program; on a CPU they run `workers` processes
     at a time ("processes"), or one after another ("sequential")."""
@@ -512,7 +513,9 @@ def frozen_load_gradients(
     jobs, owner = [], []
     for k, (bearing, op, design, states) in enumerate(cases):
         x = np.asarray(design.as_array(), dtype=float)
-        job = _FrozenSample(bearing, op, x, float(window), n, float(rtol), exponent, tail)
+        # the trajectories run with the design, as the settled states did: a bearing of another
+        # design would start every window off its contacts (micrometres against a changed end arc)
+        job = _FrozenSample(design.apply(bearing), op, x, float(window), n, float(rtol), exponent, tail)
         jobs += [(job, s) for s in states]
         owner += [k] * len(states)
     chosen = choose_strategy(strategy, min(int(workers), max(1, len(jobs))))
