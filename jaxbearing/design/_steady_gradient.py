@@ -67,6 +67,7 @@ from ..flange import DesignVariables, with_design
 from ..geometry import Bearing, OperatingPoint
 from ..io import require
 from ..run import (
+    CONTACT_THRESHOLD,
     STRATEGIES,
     TAIL_LEVEL,
     checks_without_host_callbacks,
@@ -98,8 +99,8 @@ STATISTICS = {
     "tail": STEADY_FUNCTIONALS,
 }
 #: the contact force above which a saved flange sample counts as contact time in the statistics
-#: (`run.summarise_steady`'s threshold) [N]: the tail statistic's hard indicator
-TOUCHING_FORCE = 1.0
+#: (`run.CONTACT_THRESHOLD`, `run.summarise_steady`'s threshold) [N]: the tail's hard indicator
+TOUCHING_FORCE = CONTACT_THRESHOLD
 #: default window of the short-window sensitivities [s] (benchmarks/studies/bench_steady_gradient.py)
 GRADIENT_WINDOW = 1.0e-3
 

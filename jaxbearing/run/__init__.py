@@ -8,7 +8,7 @@
   `RESULT_NAMES` (the outcome code of a solve), `SolveProgress` (the text progress meter
   inside a solve) and `HostProgress` (the same from the calling process: cacheable programs);
 - statistics: `contact_events`, `summarise`, `film_statistics` (film over contact time,
-  `FILM_KEYS`); of settled running with 95 % confidence
+  `FILM_KEYS`; a sample is contact above `CONTACT_THRESHOLD`); of settled running with 95 % confidence
   intervals: `steady_statistics`, `revolution_statistics`, `confidence_intervals`,
   `batch_means`, `student_t_interval`, `Estimate`, `tail_mean` (the mean above the
   `TAIL_LEVEL` quantile); how often the contact reached the corner,
@@ -109,9 +109,10 @@ from ._step_control import (
     RacewayNormalNorm,
     raceway_normal_norm,
 )
-from ._summary import FILM_KEYS, contact_events, film_statistics
+from ._summary import CONTACT_THRESHOLD, FILM_KEYS, contact_events, film_statistics
 
 __all__ = [
+    "CONTACT_THRESHOLD",
     "SETTLE_CAP_MS",
     "SETTLE_TOLERANCE",
     "prepare_from",

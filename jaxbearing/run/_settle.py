@@ -72,7 +72,7 @@ from ._simulate import SolveArgs, _histories, _saved_state, scaled_diffeqsolve
 from ._simulate import simulate as _simulate_fixed
 from ._statistics import steady_statistics
 from ._step_control import raceway_normal_norm, step_controller
-from ._summary import SETTLED_LABEL, UNSETTLED_LABEL
+from ._summary import CONTACT_THRESHOLD, SETTLED_LABEL, UNSETTLED_LABEL
 from ._summary import summarise as _summarise_fixed
 
 #: defaults of the settled run
@@ -867,7 +867,7 @@ def simulate_steady_points(
     ]
 
 
-def summarise_steady(result: SteadyResult, threshold: float = 1.0) -> dict:
+def summarise_steady(result: SteadyResult, threshold: float = CONTACT_THRESHOLD) -> dict:
     """The summary.json block of a settled run: how it settled, and every statistic of the
     window as {"value", "ci95_low", "ci95_high", "n"} (`_statistics`)."""
     runs = result.runs
@@ -979,7 +979,7 @@ def simulate(bearing: Bearing, op: OperatingPoint, *, settle=None, **kwargs):
     return simulate_steady(bearing, op, settle=settle, **kwargs)
 
 
-def summarise(result, threshold: float = 1.0) -> dict:
+def summarise(result, threshold: float = CONTACT_THRESHOLD) -> dict:
     """`jaxbearing.summarise`: the summary.json block of a fixed run (`_summary.summarise`) or of
     a settled run (`summarise_steady`)."""
     if isinstance(result, SteadyResult):

@@ -38,7 +38,7 @@ import numpy as np
 from scipy import stats as _sp_stats
 
 from ..geometry import kinematic_cage_speed, limited_circle_radius, rad_s_to_rpm
-from ._summary import _EVENT_QUANTITIES, FILM_KEYS, contact_events, film_statistics
+from ._summary import _EVENT_QUANTITIES, CONTACT_THRESHOLD, FILM_KEYS, contact_events, film_statistics
 
 CONFIDENCE = 0.95
 
@@ -146,7 +146,7 @@ def revolution_statistic_keys() -> tuple[str, ...]:
 
 
 def revolution_statistics(
-    hist: dict, edges, rho_lim: float, kinematic_speed: float, threshold: float = 1.0
+    hist: dict, edges, rho_lim: float, kinematic_speed: float, threshold: float = CONTACT_THRESHOLD
 ) -> dict[str, np.ndarray]:
     """Every reported statistic, one value per revolution [edges[i], edges[i+1]) (NaN where a
     revolution has no contact for a contact statistic). Keys are "group.reduction"."""
@@ -288,7 +288,9 @@ def max_contact_radius_bound(
     return {"value": bound, "revolutions": n, "confidence": float(confidence)}
 
 
-def window_statistics(window: dict, edges, bearing, op, threshold: float = 1.0) -> dict[str, np.ndarray]:
+def window_statistics(
+    window: dict, edges, bearing, op, threshold: float = CONTACT_THRESHOLD
+) -> dict[str, np.ndarray]:
     """`revolution_statistics` of one seed's measurement window `window` with revolution
     boundaries `edges` [s], for `bearing` at `op`."""
     rho_lim = float(limited_circle_radius(bearing.roller))
@@ -297,7 +299,7 @@ def window_statistics(window: dict, edges, bearing, op, threshold: float = 1.0) 
 
 
 def steady_statistics(
-    windows: list[dict], edges: list, bearing, op, threshold: float = 1.0, per_revolution=None
+    windows: list[dict], edges: list, bearing, op, threshold: float = CONTACT_THRESHOLD, per_revolution=None
 ) -> dict:
     """The statistics block of a settled run: `windows` are the measurement-window histories of
     each seed, `edges` their revolution boundaries [s]; or, instead, `per_revolution`: each

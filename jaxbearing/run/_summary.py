@@ -21,6 +21,10 @@ import numpy as np
 
 from ..geometry import kinematic_cage_speed, rad_s_to_rpm
 
+#: the normal force above which a saved contact sample is contact (contact time, events and the
+#: settled statistics; the tail statistic's indicator) [N]
+CONTACT_THRESHOLD = 1.0
+
 #: summary.json key -> history key, reduction within one event
 _EVENT_QUANTITIES = {
     "flange_force_N": ("flange_force", "max"),
@@ -34,7 +38,7 @@ _EVENT_QUANTITIES = {
 }
 
 
-def contact_events(histories: dict, threshold: float = 1.0) -> dict[str, np.ndarray]:
+def contact_events(histories: dict, threshold: float = CONTACT_THRESHOLD) -> dict[str, np.ndarray]:
     """Per-event values of every quantity in `_EVENT_QUANTITIES` plus `on_arc`, `roller`, `flange`."""
     q = np.asarray(histories["flange_force"])  # (T, Z, 4)
     t_n, z, f = q.shape
@@ -82,7 +86,7 @@ FILM_SCALARS = ("lambda_below_one_share", "top_edge_contact_share", "flange_face
 FILM_KEYS = tuple(f"{k}.{r}" for k, (_, reds) in FILM_QUANTITIES.items() for r in reds) + FILM_SCALARS
 
 
-def film_statistics(histories: dict, threshold: float = 1.0) -> dict[str, float]:
+def film_statistics(histories: dict, threshold: float = CONTACT_THRESHOLD) -> dict[str, float]:
     """Film statistics over contact time (module docstring), flat: "flange_min_film_m.min",
     ..., "lambda_below_one_share", "top_edge_contact_share", "flange_face_error_max_m". NaN
     where there is no contact sample or the histories lack the quantity."""
@@ -132,7 +136,7 @@ SETTLED_LABEL = "settled running"
 UNSETTLED_LABEL = "not settled (see settled and residual_drift_rpm)"
 
 
-def summarise(result, threshold: float = 1.0) -> dict:
+def summarise(result, threshold: float = CONTACT_THRESHOLD) -> dict:
     """The summary.json block of one run (keys documented in the `simulate` command)."""
     h = result.histories
     events = contact_events(h, threshold)
