@@ -24,9 +24,10 @@ members per hour at 11 slices on an H200), hours on the 2-core CPU.
 
 Options: `--seeds K`, `--step-mm H`, `--slices N`, `--window W`, `--points
 speed|others|all|ref|misaligned` (the speed factor, the misalignment and load factors, all seven
-points, the reference point alone, or 2 mrad alone and combined with 30,000 rpm and with 500 N), `--designs 1|2`
-(the first design, or both), `--design 2` (the second alone), `--results-dir DIR`. `--quick`: the reference point, one design, 4 seeds, 11 slices (a check of
-the script, minutes on the CPU). Results: results/study_clearance_effect[_quick].json.
+points, the reference point alone, or 2 mrad alone and combined with 30,000 rpm and with 500 N),
+`--designs 1|2` (the first design, or both), `--design 2` (the second alone), `--results-dir
+DIR`. `--quick`: the reference point, one design, 4 seeds, 11 slices (a check of the script,
+minutes on the CPU). Results: results/study_clearance_effect[_quick].json.
 `--plot [RESULTS.json]` draws a results file (default results/study_clearance_effect.json) as
 docs/figures/clearance_effect/clearance_effect.png: dJ/dDelta_bf as a share of J per 10 um at
 every point and design, with its 95 % interval (filled where significant).

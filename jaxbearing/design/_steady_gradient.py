@@ -499,10 +499,11 @@ def frozen_load_gradients(
     """`frozen_load_gradient` of every case (bearing, op, design, states), e.g. every start and
     operating point of one iteration of the design search; one `SteadyGradient` per case, in
     order. Each case's trajectories run with `design` applied to `bearing` (its other parameters
-    kept) from `states`, states of settled running of that design. Every trajectory of every case is one member of one call (`strategy`, as the
-    steady-running engine's `choose_strategy`): "vmap" (the default on an accelerator) integrates
-    and differentiates them all in one vmapped program; on a CPU they run `workers` processes
-    at a time ("processes"), or one after another ("sequential")."""
+    kept) from `states`, states of settled running of that design. Every trajectory of every
+    case is one member of one call (`strategy`, as the steady-running engine's
+    `choose_strategy`): "vmap" (the default on an accelerator) integrates and differentiates
+    them all in one vmapped program; on a CPU they run `workers` processes at a time
+    ("processes"), or one after another ("sequential")."""
     _check_window(window)
     require("saves_per_ms", saves_per_ms, lambda v: (v >= 1) & (v == np.round(v)), "an integer >= 1")
     if strategy not in STRATEGIES:

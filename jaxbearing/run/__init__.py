@@ -8,8 +8,8 @@
   `RESULT_NAMES` (the outcome code of a solve), `SolveProgress` (the text progress meter
   inside a solve) and `HostProgress` (the same from the calling process: cacheable programs);
 - statistics: `contact_events`, `summarise`, `film_statistics` (film over contact time,
-  `FILM_KEYS`; a sample is contact above `CONTACT_THRESHOLD`); of settled running with 95 % confidence
-  intervals: `steady_statistics`, `revolution_statistics`, `confidence_intervals`,
+  `FILM_KEYS`; a sample is contact above `CONTACT_THRESHOLD`); of settled running with 95 %
+  confidence intervals: `steady_statistics`, `revolution_statistics`, `confidence_intervals`,
   `batch_means`, `student_t_interval`, `Estimate`, `tail_mean` (the mean above the
   `TAIL_LEVEL` quantile); how often the contact reached the corner,
   with upper bounds: `corner_contact_bound`, `upper_probability_bound`; the prediction bound
