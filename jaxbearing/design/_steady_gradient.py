@@ -98,9 +98,6 @@ STATISTICS = {
     "peak": Functionals(pv_exponent=PEAK_EXPONENT, contact_load=CONTACT_LOAD),
     "tail": STEADY_FUNCTIONALS,
 }
-#: the contact force above which a saved flange sample counts as contact time in the statistics
-#: (`run.CONTACT_THRESHOLD`, `run.summarise_steady`'s threshold) [N]: the tail's hard indicator
-TOUCHING_FORCE = CONTACT_THRESHOLD
 #: default window of the short-window sensitivities [s] (benchmarks/studies/bench_steady_gradient.py)
 GRADIENT_WINDOW = 1.0e-3
 
@@ -357,6 +354,17 @@ def trajectory_states(
     return sol.ys, result_code(sol.result)
 
 
+def _failed_integrals() -> tuple[np.ndarray, np.ndarray]:
+    """The ((A, C), Jacobian (3, 2)) of a failed trajectory: NaN, left out by `_combine`."""
+    return np.full(2, np.nan), np.full((3, 2), np.nan)
+
+
+def _reference_loads(bearing, op, x, states):
+    """The flange contact loads Q0 (T, Z, 4) the dynamics gave at the saved `states` (a leading
+    time axis) of design x: the loads the frozen-load estimator holds."""
+    return jax.vmap(lambda s: contact_loads(s, _design_params(bearing, op, x)).flange.normal_force)(states)
+
+
 def frozen_pv(bearing, op, x, state: State, reference_load):
     """(w(Q0_c), PV_c(x) (Q0_c / Q_c(x))^(1/3) / PV_ref), each (Z, 4), over the flange contacts of
     one state: the flange PV with design x at the loads Q0 = `reference_load` (Z, 4) the
@@ -383,11 +391,11 @@ def frozen_tail_samples(bearing, op, x, states):
     """The tail statistic's samples along one trajectory (`states`: a leading time axis): per
     saved state and flange contact, the statistics' hard contact indicator 1(Q0 > 1 N), the
     frozen PV / PV_ref at x (`frozen_pv`) and its Jacobian in x (leading axis 3)."""
-    q0 = jax.vmap(lambda s: contact_loads(s, _design_params(bearing, op, x)).flange.normal_force)(states)
+    q0 = _reference_loads(bearing, op, x, states)
     pv, dpv = forward_jacobian(
         lambda v: jax.vmap(lambda s, q: frozen_pv(bearing, op, v, s, q)[1])(states, q0), x
     )
-    return (q0 > TOUCHING_FORCE).astype(float), pv, dpv
+    return (q0 > CONTACT_THRESHOLD).astype(float), pv, dpv
 
 
 def tail_integrals(samples) -> tuple[list, float]:
@@ -399,12 +407,12 @@ def tail_integrals(samples) -> tuple[list, float]:
     touching = [np.asarray(pv)[np.asarray(w) > 0.5] for w, pv, _ in filter(None, samples)]
     pooled = np.concatenate(touching) if touching else np.zeros(0)
     if pooled.size == 0:
-        return [(np.full(2, np.nan), np.full((3, 2), np.nan)) for _ in samples], float("nan")
+        return [_failed_integrals() for _ in samples], float("nan")
     q = float(np.percentile(pooled, 100.0 * TAIL_LEVEL))
     outs = []
     for sample in samples:
         if sample is None:
-            outs.append((np.full(2, np.nan), np.full((3, 2), np.nan)))
+            outs.append(_failed_integrals())
             continue
         w, pv, dpv = (np.asarray(a) for a in sample)
         above = w * (pv > q)
@@ -434,15 +442,13 @@ class _FrozenSample:
         args = (self.bearing, self.op, state, jnp.asarray(self.duration), jnp.asarray(self.rtol))
         trajectory = lambda b, o, s, d, r: trajectory_states(b, o, s, d, num_saves, rtol=r)
         states, code = compiled_program("trajectory_states", trajectory, args, num_saves)(*args)
+        if int(code) != 0:  # a failed trajectory: no samples (tail), NaN integrals (sums)
+            return None if self.tail else _failed_integrals()
         if self.tail:
-            if int(code) != 0:
-                return None
             args = (self.bearing, self.op, x, states)
             return tuple(
                 map(np.asarray, compiled_program("frozen_tail_samples", frozen_tail_samples, args)(*args))
             )
-        if int(code) != 0:
-            return np.full(2, np.nan), np.full((3, 2), np.nan)
         args = (self.bearing, self.op, x, states, np.float64(self.exponent))
         val, jac = compiled_program("frozen_load_jacobian", _frozen_jacobian, args)(*args)
         return np.asarray(val), np.asarray(jac)
@@ -451,7 +457,7 @@ class _FrozenSample:
 def _frozen_jacobian(bearing, op, x, states, exponent=1.0):
     """Sum over the saved states of the frozen-load integrands (`frozen_load_integrands`) and
     their Jacobian in x."""
-    q0 = jax.vmap(lambda s: contact_loads(s, _design_params(bearing, op, x)).flange.normal_force)(states)
+    q0 = _reference_loads(bearing, op, x, states)
 
     def total(v):
         per = jax.vmap(lambda s, q: frozen_load_integrands(bearing, op, v, s, q, exponent))(states, q0)
@@ -533,7 +539,7 @@ def frozen_load_gradients(
     found = []
     for o in per_case:
         integrals, q = tail_integrals(o)
-        found.append(_combine(integrals, window, 1.0, q * STEADY_FUNCTIONALS.pv_reference))
+        found.append(_combine(integrals, window, tail_threshold=q * STEADY_FUNCTIONALS.pv_reference))
     return found
 
 
@@ -580,7 +586,4 @@ def _frozen_samples_batched(jobs) -> list:
     if tail:
         return [tuple(a[i] for a in outs) if int(codes[i]) == 0 else None for i in range(len(jobs))]
     vals, jacs = outs
-    return [
-        (vals[i], jacs[i]) if int(codes[i]) == 0 else (np.full(2, np.nan), np.full((3, 2), np.nan))
-        for i in range(len(jobs))
-    ]
+    return [(vals[i], jacs[i]) if int(codes[i]) == 0 else _failed_integrals() for i in range(len(jobs))]
