@@ -29,8 +29,9 @@ format: $(STAMP)
 	$(BIN)/ruff check --fix jaxbearing optimise tests benchmarks
 	$(BIN)/ruff format jaxbearing optimise tests benchmarks
 
-# two test processes (one per core of the 2-core CI machine), a whole file per process so that
-# module fixtures and compiled programs are built once per file
+# two test processes (one per core of the 2-core CI machine), each taking whole groups of files
+# (tests/conftest.py: a file, or files that compile the same programs) slowest first, so that
+# module fixtures and compiled programs are built once
 test: $(STAMP) lint
 	MPLBACKEND=Agg $(BIN)/python -m pytest -q -n 2 --dist loadfile
 

@@ -19,51 +19,103 @@ if (
         ).strip()
 
 import jax  # noqa: E402
+import pytest  # noqa: E402
 
 jax.config.update("jax_enable_x64", True)
 
-#: test files slowest first. Seconds of test time per file in a cold-cache `make test` from a
-#: fresh clone on the 2-core machine, nothing else running (2026-11-26, cb481c4, junit; 1881 s
-#: in all, 15 min 58 s of pytest; docs/performance.md): notebooks 173, engine 165,
-#: steady_gradient 137, rosenbrock 136, optimise 113, optimise_steady 79, speed 78, sweep 73,
-#: settle 72, cmd_simulate 72, design 71, sweep_distributed 68, outputs 65, validate 52,
-#: flange_lubrication 49, flange_contact 48, dynamics 47, misalignment 42, contact_hertz 40,
-#: program_cache 35, raceway 33, skid 33, quasistatic 33 (outputs 65 last, below). `make test` runs `-n 2 --dist
-#: loadfile`: the two processes take whole files in collection order, so the longest start
-#: first and the short files fill in at the end (longest-processing-time-first scheduling).
-#: Unlisted files follow in their usual order.
-SLOWEST_FILES_FIRST = (
-    "test_notebooks.py",
-    "test_engine.py",
-    "test_steady_gradient.py",
-    "test_rosenbrock.py",
-    "test_optimise.py",
-    "test_optimise_steady.py",
-    "test_speed.py",
-    "test_sweep.py",
-    "test_settle.py",
-    "test_cmd_simulate.py",
-    "test_design.py",
-    "test_sweep_distributed.py",
-    "test_validate.py",
-    "test_flange_lubrication.py",
-    "test_flange_contact.py",
-    "test_dynamics.py",
-    "test_misalignment.py",
-    "test_contact_hertz.py",
-    "test_program_cache.py",
-    "test_raceway.py",
-    "test_skid.py",
-    "test_quasistatic.py",
-    # after test_sweep.py, whose first test stores the sweep program this file's fallback test
-    # loads: run side by side, both processes compiled it (22 s each)
-    "test_outputs.py",
-)
+#: seconds of test time per file in a cold-cache `make test` from a fresh clone on the 2-core
+#: machine, nothing else running (2026-11-26, 17b7437, junit; 1891 s in all, 16 min 11 s of
+#: pytest; docs/performance.md). Files not listed take under 10 s.
+FILE_SECONDS = {
+    "test_steady_gradient.py": 199,
+    "test_engine.py": 164,
+    "test_notebooks.py": 163,
+    "test_rosenbrock.py": 115,
+    "test_optimise.py": 106,
+    "test_sweep.py": 89,
+    "test_speed.py": 85,
+    "test_sweep_distributed.py": 78,
+    "test_settle.py": 78,
+    "test_outputs.py": 76,
+    "test_design.py": 73,
+    "test_cmd_simulate.py": 70,
+    "test_flange_lubrication.py": 55,
+    "test_validate.py": 54,
+    "test_flange_contact.py": 53,
+    "test_contact_hertz.py": 45,
+    "test_misalignment.py": 45,
+    "test_skid.py": 36,
+    "test_program_cache.py": 36,
+    "test_dynamics.py": 35,
+    "test_raceway.py": 34,
+    "test_quasistatic.py": 27,
+    "test_optimise_steady.py": 24,
+    "test_steady_design.py": 21,
+    "test_zone.py": 16,
+    "test_histories.py": 15,
+    "test_flange_damping.py": 14,
+}
+
+#: files that compile the same programs, run by one process (`make test`, the scheduler below),
+#: each after the first, which stores them: run side by side, two processes each compiled the
+#: same program (20-45 s each). Keyed by the file, valued by its group's first file.
+#: test_sweep's reference sweep is also test_sweep_distributed's reference and
+#: test_outputs' fallback-directory sweep (`sweep_batch`); the settled members from the skid
+#: start (`skid_start`, `solve_from` at 11 slices) serve test_settle, test_steady_gradient and
+#: test_steady_design; the full-size `simulate` with 4000 saves serves test_dynamics,
+#: test_cmd_simulate and test_misalignment_trend.
+SHARED_PROGRAMS = {
+    "test_sweep_distributed.py": "test_sweep.py",
+    "test_outputs.py": "test_sweep.py",
+    "test_settle.py": "test_steady_gradient.py",
+    "test_steady_design.py": "test_steady_gradient.py",
+    "test_cmd_simulate.py": "test_dynamics.py",
+    "test_misalignment_trend.py": "test_dynamics.py",
+}
+
+
+def test_group(file_name: str) -> str:
+    """The group a test file runs in: its own name, or that of the file it shares programs with."""
+    return SHARED_PROGRAMS.get(file_name, file_name)
+
+
+def group_seconds() -> dict:
+    """Seconds of test time per group, from FILE_SECONDS."""
+    out: dict = {}
+    for name, seconds in FILE_SECONDS.items():
+        out[test_group(name)] = out.get(test_group(name), 0) + seconds
+    return out
+
+
+def _file_name(nodeid: str) -> str:
+    return nodeid.split("::", 1)[0].rsplit("/", 1)[-1]
 
 
 def pytest_collection_modifyitems(config, items):
-    rank = {name: i for i, name in enumerate(SLOWEST_FILES_FIRST)}
-    items.sort(key=lambda item: rank.get(item.path.name, len(rank)))  # stable: order within a file kept
+    """Groups slowest first, each file's tests together in their usual order."""
+    seconds = group_seconds()
+    items.sort(
+        key=lambda item: -seconds.get(test_group(item.path.name), 0)
+    )  # stable: order within a group kept
+
+
+@pytest.hookimpl(optionalhook=True)  # a pytest-xdist hook: unknown without it (-p no:xdist)
+def pytest_xdist_make_scheduler(config, log):
+    """`--dist loadfile` (`make test`) with whole groups instead of whole files: the two processes
+    take groups in the order above, so the longest start first and the short files fill in at
+    the end (longest-processing-time-first scheduling). pytest-xdist's own ordering, by the
+    number of tests in a file, is switched off. (Its `--dist loadgroup` does not group with
+    pytest 9.2, whose node ids it can no longer rename.)"""
+    if config.getvalue("dist") != "loadfile":
+        return None
+    from xdist.scheduler import LoadScopeScheduling
+
+    class GroupScheduling(LoadScopeScheduling):
+        def _split_scope(self, nodeid: str) -> str:
+            return test_group(_file_name(nodeid))
+
+    config.option.loadscopereorder = False
+    return GroupScheduling(config, log)
 
 
 # --- compile-time profile (opt-in): JAXBEARING_TEST_COMPILE_LOG=path.json records, per test, the
@@ -71,7 +123,9 @@ def pytest_collection_modifyitems(config, items):
 # which tests pay for programs and which reuse them (docs/performance.md, issue 37): "programs"
 # lists each compile by name and seconds, "built" each engine program (`compiled_program`) a
 # test builds, by name, static arguments and a digest of its argument structure; the same
-# program built by two tests is a compile a shared setting would save.
+# program built by two tests is a compile a shared setting would save. "cache" lists each
+# persistent-cache lookup (hit or miss, program, the key's end): a key missed by tests of two
+# files, or by a test and a notebook kernel or subprocess, is a program both compiled.
 _COMPILE_LOG = __import__("os").environ.get("JAXBEARING_TEST_COMPILE_LOG")
 _compile_seconds: dict = {}
 _current_test = ["(collection)"]
@@ -102,6 +156,19 @@ if _COMPILE_LOG:
         return _plain_build(name, fn, in_tree, specs, static)
 
     _cc._build = _logged_build
+
+    import jax._src.compiler as _compiler
+
+    def _cache_logger(kind, plain):  # which persistent-cache entries each test hit or missed
+        def log(module_name, cache_key):
+            per = _compile_seconds.setdefault(_current_test[0], {})
+            per.setdefault("cache", []).append([kind, module_name, cache_key[-16:]])
+            return plain(module_name, cache_key)
+
+        return log
+
+    _compiler.log_persistent_cache_hit = _cache_logger("hit", _compiler.log_persistent_cache_hit)
+    _compiler.log_persistent_cache_miss = _cache_logger("miss", _compiler.log_persistent_cache_miss)
 
 
 def pytest_runtest_setup(item):

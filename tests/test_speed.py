@@ -202,6 +202,18 @@ def test_parallel_map_keeps_order_in_two_processes():
     assert parallel_map(operator.neg, [4], workers=2) == [-4]  # one item: no pool
 
 
+def test_one_thread_workers_add_only_the_flags_their_parent_lacks():
+    """The workers' XLA flags are the parent's with the one-thread flags it lacks: JAX's
+    persistent compilation cache keys its entries on the flags as written, so a parent that has
+    them already (the test processes of `make test`) shares its compiled programs with its
+    workers instead of each compiling them again."""
+    from jaxbearing.run._ensemble import _ONE_THREAD_FLAGS, _with_flags
+
+    assert _with_flags("", _ONE_THREAD_FLAGS) == _ONE_THREAD_FLAGS
+    assert _with_flags(_ONE_THREAD_FLAGS, _ONE_THREAD_FLAGS) == _ONE_THREAD_FLAGS
+    assert _with_flags("--xla_dump_to=d", "--a=1 --xla_dump_to=d") == "--xla_dump_to=d --a=1"
+
+
 @pytest.mark.skipif(not hasattr(os, "sched_getaffinity"), reason="CPU affinity is Linux-only")
 def test_parallel_map_pins_each_worker_to_one_cpu():
     """Every worker of a pool runs on one CPU of this process's set (its XLA threads with it),

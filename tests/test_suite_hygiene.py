@@ -408,11 +408,13 @@ def test_every_cli_option_is_invoked_by_a_named_test():
             assert f'"{option}"' in sources[ref], f"{ref} does not invoke {option}"
 
 
-def test_the_slowest_files_first_are_test_files():
-    """`conftest.SLOWEST_FILES_FIRST` names existing test files, each once (a renamed file would
-    silently drop out of the ordering)."""
-    from conftest import SLOWEST_FILES_FIRST
+def test_the_scheduling_tables_name_test_files():
+    """`conftest.FILE_SECONDS` and `conftest.SHARED_PROGRAMS` name existing test files (a renamed
+    file would silently drop out of the ordering or out of its group), and a group's first file
+    is its own group."""
+    from conftest import FILE_SECONDS, SHARED_PROGRAMS, test_group
 
     names = {p.name for p in TEST_FILES}
-    assert len(set(SLOWEST_FILES_FIRST)) == len(SLOWEST_FILES_FIRST)
-    assert set(SLOWEST_FILES_FIRST) <= names, set(SLOWEST_FILES_FIRST) - names
+    named = set(FILE_SECONDS) | set(SHARED_PROGRAMS) | set(SHARED_PROGRAMS.values())
+    assert named <= names, named - names
+    assert all(test_group(first) == first for first in SHARED_PROGRAMS.values())

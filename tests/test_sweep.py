@@ -36,15 +36,23 @@ REPO = pathlib.Path(__file__).parents[1]
 
 
 def subprocess_env(**extra) -> dict:
-    """Environment of a sweep subprocess: CPU only, one device unless `extra` sets XLA_FLAGS."""
+    """Environment of a sweep subprocess: CPU only, one device unless `extra` sets XLA_FLAGS.
+
+    The subprocess keeps this process's XLA flags (in `make test` the one-thread flags of
+    conftest.py), with `extra`'s XLA_FLAGS added: JAX's persistent compilation cache keys its
+    entries on the XLA flags, so a subprocess with other flags compiles again every program
+    this process, or another test, has already compiled and stored (tens of seconds each)."""
     env = dict(os.environ)
-    env.pop("XLA_FLAGS", None)
+    inherited = [f for f in env.get("XLA_FLAGS", "").split() if not f.startswith("--xla_force_host_platform")]
     env.update(
         JAX_PLATFORMS="cpu",
         JAX_ENABLE_X64="1",
         PYTHONPATH=str(REPO) + os.pathsep + env.get("PYTHONPATH", ""),
     )
     env.update(extra)
+    # extra's first: XLA stops reading at the first token that is not a flag (conftest's
+    # `intra_op_parallelism_threads=1`); the cache key sorts the flags, so the order is free
+    env["XLA_FLAGS"] = " ".join(extra.get("XLA_FLAGS", "").split() + inherited)
     return env
 
 

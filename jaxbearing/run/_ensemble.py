@@ -56,6 +56,14 @@ from ..io import require
 _ONE_THREAD_FLAGS = "--xla_cpu_multi_thread_eigen=false intra_op_parallelism_threads=1"
 
 
+def _with_flags(flags: str, more: str) -> str:
+    """XLA_FLAGS `flags` with the flags of `more` it lacks appended. JAX's persistent compilation
+    cache keys its entries on the flags as written, so a flag given twice would make the workers'
+    programs other entries than those of a parent that already has it."""
+    have = flags.split()
+    return " ".join(have + [f for f in more.split() if f not in have])
+
+
 def available_cpus() -> int:
     """CPUs this process may run on."""
     try:
@@ -94,7 +102,7 @@ def parallel_map(
         return [function(item) for item in items]
     flags = os.environ.get("XLA_FLAGS", "")
     if threads_per_worker == 1:
-        flags = f"{flags} {_ONE_THREAD_FLAGS}".strip()
+        flags = _with_flags(flags, _ONE_THREAD_FLAGS)
     shared = _SHARED.get(flags)
     try:
         if shared is not None and shared[0] >= workers:
