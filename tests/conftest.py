@@ -56,27 +56,32 @@ FILE_SECONDS = {
     "test_flange_damping.py": 14,
 }
 
-#: files that compile the same programs, run by one process (`make test`, the scheduler below),
-#: each after the first, which stores them: run side by side, two processes each compiled the
-#: same program (20-45 s each). Keyed by the file, valued by its group's first file.
-#: test_sweep's reference sweep is also test_sweep_distributed's reference and
-#: test_outputs' fallback-directory sweep (`sweep_batch`); the settled members from the skid
-#: start (`skid_start`, `solve_from` at 11 slices) serve test_settle, test_steady_gradient and
-#: test_steady_design; the full-size `simulate` with 4000 saves serves test_dynamics,
-#: test_cmd_simulate and test_misalignment_trend.
-SHARED_PROGRAMS = {
-    "test_sweep_distributed.py": "test_sweep.py",
-    "test_outputs.py": "test_sweep.py",
-    "test_settle.py": "test_steady_gradient.py",
-    "test_steady_design.py": "test_steady_gradient.py",
-    "test_cmd_simulate.py": "test_dynamics.py",
-    "test_misalignment_trend.py": "test_dynamics.py",
-}
+#: files that compile the same programs, run by one process in this order (`make test`, the
+#: scheduler below), the first to compile a program storing it for the others: run side by side,
+#: two processes each compiled the same program (20-45 s each). test_settle compiles the
+#: 11-slice skid start and settled members, which notebooks 03 and 05, test_steady_design and
+#: test_steady_gradient load (test_engine's settled sweep too, later, from the other process).
+#: test_cmd_simulate compiles the full-size `simulate` with 4000 saves, which test_dynamics,
+#: test_misalignment_trend, test_outputs and notebooks 01 and 02 (in the first group, which
+#: reaches them after test_settle) load; test_outputs compiles the reference sweep batch, which
+#: test_sweep and test_sweep_distributed load.
+PROGRAM_GROUPS = (
+    ("test_settle.py", "test_notebooks.py", "test_steady_design.py", "test_steady_gradient.py"),
+    (
+        "test_cmd_simulate.py",
+        "test_dynamics.py",
+        "test_misalignment_trend.py",
+        "test_outputs.py",
+        "test_sweep.py",
+        "test_sweep_distributed.py",
+    ),
+)
+_GROUP_OF = {name: (group[0], i) for group in PROGRAM_GROUPS for i, name in enumerate(group)}
 
 
 def test_group(file_name: str) -> str:
-    """The group a test file runs in: its own name, or that of the file it shares programs with."""
-    return SHARED_PROGRAMS.get(file_name, file_name)
+    """The group a test file runs in: its own name, or the first file of its PROGRAM_GROUPS entry."""
+    return _GROUP_OF.get(file_name, (file_name, 0))[0]
 
 
 def group_seconds() -> dict:
@@ -92,11 +97,15 @@ def _file_name(nodeid: str) -> str:
 
 
 def pytest_collection_modifyitems(config, items):
-    """Groups slowest first, each file's tests together in their usual order."""
+    """Groups slowest first, a group's files in their PROGRAM_GROUPS order, each file's tests
+    together in their usual order."""
     seconds = group_seconds()
-    items.sort(
-        key=lambda item: -seconds.get(test_group(item.path.name), 0)
-    )  # stable: order within a group kept
+
+    def rank(item):
+        group, position = _GROUP_OF.get(item.path.name, (item.path.name, 0))
+        return -seconds.get(group, 0), position
+
+    items.sort(key=rank)  # stable: the order within a file kept
 
 
 @pytest.hookimpl(optionalhook=True)  # a pytest-xdist hook: unknown without it (-p no:xdist)

@@ -361,13 +361,16 @@ def test_simulate_help_shows_the_actual_defaults_and_values():
 # -- items 2 and 4 with a solve: fallback directory, self-describing summary.json ------------------
 #: the default max_steps and 4000 saves: the same compiled program as
 #: tests/test_misalignment_trend.py's runs (a second process loads it from the program cache)
-SMALL = "[bearing]\nnum_slices = 11\n\n[simulation]\nprogress = false\n"
+#: the reference bearing at full size: the program of `jaxbearing simulate` that test_cmd_simulate,
+#: test_dynamics and two notebooks run (conftest.PROGRAM_GROUPS), which 1 ms from the
+#: quasi-static start takes under a second to run, so 11 slices would only compile another
+SMALL = "[simulation]\nprogress = false\n"
 STATS_SKIPPED = {"wall_time_s", "compile_time_s"}
 
 
 @pytest.fixture(scope="module")
 def first_run(tmp_path_factory):
-    """One reduced-size simulate (arc end and 1 ms given as options), compiled once here."""
+    """One simulate (arc end and 1 ms given as options)."""
     d = tmp_path_factory.mktemp("first")
     cfg = d / "small.toml"
     cfg.write_text(SMALL)
@@ -404,7 +407,7 @@ def test_summary_json_describes_itself(first_run):
     assert doc["command"][doc["command"].index("--end") + 1] == "arc"
     assert doc["seeds"] == [0] and doc["ends"] == ["arc"]
     assert doc["config"]["simulation"]["end"] == "arc" and doc["config"]["simulation"]["duration_ms"] == 1.0
-    assert doc["config"]["bearing"]["num_slices"] == 11
+    assert doc["config"]["bearing"]["num_slices"] == jaxbearing.reference_bearing().num_slices
     assert doc["units"]["cage_speed_rpm"] == "rpm" and doc["units"]["flange_pv_Pa_m_s"] == "Pa m/s"
     assert doc["units"]["cage_slip"] == "1"
 

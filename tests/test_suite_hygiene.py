@@ -409,12 +409,12 @@ def test_every_cli_option_is_invoked_by_a_named_test():
 
 
 def test_the_scheduling_tables_name_test_files():
-    """`conftest.FILE_SECONDS` and `conftest.SHARED_PROGRAMS` name existing test files (a renamed
-    file would silently drop out of the ordering or out of its group), and a group's first file
-    is its own group."""
-    from conftest import FILE_SECONDS, SHARED_PROGRAMS, test_group
+    """`conftest.FILE_SECONDS` and `conftest.PROGRAM_GROUPS` name existing test files (a renamed
+    file would silently drop out of the ordering or out of its group), each file in one group."""
+    from conftest import FILE_SECONDS, PROGRAM_GROUPS
 
     names = {p.name for p in TEST_FILES}
-    named = set(FILE_SECONDS) | set(SHARED_PROGRAMS) | set(SHARED_PROGRAMS.values())
+    grouped = [name for group in PROGRAM_GROUPS for name in group]
+    assert len(grouped) == len(set(grouped))
+    named = set(FILE_SECONDS) | set(grouped)
     assert named <= names, named - names
-    assert all(test_group(first) == first for first in SHARED_PROGRAMS.values())
