@@ -1,5 +1,6 @@
-"""Misalignment: its sign and the free, tilted ring under axial load at a reduced size in the
-default suite (11 slices, 1 ms from the quasi-static start: seconds), and the study on settled
+"""Misalignment: its sign and the free, tilted ring under axial load in the default suite (1 ms
+of the full-size bearing from the quasi-static start: seconds, with the program that
+test_cmd_simulate compiles), and the study on settled
 running (slow: 468 s on the shared 2-core machine under a load average of 6-10,
 `pytest -m slow -k skew`).
 
@@ -55,14 +56,15 @@ def test_free_ring_under_axial_load_integrates_and_loads_the_opposite_flanges():
 
 def _flange_totals(cfg_text: str, duration: float = 1e-3, num_saves: int = 4000):
     """Total force on each flange (inner -X, inner +X, outer -X, outer +X), mean over the last
-    fifth of a run of the 11-slice bearing from the quasi-static start, and the run's status.
-    4000 saves, as `jaxbearing simulate` saves: one compiled program with tests/test_outputs.py's
-    reduced-size run (about 25 s of compiling on the 2-core machine)."""
+    fifth of a run of the full-size bearing from the quasi-static start, and the run's status.
+    4000 saves, as `jaxbearing simulate` saves: the program test_cmd_simulate compiles
+    (conftest.PROGRAM_GROUPS), which 1 ms from the quasi-static start runs in seconds; an
+    11-slice bearing would compile another (about 25 s on the 2-core machine)."""
     import numpy as np
 
     import jaxbearing as jb
 
-    cfg = jb.loads_config("[bearing]\nnum_slices = 11\n" + cfg_text)
+    cfg = jb.loads_config(cfg_text)
     res = jb.simulate(cfg.bearing(), cfg.operating_point(), duration=duration, num_saves=num_saves)
     f = np.asarray(res.histories["flange_force"])[-num_saves // 5 :].sum(axis=1).mean(axis=0)
     return res.status, f
@@ -72,11 +74,11 @@ def test_misalignment_sign_picks_the_loaded_outer_flange():
     """The sign of the imposed misalignment (a tilt about +Y; > 0 turns the +X end of the inner
     ring towards -Z) decides which outer flange the skewed rollers load: +2 mrad the outer +X
     flange, -2 mrad the outer -X one, each carrying over 10 times the other's load; aligned, the
-    flanges carry far less than either misaligned run (total under a third). Reduced size and a
-    start-up transient (11 slices, the last 0.2 ms of 1 ms from the quasi-static start), so these
-    are signs and large ratios, not settled statistics (measured 2026-11-25: outer flanges
-    0.9 / 54.7 N at +2 mrad, 56.9 / 2.8 N at -2 mrad; totals 8 N aligned, 72-84 N misaligned);
-    the settled trend is the slow study above."""
+    flanges carry far less than either misaligned run (total under a third). A start-up
+    transient (the last 0.2 ms of 1 ms from the quasi-static start), so these are signs and large
+    ratios, not settled statistics (measured 2026-11-26: outer flanges 1.5 / 52.9 N at +2 mrad,
+    56.3 / 0.5 N at -2 mrad; totals 6 N aligned, 72-79 N misaligned); the settled trend is the
+    slow study above."""
     totals = {}
     for m in (-2.0, 0.0, 2.0):
         status, f = _flange_totals(f"[operating]\nmisalignment_mrad = {m}\n")
@@ -87,10 +89,10 @@ def test_misalignment_sign_picks_the_loaded_outer_flange():
     assert 3 * totals[0.0].sum() < min(totals[2.0].sum(), totals[-2.0].sum())
 
 
-def test_free_tilted_ring_under_axial_load_at_reduced_size():
-    """The free-ring run below at a reduced size (11 slices, 1 ms): both freedoms on, 1 mrad
-    initial tilt, 200 N along +X; the load path is inner -X flange -> rollers -> outer +X
-    flange and the other two flanges stay open (measured 2026-11-25: 694 and 758 N, 0 and 0)."""
+def test_free_tilted_ring_under_axial_load_in_1_ms():
+    """The slow free-ring run above for 1 ms: both freedoms on, 1 mrad initial tilt, 200 N along
+    +X; the load path is inner -X flange -> rollers -> outer +X flange and the other two flanges
+    stay open (measured 2026-11-26: 685 and 746 N, 0 and 0)."""
     status, f = _flange_totals(
         "[operating]\naxial_load_N = 200.0\ninner_ring_axial_freedom = true\n"
         "inner_ring_tilt_freedom = true\nmisalignment_mrad = 1.0\n"
