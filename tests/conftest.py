@@ -3,7 +3,11 @@ import os
 # One CPU per test process (`make test` runs two, `-n 2`): each pytest-xdist worker runs on its
 # own CPU with single-threaded XLA, as the engine's own worker processes do
 # (`jaxbearing.run._ensemble`), instead of two processes each spreading XLA's threads over both
-# CPUs. JAXBEARING_TEST_PIN=0 switches it off.
+# CPUs. JAXBEARING_TEST_PIN=0 switches it off. And XLA's older CPU emitters instead of its fusion
+# emitters: a solve compiles in 14 s instead of 22-24 s and runs as fast, with the same numbers
+# (benchmarks/studies/diagnose_compile_flags.py), and compiling is about half of the suite's time.
+# (XLA reads XLA_FLAGS up to the first token that is not a flag: `intra_op_parallelism_threads=1`
+# comes last.)
 _WORKER = os.environ.get("PYTEST_XDIST_WORKER", "")
 if (
     _WORKER.startswith("gw")
@@ -15,7 +19,7 @@ if (
         os.sched_setaffinity(0, {_cpus[int(_WORKER[2:]) % len(_cpus)]})
         os.environ["XLA_FLAGS"] = (
             os.environ.get("XLA_FLAGS", "")
-            + " --xla_cpu_multi_thread_eigen=false intra_op_parallelism_threads=1"
+            + " --xla_cpu_use_fusion_emitters=false --xla_cpu_multi_thread_eigen=false intra_op_parallelism_threads=1"
         ).strip()
 
 import jax  # noqa: E402
