@@ -179,7 +179,13 @@ def test_simulate_in_a_second_process_is_not_traced(tmp_path):
                           "files": len(list(cc.program_cache_dir().glob("simulate-*")))}))
         """
     )
-    env = {"JAXBEARING_CACHE_DIR": str(tmp_path / "cache"), "PATH": "/usr/bin:/bin", "HOME": str(tmp_path)}
+    # this process's XLA flags (in `make test` the older CPU emitters, which compile faster)
+    env = {
+        "JAXBEARING_CACHE_DIR": str(tmp_path / "cache"),
+        "PATH": "/usr/bin:/bin",
+        "HOME": str(tmp_path),
+        "XLA_FLAGS": __import__("os").environ.get("XLA_FLAGS", ""),
+    }
     outs = []
     for _ in range(2):
         done = subprocess.run(
