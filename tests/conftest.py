@@ -63,7 +63,8 @@ FILE_SECONDS = {
 #: files that compile the same programs, run by one process in this order (`make test`, the
 #: scheduler below), the first to compile a program storing it for the others: run side by side,
 #: two processes each compiled the same program (20-45 s each). test_settle compiles the
-#: 11-slice skid start and settled members, which notebooks 03 and 05, test_steady_design and
+#: 11-slice skid start and settled members, which notebook 05 (checked: after test_settle it
+#: stores no skid start or settled-member program of its own), test_steady_design and
 #: test_steady_gradient load (test_engine's settled sweep too, later, from the other process).
 #: test_cmd_simulate compiles the full-size `simulate` with 4000 saves, which test_dynamics,
 #: test_misalignment_trend, test_outputs and notebooks 01 and 02 (in the first group, which
