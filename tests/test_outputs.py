@@ -359,12 +359,11 @@ def test_simulate_help_shows_the_actual_defaults_and_values():
 
 
 # -- items 2 and 4 with a solve: fallback directory, self-describing summary.json ------------------
-#: the default max_steps and 4000 saves: the same compiled program as
-#: tests/test_misalignment_trend.py's runs (a second process loads it from the program cache)
-#: the reference bearing at full size: the program of `jaxbearing simulate` that test_cmd_simulate,
-#: test_dynamics and two notebooks run (conftest.PROGRAM_GROUPS), which 1 ms from the
-#: quasi-static start takes under a second to run, so 11 slices would only compile another
-SMALL = "[simulation]\nprogress = false\n"
+#: the reference bearing at full size with the default max_steps and 4000 saves: the program of
+#: `jaxbearing simulate` that test_cmd_simulate, test_dynamics, test_misalignment_trend and two
+#: notebooks run (conftest.PROGRAM_GROUPS); 1 ms from the quasi-static start runs in seconds, so
+#: 11 slices would only compile another
+NO_PROGRESS = "[simulation]\nprogress = false\n"
 STATS_SKIPPED = {"wall_time_s", "compile_time_s"}
 
 
@@ -373,7 +372,7 @@ def first_run(tmp_path_factory):
     """One simulate (arc end and 1 ms given as options)."""
     d = tmp_path_factory.mktemp("first")
     cfg = d / "small.toml"
-    cfg.write_text(SMALL)
+    cfg.write_text(NO_PROGRESS)
     out = d / "out"
     code = jb_main(
         [

@@ -5,6 +5,7 @@ forgetting the in-process programs; whether the function was traced is counted a
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 import textwrap
@@ -184,7 +185,7 @@ def test_simulate_in_a_second_process_is_not_traced(tmp_path):
         "JAXBEARING_CACHE_DIR": str(tmp_path / "cache"),
         "PATH": "/usr/bin:/bin",
         "HOME": str(tmp_path),
-        "XLA_FLAGS": __import__("os").environ.get("XLA_FLAGS", ""),
+        "XLA_FLAGS": os.environ.get("XLA_FLAGS", ""),
     }
     outs = []
     for _ in range(2):
