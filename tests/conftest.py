@@ -28,36 +28,34 @@ import pytest  # noqa: E402
 jax.config.update("jax_enable_x64", True)
 
 #: seconds of test time per file in a cold-cache `make test` from a fresh clone on the 2-core
-#: machine, nothing else running (2026-11-26, 17b7437, junit; 1891 s in all, 16 min 11 s of
-#: pytest; docs/performance.md). Files not listed take under 10 s.
+#: machine, nothing else running (2026-11-26, 70c8000, junit; 1282 s in all, 10 min 59 s of
+#: pytest; docs/performance.md), less what this change took from test_program_cache.py and
+#: test_speed.py. Files not listed take under 10 s.
 FILE_SECONDS = {
-    "test_steady_gradient.py": 199,
-    "test_engine.py": 164,
-    "test_notebooks.py": 163,
-    "test_rosenbrock.py": 115,
-    "test_optimise.py": 106,
-    "test_sweep.py": 89,
-    "test_speed.py": 85,
-    "test_sweep_distributed.py": 78,
-    "test_settle.py": 78,
-    "test_outputs.py": 76,
-    "test_design.py": 73,
-    "test_cmd_simulate.py": 70,
-    "test_flange_lubrication.py": 55,
-    "test_validate.py": 54,
-    "test_flange_contact.py": 53,
-    "test_contact_hertz.py": 45,
-    "test_misalignment.py": 45,
-    "test_skid.py": 36,
-    "test_program_cache.py": 36,
-    "test_dynamics.py": 35,
-    "test_raceway.py": 34,
+    "test_engine.py": 137,
+    "test_steady_gradient.py": 135,
+    "test_notebooks.py": 129,
+    "test_rosenbrock.py": 79,
+    "test_optimise.py": 79,
+    "test_speed.py": 60,
+    "test_settle.py": 60,
+    "test_cmd_simulate.py": 51,
+    "test_sweep_distributed.py": 51,
+    "test_validate.py": 49,
+    "test_design.py": 46,
+    "test_outputs.py": 33,
+    "test_sweep.py": 31,
     "test_quasistatic.py": 27,
-    "test_optimise_steady.py": 24,
-    "test_steady_design.py": 21,
-    "test_zone.py": 16,
-    "test_histories.py": 15,
-    "test_flange_damping.py": 14,
+    "test_skid.py": 26,
+    "test_dynamics.py": 26,
+    "test_flange_contact.py": 23,
+    "test_misalignment.py": 22,
+    "test_flange_lubrication.py": 20,
+    "test_contact_hertz.py": 20,
+    "test_raceway.py": 20,
+    "test_steady_design.py": 18,
+    "test_optimise_steady.py": 13,
+    "test_docs.py": 11,
 }
 
 #: files that compile the same programs, run by one process in this order (`make test`, the
