@@ -6,8 +6,8 @@ import os
 # CPUs. JAXBEARING_TEST_PIN=0 switches it off. And XLA's older CPU emitters instead of its fusion
 # emitters: a solve compiles in 14 s instead of 22-24 s and runs as fast, with the same numbers
 # (benchmarks/studies/diagnose_compile_flags.py), and compiling is about half of the suite's time.
-# (XLA reads XLA_FLAGS up to the first token that is not a flag: `intra_op_parallelism_threads=1`
-# comes last.)
+# (XLA reads XLA_FLAGS up to the first token that is not a flag, such as the often-quoted
+# `intra_op_parallelism_threads=1`, and ignores the rest.)
 _WORKER = os.environ.get("PYTEST_XDIST_WORKER", "")
 if (
     _WORKER.startswith("gw")
@@ -19,7 +19,7 @@ if (
         os.sched_setaffinity(0, {_cpus[int(_WORKER[2:]) % len(_cpus)]})
         os.environ["XLA_FLAGS"] = (
             os.environ.get("XLA_FLAGS", "")
-            + " --xla_cpu_use_fusion_emitters=false --xla_cpu_multi_thread_eigen=false intra_op_parallelism_threads=1"
+            + " --xla_cpu_use_fusion_emitters=false --xla_cpu_multi_thread_eigen=false"
         ).strip()
 
 import jax  # noqa: E402
@@ -138,6 +138,8 @@ def pytest_xdist_make_scheduler(config, log):
 # program built by two tests is a compile a shared setting would save. "cache" lists each
 # persistent-cache lookup (hit or miss, program, the key's end): a key missed by tests of two
 # files, or by a test and a notebook kernel or subprocess, is a program both compiled.
+# "started": when the test started (epoch seconds; "(session end)" when the process finished),
+# which shows how evenly the two processes end.
 _COMPILE_LOG = __import__("os").environ.get("JAXBEARING_TEST_COMPILE_LOG")
 _compile_seconds: dict = {}
 _current_test = ["(collection)"]
@@ -185,13 +187,17 @@ if _COMPILE_LOG:
 
 def pytest_runtest_setup(item):
     _current_test[0] = item.nodeid
+    if _COMPILE_LOG:  # when each test started (epoch seconds): each process's timeline
+        _compile_seconds.setdefault(item.nodeid, {})["started"] = __import__("time").time()
 
 
 def pytest_sessionfinish(session):
     if _COMPILE_LOG:
         import json
         import os
+        import time
 
+        _compile_seconds["(session end)"] = {"started": time.time()}
         path = f"{_COMPILE_LOG}.{os.environ.get('PYTEST_XDIST_WORKER', 'main')}.json"
         with open(path, "w") as f:
             json.dump(_compile_seconds, f, indent=1)

@@ -49,8 +49,8 @@ def subprocess_env(**extra) -> dict:
         PYTHONPATH=str(REPO) + os.pathsep + env.get("PYTHONPATH", ""),
     )
     env.update(extra)
-    # extra's first: XLA stops reading at the first token that is not a flag (conftest's
-    # `intra_op_parallelism_threads=1`); the cache key sorts the flags, so the order is free
+    # extra's first (XLA stops reading at the first token that is not a flag, should the
+    # inherited flags hold one); the cache key sorts the flags, so the order is free
     env["XLA_FLAGS"] = " ".join(extra.get("XLA_FLAGS", "").split() + inherited)
     return env
 

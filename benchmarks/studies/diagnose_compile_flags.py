@@ -7,6 +7,9 @@ a fresh process per flag set with an empty cache, on one CPU with single-threade
 `make test`; then run twice, the second timed. Each flag set is measured after a run with the
 default flags (interleaved: this machine's speed drifts by tens of per cent within minutes). Result: results/diagnose_compile_flags.json (compile and run seconds, and
 the largest roller load, which must not change).
+
+``--on-top``: the further flag sets `ON_TOP` added to the older emitters (what `make test` uses),
+each after a run with the older emitters alone; results/diagnose_compile_flags_on_top.json.
 """
 
 from __future__ import annotations
@@ -33,6 +36,17 @@ FLAG_SETS = (
     "--xla_llvm_disable_expensive_passes=true",
     "--xla_cpu_use_thunk_runtime=false",
 )
+#: further flag sets tried on top of the older emitters (`--on-top`)
+ON_TOP = (
+    "--xla_backend_optimization_level=1",
+    "--xla_cpu_parallel_codegen_split_count=1",
+    "--xla_llvm_force_inline_before_split=false",
+    "--xla_cpu_copy_insertion_use_region_analysis=false",
+    "--xla_cpu_prefer_vector_width=128",
+    "--xla_cpu_max_isa=SSE4_2",
+    "--xla_cpu_enable_concurrency_optimized_scheduler=false",
+)
+EMITTERS = FLAG_SETS[0]
 REPEATS = 1
 
 _CHILD = """
@@ -63,31 +77,34 @@ def measure(flags: str) -> dict:
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
-def main() -> dict:
+def main(on_top: bool = False) -> dict:
+    base, sets = (EMITTERS, ON_TOP) if on_top else ("", FLAG_SETS)
+    plain = "(older emitters alone)" if on_top else "(default)"
     rows = []
     for repeat in range(REPEATS):
-        for flags in FLAG_SETS:
-            for tried in ("", flags):  # the default interleaved with each flag set
-                r = measure(tried) | {"flags": tried or "(default)", "repeat": repeat}
+        for flags in sets:
+            for tried in ("", flags):  # the base interleaved with each flag set
+                r = measure(f"{base} {tried}".strip()) | {"flags": tried or plain, "repeat": repeat}
                 _common.log(f"{NAME}: {r['flags']}: compile {r['compile_s']:.1f} s, run {r['run_s']:.3f} s")
                 rows.append(r)
-    default = [r["compile_s"] for r in rows if r["flags"] == "(default)"]
+    default = [r["compile_s"] for r in rows if r["flags"] == plain]
     summary = {
         flags: {
             "compile_s": [r["compile_s"] for r in rows if r["flags"] == flags],
             "run_s": [r["run_s"] for r in rows if r["flags"] == flags],
         }
-        for flags in FLAG_SETS
+        for flags in sets
     }
     data = {
         "program": "solve, 11-slice reference bearing, 0.1 ms, Tsit5, rtol 1e-5, atol 1e-10, 11 saves",
+        "base_flags": base or "(none)",
         "default_compile_s": default,
         "by_flags": summary,
         "rows": rows,
     }
-    _common.write_json(NAME, data)
+    _common.write_json(NAME + ("_on_top" if on_top else ""), data)
     return data
 
 
 if __name__ == "__main__":
-    main()
+    main(on_top="--on-top" in sys.argv[1:])

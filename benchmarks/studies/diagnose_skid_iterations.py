@@ -1,6 +1,6 @@
 """How many roller balances one static skid equilibrium costs, and a warm cage-speed bracket
 tried in place of the full one (issue 37: the skid equilibrium of every fresh member):
-``python benchmarks/studies/diagnose_skid_iterations.py [--warm-bracket]``.
+``python benchmarks/studies/diagnose_skid_iterations.py [--warm-bracket | --illinois-rollers]``.
 
 The reference bearing at 11 slices, 20,000 rpm, seeds 0-2: `run._initial._skid` compiled once,
 then each seed timed warm, with every cage speed at which `dynamics._skid._roller_balance` runs
@@ -12,6 +12,15 @@ balances, 3.2-3.9 s warm, cage speed 893.92 rad/s; warm bracket 54-59 balances, 
 cage speed 951.21 rad/s: at the second alternation's cage centre the torque balance has roots
 near 887 and 951 rad/s, and the warm bracket finds the far one (the dynamics' plateau is about
 881 rad/s). Not adopted (docs/performance.md). Results: results/diagnose_skid_iterations[_warm].json.
+
+With `--illinois-rollers` each roller's spin and pocket offset are found by the Illinois regula
+falsi on the same brackets (every roller at once, one evaluation of the field per step, a
+phase ending when every bracket is 2^-48 of its width, as the bisection's 48 steps leave it)
+instead of by bisection, to see whether fewer evaluations of the field per roller balance
+would do; the evaluations of each balance are recorded. Finding (2026-11-26, 2-core CPU): no
+fewer than bisection's 288 (about 300 per balance: the offset's residual is flat inside the
+pocket clearance, then stiff), no faster, and seed 0 ended on the bracket's end (973.89 rad/s,
+the cage torque unbalanced). Not adopted. Results: results/diagnose_skid_iterations_illinois.json.
 """
 
 from __future__ import annotations
@@ -86,7 +95,95 @@ def warm_cage_speed(original):
     return cage_speed
 
 
-def main(warm: bool = False, seeds: int = 3) -> dict:
+def illinois_roller_balance(skid, evaluations: list):
+    """The tried variant of `dynamics._skid._roller_balance` (module docstring): Illinois instead
+    of bisection in every phase of the block Gauss-Seidel rounds, one call site of the field;
+    appends each balance's number of field evaluations to `evaluations`."""
+    import jax
+    import jax.numpy as jnp
+
+    tol, cap = 2.0**-48, 64  # a phase ends at 2^-48 of its bracket, or after `cap` steps
+
+    def balance(params, base, omega_c, centre, offset0):
+        b = params.bearing
+        z = base.rollers.azimuth.shape[0]
+        rolling_spin = -omega_c * b.pitch_diameter / b.roller.diameter
+        inner_spin = (
+            -(params.operating.inner_speed - omega_c)
+            * (b.pitch_diameter - b.roller.diameter)
+            / b.roller.diameter
+        )
+        half_range = (b.cage.pocket_clearance / 2 + 0.1 * b.roller.diameter) / (b.pitch_diameter / 2)
+        s_range = (1.5 * jnp.minimum(rolling_spin, inner_spin) * jnp.ones(z), jnp.zeros(z))
+        o_range = (-half_range * jnp.ones(z), half_range * jnp.ones(z))
+
+        def body(c):  # k = 0, 1: the bracket's ends; then Illinois steps
+            p, k = c["phase"], c["k"]
+            spin_phase = p % 2 == 0
+            lo, hi, flo, fhi = c["lo"], c["hi"], c["flo"], c["fhi"]
+            regula = (lo * fhi - hi * flo) / (fhi - flo)
+            inside = jnp.isfinite(regula) & (regula > lo) & (regula < hi)
+            x = jnp.where(k == 0, lo, jnp.where(k == 1, hi, jnp.where(inside, regula, 0.5 * (lo + hi))))
+            spin = jnp.where(spin_phase, x, c["spin"])
+            offset = jnp.where(spin_phase, c["offset"], x)
+            spin_res, orbit_res, torque, force = skid._residuals(params, base, omega_c, spin, offset, centre)
+            f = jnp.where(spin_phase, spin_res, orbit_res)
+            flo, fhi = jnp.where(k == 0, f, flo), jnp.where(k == 1, f, fhi)
+            at_lo = (k == 1) & (flo <= 0)  # a root outside the bracket pins it to that end
+            at_hi = (k == 1) & (fhi >= 0) & ~at_lo
+            lo, hi = jnp.where(at_hi, hi, lo), jnp.where(at_lo, lo, hi)
+            step, up = k >= 2, f > 0  # decreasing residual: the root lies above x
+            new_lo, new_hi = jnp.where(step & up, x, lo), jnp.where(step & ~up, x, hi)
+            new_flo = jnp.where(step & up, f, jnp.where(step & ~up & (c["side"] == -1), 0.5 * flo, flo))
+            new_fhi = jnp.where(step & ~up, f, jnp.where(step & up & (c["side"] == 1), 0.5 * fhi, fhi))
+            exact = step & (f == 0)
+            new_lo, new_hi = jnp.where(exact, x, new_lo), jnp.where(exact, x, new_hi)
+            done = (k >= 1) & (jnp.all(new_hi - new_lo <= tol * (c["hi0"] - c["lo0"])) | (k >= cap + 1))
+            value = 0.5 * (new_lo + new_hi)
+            nxt = p + 1
+            nlo = jnp.where(nxt % 2 == 0, s_range[0], o_range[0])
+            nhi = jnp.where(nxt % 2 == 0, s_range[1], o_range[1])
+            return dict(
+                phase=jnp.where(done, nxt, p),
+                k=jnp.where(done, 0, k + 1),
+                lo=jnp.where(done, nlo, new_lo),
+                hi=jnp.where(done, nhi, new_hi),
+                lo0=jnp.where(done, nlo, c["lo0"]),
+                hi0=jnp.where(done, nhi, c["hi0"]),
+                flo=new_flo,
+                fhi=new_fhi,
+                side=jnp.where(done | ~step, 0, jnp.where(up, 1, -1)),
+                spin=jnp.where(done & spin_phase, value, c["spin"]),
+                offset=jnp.where(done & ~spin_phase, value, c["offset"]),
+                torque=torque,
+                force=force,
+                evals=c["evals"] + 1,
+            )
+
+        init = dict(
+            phase=jnp.asarray(0),
+            k=jnp.asarray(0),
+            lo=s_range[0],
+            hi=s_range[1],
+            lo0=s_range[0],
+            hi0=s_range[1],
+            flo=jnp.zeros(z),
+            fhi=jnp.zeros(z),
+            side=jnp.zeros(z, int),
+            spin=jnp.zeros(z),
+            offset=offset0,
+            torque=jnp.zeros(()),
+            force=jnp.zeros(2),
+            evals=jnp.asarray(0),
+        )
+        out = jax.lax.while_loop(lambda c: c["phase"] < 2 * skid._GAUSS_SEIDEL_ROUNDS, body, init)
+        jax.debug.callback(lambda e: evaluations.append(int(e)), out["evals"])
+        return out["spin"], out["offset"], out["torque"], out["force"]
+
+    return balance
+
+
+def main(warm: bool = False, seeds: int = 3, illinois: bool = False) -> dict:
     import jax
 
     import jaxbearing as jb
@@ -94,12 +191,14 @@ def main(warm: bool = False, seeds: int = 3) -> dict:
     from jaxbearing.run import _initial
 
     speeds: list[float] = []
+    evaluations: list[int] = []  # field evaluations per roller balance (--illinois-rollers)
     plain = (_skid._roller_balance, _skid._cage_speed, _skid._cage_centre)
+    balance = illinois_roller_balance(_skid, evaluations) if illinois else plain[0]
     last_speed: list = [None]  # the alternation's speed, as `_cage_centre` receives it (traced)
 
     def counted(params, base, omega_c, centre, offset0):
         jax.debug.callback(lambda w: speeds.append(float(w)), omega_c)
-        return plain[0](params, base, omega_c, centre, offset0)
+        return balance(params, base, omega_c, centre, offset0)
 
     def centre_seen(params, base, omega_c, spin, offset, centre0):
         last_speed[0] = omega_c
@@ -118,6 +217,7 @@ def main(warm: bool = False, seeds: int = 3) -> dict:
         for seed in range(seeds):
             args = (bearing, op, _initial.traced_scatter(jb.Perturbation(seed=seed)))
             speeds.clear()
+            evaluations.clear()
             t0 = time.perf_counter()
             out = jax.block_until_ready(skid(*args))
             rows.append(
@@ -127,6 +227,8 @@ def main(warm: bool = False, seeds: int = 3) -> dict:
                     "roller_balances": len(speeds),
                     "cage_speed_rad_s": float(out.equilibrium.cage_speed),
                     "balance_speeds_rad_s": list(speeds),
+                    "cage_torque_residual_rad_s2": float(out.equilibrium.cage_torque_residual),
+                    **({"field_evaluations_per_balance": list(evaluations)} if illinois else {}),
                 }
             )
             _common.log(
@@ -135,10 +237,10 @@ def main(warm: bool = False, seeds: int = 3) -> dict:
             )
     finally:
         _skid._roller_balance, _skid._cage_speed, _skid._cage_centre = plain
-    data = {"warm_bracket": warm, "num_slices": 11, "rows": rows}
-    _common.write_json(NAME + ("_warm" if warm else ""), data)
+    data = {"warm_bracket": warm, "illinois_rollers": illinois, "num_slices": 11, "rows": rows}
+    _common.write_json(NAME + ("_warm" if warm else "") + ("_illinois" if illinois else ""), data)
     return data
 
 
 if __name__ == "__main__":
-    main("--warm-bracket" in sys.argv)
+    main("--warm-bracket" in sys.argv, illinois="--illinois-rollers" in sys.argv)

@@ -52,8 +52,10 @@ from typing import Any
 from .._errors import UserInputError
 from ..io import require
 
-#: XLA flags of a worker with one thread
-_ONE_THREAD_FLAGS = "--xla_cpu_multi_thread_eigen=false intra_op_parallelism_threads=1"
+#: XLA flags of a worker with one thread. (The often-quoted `intra_op_parallelism_threads=1` after
+#: it is not an XLA flag: XLA stops reading XLA_FLAGS at the first such token, so every flag
+#: written after it was ignored.)
+_ONE_THREAD_FLAGS = "--xla_cpu_multi_thread_eigen=false"
 
 
 def _with_flags(flags: str, more: str) -> str:
