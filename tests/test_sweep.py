@@ -38,9 +38,10 @@ REPO = pathlib.Path(__file__).parents[1]
 def subprocess_env(**extra) -> dict:
     """Environment of a sweep subprocess: CPU only, one device unless `extra` sets XLA_FLAGS.
 
-    The subprocess keeps this process's XLA flags (in `make test` those of conftest.py), with `extra`'s XLA_FLAGS added: JAX's persistent compilation cache keys its
-    entries on the XLA flags, so a subprocess with other flags compiles again every program
-    this process, or another test, has already compiled and stored (tens of seconds each)."""
+    The subprocess keeps this process's XLA flags (in `make test` those of conftest.py), with
+    `extra`'s XLA_FLAGS added: JAX's persistent compilation cache keys its entries on the XLA
+    flags, so a subprocess with other flags compiles again every program this process, or
+    another test, has already compiled and stored (tens of seconds each)."""
     env = dict(os.environ)
     inherited = [f for f in env.get("XLA_FLAGS", "").split() if not f.startswith("--xla_force_host_platform")]
     env.update(

@@ -105,17 +105,8 @@ def illinois_roller_balance(skid, evaluations: list):
     tol, cap = 2.0**-48, 64  # a phase ends at 2^-48 of its bracket, or after `cap` steps
 
     def balance(params, base, omega_c, centre, offset0):
-        b = params.bearing
         z = base.rollers.azimuth.shape[0]
-        rolling_spin = -omega_c * b.pitch_diameter / b.roller.diameter
-        inner_spin = (
-            -(params.operating.inner_speed - omega_c)
-            * (b.pitch_diameter - b.roller.diameter)
-            / b.roller.diameter
-        )
-        half_range = (b.cage.pocket_clearance / 2 + 0.1 * b.roller.diameter) / (b.pitch_diameter / 2)
-        s_range = (1.5 * jnp.minimum(rolling_spin, inner_spin) * jnp.ones(z), jnp.zeros(z))
-        o_range = (-half_range * jnp.ones(z), half_range * jnp.ones(z))
+        s_range, o_range = skid._balance_brackets(params, omega_c, z)  # the bisection's brackets
 
         def body(c):  # k = 0, 1: the bracket's ends; then Illinois steps
             p, k = c["phase"], c["k"]

@@ -120,15 +120,12 @@ def _residuals(params: Params, base: State, omega_c, spin, offset, centre):
     return spin_res, rates.rollers.azimuth_rate, rates.cage.speed, rates.cage.velocity
 
 
-def _roller_balance(params: Params, base: State, omega_c, centre, offset0):
-    """Each roller's spin and pocket offset at cage speed omega_c: rounds of block Gauss-Seidel,
-    each a bisection of every roller's spin equation (decreasing in s_j) at fixed offsets, then
-    of its tangential equation (decreasing in phi_j) at fixed spins, all rollers at once and with
-    one evaluation of the vector field per step (one call site: one compilation of the field).
-    Returns (spin, offset, cage torque residual, cage force residual) at the last evaluation."""
+def _balance_brackets(params: Params, omega_c, z: int):
+    """The brackets of every roller's spin and pocket offset at cage speed omega_c, each a (lo,
+    hi) pair of (Z,) arrays: the spin between 1.5 times the faster of the outer- and
+    inner-raceway rolling spins and 0, the offset across the pocket clearance plus a margin of
+    0.1 roller diameters (module docstring)."""
     b = params.bearing
-    z = base.rollers.azimuth.shape[0]
-    n = _BISECTION_STEPS
     rolling_spin = -omega_c * b.pitch_diameter / b.roller.diameter  # pure rolling on the outer race
     # pure rolling on the inner race (ring at omega_i, roller centre on the pitch circle)
     inner_spin = (
@@ -138,6 +135,17 @@ def _roller_balance(params: Params, base: State, omega_c, centre, offset0):
     # spin < 0: lo is the faster; the balance lies between the two rolling spins
     s_range = (1.5 * jnp.minimum(rolling_spin, inner_spin) * jnp.ones(z), jnp.zeros(z))
     o_range = (-half_range * jnp.ones(z), half_range * jnp.ones(z))
+    return s_range, o_range
+
+
+def _roller_balance(params: Params, base: State, omega_c, centre, offset0):
+    """Each roller's spin and pocket offset at cage speed omega_c: rounds of block Gauss-Seidel,
+    each a bisection of every roller's spin equation (decreasing in s_j) at fixed offsets, then
+    of its tangential equation (decreasing in phi_j) at fixed spins, all rollers at once and with
+    one evaluation of the vector field per step (one call site: one compilation of the field).
+    Returns (spin, offset, cage torque residual, cage force residual) at the last evaluation."""
+    n = _BISECTION_STEPS
+    s_range, o_range = _balance_brackets(params, omega_c, base.rollers.azimuth.shape[0])
 
     def step(k, carry):
         s_lo, s_hi, o_lo, o_hi, _, _ = carry
