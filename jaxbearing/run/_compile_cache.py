@@ -231,12 +231,12 @@ def _store(path: Path, serialized: bytes, out_tree) -> None:
     _evict(path.parent, keep=path, max_bytes=PROGRAM_CACHE_MAX_BYTES)
 
 
-def _evict(directory: Path, *, keep: Path, max_bytes: int) -> None:
-    """Remove the least recently used programs (oldest modification time: `_load` touches the
-    files it reads) until those in `directory` take at most `max_bytes`; `keep` stays. Files
-    another process removes meanwhile are skipped."""
+def _evict(directory: Path, *, keep: Path, max_bytes: int, pattern: str = "*.jaxexport") -> None:
+    """Remove the least recently used files matching `pattern` (oldest modification time: a
+    load touches the files it reads) until those in `directory` take at most `max_bytes`;
+    `keep` stays. Files another process removes meanwhile are skipped."""
     files = []
-    for path in directory.glob("*.jaxexport"):
+    for path in directory.glob(pattern):
         with contextlib.suppress(OSError):
             st = path.stat()
             files.append((st.st_mtime, st.st_size, path))

@@ -65,6 +65,7 @@ from ..dynamics import (
 from ..geometry import Bearing, OperatingPoint, kinematic_cage_speed
 from ._compile_cache import compiled_program
 from ._engine import drive
+from ._start_cache import load_start, start_key, store_start
 
 
 @dataclasses.dataclass(frozen=True)
@@ -179,13 +180,20 @@ def _skid(bearing, op, scatter):
 
 
 def _static_skid_start(bearing: Bearing, op: OperatingPoint, perturbation: Perturbation | None) -> SkidStart:
+    """The static skid equilibrium of one case, solved once per machine: read from the start
+    cache (`_start_cache`) when this very solve was stored, else solved and stored."""
     dyn = (bearing, op, traced_scatter(perturbation))
-    static = compiled_program("skid_start", _skid, dyn)(*dyn)
-    return dataclasses.replace(
-        static,
-        plateau_speed=float(static.equilibrium.cage_speed),
-        static_time_constant=float(static.time_constant),
-    )
+    key = start_key("static", dyn)
+    static = load_start("static", key)
+    if static is None:
+        static = compiled_program("skid_start", _skid, dyn)(*dyn)
+        static = dataclasses.replace(
+            static,
+            plateau_speed=float(static.equilibrium.cage_speed),
+            static_time_constant=float(static.time_constant),
+        )
+        store_start("static", key, static)
+    return static
 
 
 def static_skid_starts(members, devices=None) -> list[SkidStart]:

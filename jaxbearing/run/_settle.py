@@ -65,11 +65,13 @@ from ._initial import (
     pre_start_steps,
     skid_start,
     static_skid_starts,
+    traced_scatter,
 )
 from ._result import result_code
 from ._rosenbrock import DEFAULT_SOLVER, check_solver
 from ._simulate import SolveArgs, _histories, _saved_state, scaled_diffeqsolve
 from ._simulate import simulate as _simulate_fixed
+from ._start_cache import load_start, start_key, store_start
 from ._statistics import steady_statistics
 from ._step_control import raceway_normal_norm, step_controller
 from ._summary import CONTACT_THRESHOLD, SETTLED_LABEL, UNSETTLED_LABEL
@@ -507,13 +509,15 @@ class SteadyOptions:
         return Params(bearing=member.bearing, operating=member.operating, functionals=self.functionals)
 
 
-def member_steps(member: Member, options: SteadyOptions, reduce=None, static=None):
+def member_steps(member: Member, options: SteadyOptions, reduce=None, static=None, *, stored_start=False):
     """The settled run of one member as a program of integration requests (`_engine`): its
     start (the skid equilibrium and its pre-start, the kinematic start, or the given state),
     settling and the window (module docstring); returns its `SeedRun`, passed through
     `reduce(run, member)` if given (e.g. a sweep's statistics, so that the window's histories
     need not be kept). `static`: the member's static skid equilibrium if already solved
-    (`static_skid_starts`, the vmapped path), else it is solved here when needed."""
+    (`static_skid_starts`, the vmapped path), else it is solved here when needed.
+    `stored_start`: read the pre-start from the start cache, or store it there
+    (`_start_cache`; only where `integrate` is the one-member program, `_run_one`)."""
     bearing, op, pert, given = member.bearing, member.operating, member.perturbation, member.initial_state
     skid = None
     settle = options.settle
@@ -521,9 +525,14 @@ def member_steps(member: Member, options: SteadyOptions, reduce=None, static=Non
         y0, tau = jax.tree_util.tree_map(jnp.asarray, given), None
         settle = continuation_settle(options, y0)
     elif options.start == "skid":
-        skid = yield from pre_start_steps(
-            static if static is not None else _static_skid_start(bearing, op, pert)
-        )
+        key = pre_start_key(member, options) if stored_start else None
+        skid = None if key is None else load_start("pre-start", key)
+        if skid is None:
+            skid = yield from pre_start_steps(
+                static if static is not None else _static_skid_start(bearing, op, pert)
+            )
+            if key is not None and skid.pre_start_status == "ok":
+                store_start("pre-start", key, skid)
         # on the plateau after a completed pre-start: no projective steps (their drift, from
         # two revolution means, is noisier than the pre-start's secant; docs/model.md 16)
         y0 = skid.state
@@ -550,6 +559,20 @@ def member_steps(member: Member, options: SteadyOptions, reduce=None, static=Non
     )
     run = SeedRun(pert.seed, *out, start_cage_speed_rpm=float(rad_s_to_rpm(y0.cage.speed)), verdict=verdict)
     return run if reduce is None else reduce(run, member)
+
+
+def pre_start_key(member: Member, options: SteadyOptions) -> str:
+    """The start cache's key of `member`'s pre-start (`_start_cache`): its case and scatter, and
+    everything that defines the one-member integration it runs (`_integrator`): the
+    functionals, the tolerances, the saves per revolution, the step cap and the solver."""
+    inputs = (member.bearing, member.operating, traced_scatter(member.perturbation), options.functionals)
+    setting = (
+        *options.tolerances(member),
+        int(options.saves_per_rev),
+        int(options.max_steps),
+        str(options.solver),
+    )
+    return start_key("pre-start", inputs, setting)
 
 
 def continuation_settle(options: SteadyOptions, state) -> object:
@@ -579,7 +602,7 @@ def _run_one(member: Member, options: SteadyOptions, reduce=None, static=None) -
         compiled,
         options.solver,
     )
-    run = drive(member_steps(member, options, reduce, static), integrate)
+    run = drive(member_steps(member, options, reduce, static, stored_start=True), integrate)
     return run, sum(compiled)
 
 
