@@ -63,12 +63,15 @@ FILE_SECONDS = {
 #: 11-slice skid start and settled members, which notebook 05 (checked: after test_settle it
 #: stores no skid start or settled-member program of its own), test_steady_design and
 #: test_steady_gradient load (test_engine's settled sweep too, later, from the other process).
+#: test_steady_gradient before the notebooks: notebook 05 then reads the skid starts of seeds
+#: 0-2 of the 11-slice reference that its settled ensemble stored (the start cache,
+#: `jaxbearing.run._start_cache`) and loads its frozen-load programs.
 #: test_cmd_simulate compiles the full-size `simulate` with 4000 saves, which test_dynamics,
 #: test_misalignment_trend, test_outputs and notebooks 01 and 02 (in the first group, which
-#: reaches them after test_settle) load; test_outputs compiles the reference sweep batch, which
+#: reaches them after test_settle and test_steady_gradient) load; test_outputs compiles the reference sweep batch, which
 #: test_sweep and test_sweep_distributed load.
 PROGRAM_GROUPS = (
-    ("test_settle.py", "test_notebooks.py", "test_steady_design.py", "test_steady_gradient.py"),
+    ("test_settle.py", "test_steady_gradient.py", "test_notebooks.py", "test_steady_design.py"),
     (
         "test_cmd_simulate.py",
         "test_dynamics.py",

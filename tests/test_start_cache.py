@@ -106,12 +106,12 @@ def test_a_file_that_is_not_a_start_is_removed_not_executed(starts, tmp_path):
     marker = tmp_path / "ran"
     planted.write_bytes(pickle.dumps(eval, protocol=2) + str(marker).encode())
     with pytest.warns(UserWarning, match="not a stored skid start"):
-        assert start_cache.load_start("static", key) is None
+        assert start_cache.load_start("static", key, initial.SkidStart) is None
     assert not planted.exists() and not marker.exists()
     # data, but not a skid start
     jb.io.save_tree(planted, {"state": np.zeros(3)})
     with pytest.warns(UserWarning, match="not a stored skid start"):
-        assert start_cache.load_start("static", key) is None
+        assert start_cache.load_start("static", key, initial.SkidStart) is None
     assert not planted.exists()
 
 
@@ -120,5 +120,5 @@ def test_with_the_cache_off_nothing_is_stored(monkeypatch, tmp_path):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         start_cache.store_start("static", "0" * 40, object())
-        assert start_cache.load_start("static", "0" * 40) is None
+        assert start_cache.load_start("static", "0" * 40, initial.SkidStart) is None
     assert list(tmp_path.iterdir()) == []

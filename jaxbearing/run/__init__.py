@@ -32,7 +32,8 @@
   persistent cache in a user directory, `$JAXBEARING_CACHE_DIR`; on at import),
   `compiled_program` (a program compiled once per process and traced once per machine:
   `jax.export` artefacts in `program_cache_dir`; `checks_without_host_callbacks` traces
-  equinox's run-time checks so that such a program can be stored),
+  equinox's run-time checks so that such a program can be stored), `start_cache_dir` (skid
+  starts solved once per machine, data-only files read back bit for bit),
   `parallel_map` / `simulate_ensemble` (independent cases, one process per core),
   `as_completed_map` (the same, each result as it finishes: the sweep's batches),
   `shared_workers` (one pool for every `parallel_map` of a block).
@@ -83,6 +84,7 @@ from ._settle import (
     summarise_steady,
 )
 from ._simulate import SolveArgs, flange_functionals, scaled_diffeqsolve, scaled_field, solve
+from ._start_cache import start_cache_dir
 from ._statistics import (
     TAIL_LEVEL,
     Estimate,
@@ -135,6 +137,7 @@ __all__ = [
     "compiled_program",
     "checks_without_host_callbacks",
     "program_cache_dir",
+    "start_cache_dir",
     "parallel_map",
     "shared_workers",
     "raceway_normal_norm",

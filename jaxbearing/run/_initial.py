@@ -184,7 +184,7 @@ def _static_skid_start(bearing: Bearing, op: OperatingPoint, perturbation: Pertu
     cache (`_start_cache`) when this very solve was stored, else solved and stored."""
     dyn = (bearing, op, traced_scatter(perturbation))
     key = start_key("static", dyn)
-    static = load_start("static", key)
+    static = load_start("static", key, SkidStart)
     if static is None:
         static = compiled_program("skid_start", _skid, dyn)(*dyn)
         static = dataclasses.replace(

@@ -59,6 +59,7 @@ from ._ensemble import parallel_map
 from ._initial import (
     STARTS,
     Perturbation,
+    SkidStart,
     _static_skid_start,
     along_slow_mode,
     kinematic_start,
@@ -526,7 +527,7 @@ def member_steps(member: Member, options: SteadyOptions, reduce=None, static=Non
         settle = continuation_settle(options, y0)
     elif options.start == "skid":
         key = pre_start_key(member, options) if stored_start else None
-        skid = None if key is None else load_start("pre-start", key)
+        skid = None if key is None else load_start("pre-start", key, SkidStart)
         if skid is None:
             skid = yield from pre_start_steps(
                 static if static is not None else _static_skid_start(bearing, op, pert)

@@ -100,17 +100,15 @@ def _path(kind: str, key: str) -> Path | None:
     return None if directory is None else directory / f"{kind}-{key}{_SUFFIX}"
 
 
-def load_start(kind: str, key: str):
-    """The `SkidStart` stored under `key`, or None (cache off, absent, or a file that is not a
-    stored start: removed with a warning)."""
-    from ._initial import SkidStart
-
+def load_start(kind: str, key: str, start_type: type):
+    """The start (a `start_type`, `_initial.SkidStart`) stored under `key`, or None (cache off,
+    absent, or a file that is not a stored start: removed with a warning)."""
     path = _path(kind, key)
     if path is None or not path.is_file():
         return None
     try:
         start = load_tree(path, what="stored skid start")
-        if not isinstance(start, SkidStart):
+        if not isinstance(start, start_type):
             raise TreeFileError(f"{path}: not a stored skid start (a {type(start).__name__})")
     except TreeFileError as exc:
         warnings.warn(f"{exc}; removed, the start is solved again", stacklevel=2)
