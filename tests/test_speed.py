@@ -24,7 +24,12 @@ from jaxbearing.run import (
     parallel_map,
     raceway_normal_norm,
 )
-from jaxbearing.run._compile_cache import cache_dir_from_environment, default_cache_dir
+from jaxbearing.run._compile_cache import (
+    MIN_COMPILE_TIME_ENV,
+    cache_dir_from_environment,
+    default_cache_dir,
+    enable_compilation_cache,
+)
 from jaxbearing.run._initial import kinematic_start
 
 
@@ -195,6 +200,26 @@ def test_cache_directory_from_environment(monkeypatch, tmp_path):
         assert cache_dir_from_environment() is None
     monkeypatch.setenv(CACHE_ENV, str(tmp_path / "c"))
     assert cache_dir_from_environment() == tmp_path / "c"
+
+
+def test_the_cache_stores_every_compiled_program_unless_the_user_says_otherwise(monkeypatch):
+    """Also the single operations eager code compiles (a second process compiles none of them
+    again); JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS, JAX's own variable, wins."""
+    option = "jax_persistent_cache_min_compile_time_secs"
+    directory, before = jax.config.jax_compilation_cache_dir, getattr(jax.config, option)
+    if not directory:
+        pytest.skip("the compilation cache is off in this run")
+    try:
+        monkeypatch.delenv(MIN_COMPILE_TIME_ENV, raising=False)
+        jax.config.update(option, 1.0)
+        assert enable_compilation_cache(directory) is not None
+        assert getattr(jax.config, option) == 0.0
+        monkeypatch.setenv(MIN_COMPILE_TIME_ENV, "2")
+        jax.config.update(option, 2.0)  # as JAX reads it from the environment when it starts
+        enable_compilation_cache(directory)
+        assert getattr(jax.config, option) == 2.0
+    finally:
+        jax.config.update(option, before)
 
 
 def test_parallel_map_keeps_order_in_two_processes():
