@@ -4,6 +4,7 @@ raceway, a fixed 0.5 ms settling time, a 2-revolution window, 2 seeds."""
 import dataclasses
 import math
 
+import numpy as np
 import pytest
 
 import jaxbearing as jb
@@ -22,6 +23,13 @@ def test_steady_design_metrics_report_intervals_and_margins(small):
     # a settling time given as text is a settling time (it once ran as "auto", two revolutions more)
     m = jb.steady_design_metrics(b, op, design, seeds=2, window_revs=2, settle="0.5", first_seed=5)
     assert m.seeds == [5, 6] and m.settled
+    # the mean's accumulators give the tail statistic too, from the same runs; not the peak's
+    assert set(m.objectives_per_seed) == {"mean", "tail"}
+    assert m.objectives_per_seed["mean"] == m.objective_per_seed
+    assert (
+        all(np.isfinite(m.objectives_per_seed["tail"]))
+        and m.objectives_per_seed["tail"] != m.objective_per_seed
+    )
     assert m.summary["settle_mode"] == "fixed" and m.summary["settle_time_ms"] == pytest.approx(0.5)
     for est in (m.mean_pv, m.p95_pv, m.corner_contact_share, m.corner_margin):
         assert est["ci95_low"] <= est["value"] <= est["ci95_high"] and est["n"] == 2

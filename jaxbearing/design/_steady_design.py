@@ -32,6 +32,8 @@ limited circle, clearance; positive when satisfied) and the full settled summary
   p-mean PV_ref (int w (PV/PV_ref)^p dt / int w dt)^(1/p), p = `PEAK_EXPONENT`, which weights
   the peaks; with `statistic="tail"` the tail mean of PV over contact time per revolution, the
   mean of its worst 5 % of the saved touching samples (`run.tail_mean`) (`STATISTICS`);
+- `objectives_per_seed`: per seed, the objective of every statistic the run's accumulators give
+  (the mean and the tail integrate the same ones, so one ensemble gives both);
 
 It is a measurement, not a differentiable function: the gradient of a long impacting trajectory
 is not a design signal (`_design`, docs/model.md 14); `steady_gradient` estimates the gradient
@@ -47,6 +49,7 @@ from __future__ import annotations
 
 import dataclasses
 
+import jax
 import numpy as np
 
 from .._errors import UserInputError
@@ -67,7 +70,7 @@ from ..run import (
     summarise_steady,
     window_statistics,
 )
-from ._steady_gradient import _functionals
+from ._steady_gradient import STATISTICS, _functionals
 
 #: default dynamic corner margin [m]: the largest contact radius this far inside the limited circle
 CORNER_MARGIN = 0.05e-3
@@ -97,6 +100,10 @@ class SteadyDesignMetrics:
     #: radius (`run.max_contact_radius_bound`) [m]: the corner margin that holds for a further
     #: revolution with 95 % probability, not only on average
     corner_margin_bound: float = float("nan")
+    #: per seed, the objective of every statistic of `STATISTICS` that the run's accumulators
+    #: give (those with the run's functionals: the mean and the tail come from one ensemble,
+    #: the peak from its own); `objective_per_seed` is the chosen statistic's
+    objectives_per_seed: dict = dataclasses.field(default_factory=dict)
 
     def as_dict(self) -> dict:
         """Everything but the final states, as plain (JSON-able) values."""
@@ -224,17 +231,14 @@ def _metrics(
         }
 
     bound = float(s.get("max_contact_radius_bound", {}).get("value", np.nan))  # NaN stays NaN
-    pv_ref, p = float(functionals.pv_reference), float(functionals.pv_exponent)
-    if statistic == "tail":
-        per_seed = [_tail_per_seed(result, r) for r in result.runs]
-    else:
-        per_seed = [
-            pv_ref
-            * (sum(a for a, _ in r.window_integrals) / sum(c for _, c in r.window_integrals)) ** (1.0 / p)
-            if r.status == "ok" and r.window_integrals and sum(c for _, c in r.window_integrals) > 0
-            else np.nan
-            for r in result.runs
-        ]
+    objectives = {
+        name: [float(v) for v in _objective_per_seed(result, name, functionals)]
+        for name, fn in STATISTICS.items()
+        if _same_functionals(fn, functionals)
+    }
+    per_seed = objectives.get(statistic)
+    if per_seed is None:  # functionals of the caller's own
+        per_seed = _objective_per_seed(result, statistic, functionals)
     return SteadyDesignMetrics(
         design={
             "end_radius_m": float(design.end_radius),
@@ -256,4 +260,28 @@ def _metrics(
             x for r in result.runs if r.status == "ok" for x in (r.window_start_state, r.final_state)
         ],
         corner_margin_bound=float("nan") if rho_lim is None else rho_lim - corner_margin - bound,
+        objectives_per_seed=objectives,
     )
+
+
+def _same_functionals(a, b) -> bool:
+    """True when `a` and `b` integrate the same accumulators (equal leaves, floats or arrays)."""
+    la, ta = jax.tree_util.tree_flatten(a)
+    lb, tb = jax.tree_util.tree_flatten(b)
+    return ta == tb and all(np.array_equal(np.asarray(x), np.asarray(y)) for x, y in zip(la, lb))
+
+
+def _objective_per_seed(result, statistic: str, functionals) -> list:
+    """Each seed's objective of `statistic` from the window of `result`'s runs (module
+    docstring): the tail from the revolutions' tail means, the mean and the peak from the
+    accumulated integrals of `functionals`, PV_ref (sum A / sum C)^(1/p); NaN where a seed has
+    no measured window or contact."""
+    if statistic == "tail":
+        return [_tail_per_seed(result, r) for r in result.runs]
+    pv_ref, p = float(functionals.pv_reference), float(functionals.pv_exponent)
+    return [
+        pv_ref * (sum(a for a, _ in r.window_integrals) / sum(c for _, c in r.window_integrals)) ** (1.0 / p)
+        if r.status == "ok" and r.window_integrals and sum(c for _, c in r.window_integrals) > 0
+        else np.nan
+        for r in result.runs
+    ]
