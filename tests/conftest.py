@@ -140,8 +140,8 @@ def pytest_xdist_make_scheduler(config, log):
 # program built by two tests is a compile a shared setting would save. "cache" lists each
 # persistent-cache lookup (hit or miss, program, the key's end): a key missed by tests of two
 # files, or by a test and a notebook kernel or subprocess, is a program both compiled.
-# "skid": a digest of the inputs of each static skid start a test solves (one-at-a-time path):
-# a digest solved by two tests, or twice, is a start a cache of starts would save.
+# "skid": the start cache's key (its start) of each static skid start a test needs (one-at-a-time
+# path), and whether it was "read" from the start cache or "solved".
 # "started": when the test started (epoch seconds; "(session end)" when the process finished),
 # which shows how evenly the two processes end.
 _COMPILE_LOG = __import__("os").environ.get("JAXBEARING_TEST_COMPILE_LOG")
@@ -175,19 +175,18 @@ if _COMPILE_LOG:
 
     _cc._build = _logged_build
 
-    import numpy as _np
-
     import jaxbearing.run._initial as _initial
     import jaxbearing.run._settle as _settle
+    import jaxbearing.run._start_cache as _start_cache
 
     _plain_skid = _initial._static_skid_start
 
-    def _logged_skid(bearing, op, perturbation):  # which static skid starts each test solves
-        leaves, tree = jax.tree_util.tree_flatten((bearing, op, _initial.traced_scatter(perturbation)))
-        h = hashlib.sha256(str(tree).encode())
-        for leaf in leaves:
-            h.update(_np.asarray(leaf).tobytes())
-        _compile_seconds.setdefault(_current_test[0], {}).setdefault("skid", []).append(h.hexdigest()[:12])
+    def _logged_skid(bearing, op, perturbation):  # which static skid starts each test needs
+        key = _start_cache.start_key("static", (bearing, op, _initial.traced_scatter(perturbation)))
+        directory = _start_cache.start_cache_dir()
+        stored = directory is not None and any(directory.glob(f"static-{key}.*"))
+        per = _compile_seconds.setdefault(_current_test[0], {})
+        per.setdefault("skid", []).append([key[:12], "read" if stored else "solved"])
         return _plain_skid(bearing, op, perturbation)
 
     _initial._static_skid_start = _settle._static_skid_start = _logged_skid
