@@ -51,7 +51,7 @@ import numpy as np
 from ..io import TreeFileError, load_tree, save_tree
 from ._compile_cache import _code_digest, _evict
 
-#: most bytes the stored starts keep (a start at 11 to 31 slices is 20-60 kB)
+#: most bytes the stored starts keep (a start at 11 slices is about 29 kB)
 START_CACHE_MAX_BYTES = 64 * 2**20
 _SUFFIX = ".start.npz"
 
