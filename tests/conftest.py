@@ -28,33 +28,32 @@ import pytest  # noqa: E402
 jax.config.update("jax_enable_x64", True)
 
 #: seconds of test time per file in a cold-cache `make test` from a fresh clone on the 2-core
-#: machine, nothing else running (2026-11-26, 83562ee, junit; 1263 s in all, 10 min 48 s of
+#: machine, nothing else running (2026-11-26, bc6ad24, junit; 938 s in all, 8 min 01 s of
 #: pytest; docs/performance.md). Files not listed take under 10 s.
 FILE_SECONDS = {
-    "test_engine.py": 144,
-    "test_steady_gradient.py": 141,
-    "test_notebooks.py": 133,
-    "test_optimise.py": 81,
-    "test_rosenbrock.py": 80,
-    "test_settle.py": 60,
-    "test_speed.py": 58,
-    "test_sweep_distributed.py": 51,
-    "test_cmd_simulate.py": 49,
-    "test_validate.py": 49,
-    "test_design.py": 43,
-    "test_outputs.py": 33,
-    "test_sweep.py": 33,
-    "test_dynamics.py": 29,
-    "test_skid.py": 26,
-    "test_quasistatic.py": 23,
-    "test_misalignment.py": 22,
-    "test_flange_contact.py": 22,
-    "test_contact_hertz.py": 21,
-    "test_raceway.py": 20,
-    "test_flange_lubrication.py": 20,
-    "test_steady_design.py": 19,
-    "test_optimise_steady.py": 13,
-    "test_program_cache.py": 12,
+    "test_steady_gradient.py": 101,
+    "test_engine.py": 100,
+    "test_notebooks.py": 87,
+    "test_optimise.py": 64,
+    "test_rosenbrock.py": 64,
+    "test_settle.py": 48,
+    "test_speed.py": 46,
+    "test_cmd_simulate.py": 43,
+    "test_sweep_distributed.py": 40,
+    "test_design.py": 36,
+    "test_outputs.py": 27,
+    "test_validate.py": 25,
+    "test_sweep.py": 24,
+    "test_dynamics.py": 23,
+    "test_quasistatic.py": 19,
+    "test_flange_lubrication.py": 18,
+    "test_misalignment.py": 17,
+    "test_raceway.py": 16,
+    "test_skid.py": 16,
+    "test_steady_design.py": 16,
+    "test_contact_hertz.py": 15,
+    "test_flange_contact.py": 15,
+    "test_program_cache.py": 10,
 }
 
 #: files that compile the same programs, run by one process in this order (`make test`, the
