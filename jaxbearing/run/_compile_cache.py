@@ -42,7 +42,6 @@ import contextlib
 import functools
 import hashlib
 import os
-import tempfile
 import warnings
 from pathlib import Path
 
@@ -50,7 +49,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ..io import tree_bytes, tree_from_bytes
+from ..io import atomic_write, tree_bytes, tree_from_bytes
 
 #: environment variable naming the cache directory (or switching the cache off)
 CACHE_ENV = "JAXBEARING_CACHE_DIR"
@@ -222,7 +221,7 @@ def _load(path: Path):
 
 
 def _store(path: Path, serialized: bytes, out_tree) -> None:
-    """Write the serialized program atomically (a temporary file renamed): whole or absent. A
+    """Write the serialized program atomically (`io.atomic_write`): whole or absent. A
     full or read-only disk only costs the next process the tracing; an output structure that is
     not plain data (`tree_bytes`) is not stored."""
     skeleton = jax.tree_util.tree_unflatten(out_tree, [0] * out_tree.num_leaves)
@@ -231,13 +230,8 @@ def _store(path: Path, serialized: bytes, out_tree) -> None:
     except TypeError:
         return
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        with tempfile.NamedTemporaryFile(dir=path.parent, prefix=path.name, suffix=".tmp", delete=False) as f:
-            f.write(data)
-        os.replace(f.name, path)
+        atomic_write(path, lambda f: f.write(data))
     except OSError:
-        with contextlib.suppress(OSError, UnboundLocalError):
-            os.unlink(f.name)
         return
     _evict(path.parent, keep=path, max_bytes=PROGRAM_CACHE_MAX_BYTES)
 
