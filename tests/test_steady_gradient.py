@@ -405,10 +405,12 @@ def test_frozen_load_gradients_batched_equal_one_at_a_time(settled, statistic):
     cases run one trajectory at a time do, each case only from its own states. Not bitwise: the
     vmapped solve is another program, its roundings flip a step's acceptance now and then, and
     over the 1 ms window the impacting dynamics grow such a difference (module docstring of
-    `_steady_gradient`; measured 2026-11-26: values 0.1-1.1 % apart, depending on the batch's
-    size). So the two must agree within the estimator's own standard error. The tail statistic
-    too: its vmapped program returns every sample's frozen PV and Jacobian, the accelerator's
-    path (`frozen_tail_members`)."""
+    `_steady_gradient`), by an amount that depends on the CPU and the batch's size. The two are
+    then two estimates of the same expectation, each with its own standard error, so they must
+    agree within three standard errors of their difference, sqrt(SE_1^2 + SE_b^2) (a false alarm
+    at most 0.3 % of the time for normal errors; one standard error of one of them failed on a
+    fresh machine). The tail statistic too: its vmapped program returns every sample's frozen PV
+    and Jacobian, the accelerator's path (`frozen_tail_members`)."""
     from jaxbearing.design import frozen_load_gradients
 
     b, op, x, base = settled
@@ -425,10 +427,11 @@ def test_frozen_load_gradients_batched_equal_one_at_a_time(settled, statistic):
         print(
             f"value {a.value:.6e} / {v.value:.6e}, gradient {a.gradient} / {v.gradient} +- {a.gradient_stderr}"
         )
-        assert abs(v.value - a.value) <= a.value_stderr
+        assert abs(v.value - a.value) <= 3.0 * np.hypot(a.value_stderr, v.value_stderr)
         # Delta_bf's component is round-off (~1e-11 of the others: the estimator cannot see it)
         floor = 1e-9 * np.max(np.abs(a.gradient))
-        assert np.all(np.abs(v.gradient - a.gradient) <= a.gradient_stderr + floor)
+        spread = 3.0 * np.hypot(a.gradient_stderr, v.gradient_stderr)
+        assert np.all(np.abs(v.gradient - a.gradient) <= spread + floor)
     assert [g.num_samples for g in batched] == [2, 3] and one[0].value != one[1].value
 
 

@@ -142,7 +142,22 @@ def _rpm(value) -> str:
 
 
 def format_table(summaries: dict) -> str:
-    """Statistic per row, one column per end type: value [95 % CI]."""
+    """Statistic per row, one column per end type: value [95 % CI]. A run whose solve failed
+    before its window was measured has no statistics: it gets one line saying why it failed
+    (`_failure_line`), and the table only the end types that were measured."""
+    failed = {e: _failure_line(e, s) for e, s in summaries.items() if s.get("status", "ok") != "ok"}
+    measured = {e: s for e, s in summaries.items() if e not in failed or s.get("window_ms", 0.0) > 0.0}
+    if not measured:
+        return "\n".join(failed.values())
+    return "\n".join([_statistics_table(measured), *failed.values()])
+
+
+def _failure_line(end: str, s: dict) -> str:
+    """One line for a failed settled run: the end type, the solver's reason and where it failed."""
+    return f"[{end}] FAILED: {s['status'].removeprefix('failed: ')}; no statistics (summary.json has the run's record)"
+
+
+def _statistics_table(summaries: dict) -> str:
     ends = list(summaries)
     w = 36
     head = f"{'quantity (per cage revolution)':<34}{'unit':>8}" + "".join(f"{e:>{w}}" for e in ends)
@@ -204,7 +219,7 @@ def format_table(summaries: dict) -> str:
                 f"[{e}] skid start: cage {np.nanmean(starts):.1f} rpm; projective steps of the cage speed "
                 f"[rpm]: {', '.join(steps) or 'none'}"
             )
-        if s["settle_mode"] == "auto" and not s["settled"]:
+        if s["settle_mode"] == "auto" and not s["settled"] and s["status"] == "ok":
             lines.append(
                 f"[{e}] NOT SETTLED: the cage speed's remaining drift (up to "
                 f"{_rpm(s.get('residual_drift_bound_rpm'))} rpm) still exceeded {s['settle_tolerance']:.2g} "

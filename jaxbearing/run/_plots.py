@@ -18,12 +18,18 @@ from ._summary import SETTLED_LABEL, TRANSIENT_LABEL
 
 
 def plot_run(out_dir: pathlib.Path, results: dict) -> list[pathlib.Path]:
+    """The figures of `results` ({end: (result, summary)}) in `out_dir`, for the runs that have
+    histories (a failed settled run may have none); the files written."""
     from ..geometry import kinematic_cage_speed, limited_circle_radius, rad_s_to_rpm
     from ._summary import contact_events
 
     plt = _plt()
     out_dir = pathlib.Path(out_dir)
     files = []
+    # a settled run whose solve failed before its window has no histories: nothing to draw
+    results = {end: rs for end, rs in results.items() if rs[0].histories}
+    if not results:
+        return files
     events = {end: contact_events(res.histories) for end, (res, _) in results.items()}
     label = _running_label(results)
 

@@ -105,7 +105,7 @@ def result_code(result) -> Array:
     return code
 
 
-def _result_message(code: int) -> str:
+def result_message(code: int) -> str:
     name = RESULT_NAMES[code] if 0 <= code < len(RESULT_NAMES) else "other"
     return _RESULT_TEXT.get(name, f"the solver did not succeed ({name}, result code {code})")
 
@@ -126,7 +126,7 @@ def simulation_result(
         pv_peak, h_max, h_min = (float(v) for v in smooth_functionals(sol.accumulators, functionals))
     else:
         status = (
-            f"failed: {_result_message(code)} (simulated time reached {reached * 1e3:.4f} ms"
+            f"failed: {result_message(code)} (simulated time reached {reached * 1e3:.4f} ms"
             f" of {duration * 1e3:.4f} ms)"
         )
         pv_peak = h_max = h_min = float("nan")

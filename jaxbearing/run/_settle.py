@@ -68,14 +68,14 @@ from ._initial import (
     static_skid_starts,
     traced_scatter,
 )
-from ._result import result_code
+from ._result import result_message, result_code
 from ._rosenbrock import DEFAULT_SOLVER, check_solver
 from ._simulate import SolveArgs, _histories, _saved_state, scaled_diffeqsolve
 from ._simulate import simulate as _simulate_fixed
 from ._start_cache import load_start, start_key, store_start
 from ._statistics import steady_statistics
 from ._step_control import raceway_normal_norm, step_controller
-from ._summary import CONTACT_THRESHOLD, SETTLED_LABEL, UNSETTLED_LABEL
+from ._summary import CONTACT_THRESHOLD, FAILED_LABEL, SETTLED_LABEL, UNSETTLED_LABEL
 from ._summary import summarise as _summarise_fixed
 
 #: defaults of the settled run
@@ -363,9 +363,8 @@ def settle_and_measure_steps(
         hist = {k: np.asarray(v) for k, v in hist.items()}
         steps += int(n)
         if int(code) != 0 or not np.all(np.isfinite(hist["cage_speed"])):
-            status = (
-                f"failed: the solver did not succeed in the revolution ending at {(t + rev) * 1e3:.2f} ms"
-            )
+            why = result_message(int(code)) if int(code) != 0 else "the cage speed became non-finite"
+            status = f"failed: {why}, in the cage revolution from {t * 1e3:.2f} to {(t + rev) * 1e3:.2f} ms"
             break
         hist["t"] = hist["t"] + t
         t += rev
@@ -897,7 +896,7 @@ def summarise_steady(result: SteadyResult, threshold: float = CONTACT_THRESHOLD)
     runs = result.runs
     ok = [r for r in runs if r.measured]
     block = {
-        "running": SETTLED_LABEL if result.settled else UNSETTLED_LABEL,
+        "running": FAILED_LABEL if not result.ok else SETTLED_LABEL if result.settled else UNSETTLED_LABEL,
         "status": "ok" if result.ok else next(r.status for r in runs if r.status != "ok"),
         "settled": bool(result.settled),
         "settle_mode": result.settle if isinstance(result.settle, str) else "fixed",

@@ -134,6 +134,8 @@ TRANSIENT_LABEL = "start-up transient"
 #: ... and a settled run's, when the settling verdict passed (else `UNSETTLED_LABEL`)
 SETTLED_LABEL = "settled running"
 UNSETTLED_LABEL = "not settled (see settled and residual_drift_rpm)"
+#: ... and a settled run whose solve failed before its window was measured
+FAILED_LABEL = "failed (see status)"
 
 
 def summarise(result, threshold: float = CONTACT_THRESHOLD) -> dict:
