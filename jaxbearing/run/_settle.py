@@ -68,7 +68,7 @@ from ._initial import (
     static_skid_starts,
     traced_scatter,
 )
-from ._result import result_message, result_code
+from ._result import result_code, result_message
 from ._rosenbrock import DEFAULT_SOLVER, check_solver
 from ._simulate import SolveArgs, _histories, _saved_state, scaled_diffeqsolve
 from ._simulate import simulate as _simulate_fixed
