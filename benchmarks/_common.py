@@ -428,13 +428,3 @@ def run_solve_ivp(fun: Callable, t_span, y0, *, rtol: float, atol: float, method
         "t1": float(sol.t[-1]),
         "y1": sol.y[:, -1],
     }
-
-
-def jaxbearing_version() -> str:
-    import jaxbearing
-
-    return jaxbearing.__version__
-
-
-def python_executable() -> str:
-    return sys.executable

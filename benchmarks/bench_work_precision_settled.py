@@ -186,7 +186,7 @@ VARIANTS = (
         )
     ),
     # rows 25-27: the rollers' orbital rate and angular velocity and the cage, which held the
-    # step under the per-roller RMS (diagnose_step_control.py --norm body_rms), looser; x10 is
+    # step under the per-roller RMS (results/diagnose_step_control_body_rms.json), looser; x10 is
     # the library's default (`jaxbearing.run.ROTATION_LOOSEN`)
     *(
         (

@@ -101,7 +101,7 @@ ESTIMATORS = ("frozen", "window")
 #: this [m] (`next_active`): one step of the default search moved the limited-circle margin by
 #: up to 0.25 mm and the dynamic corner margin by up to 0.28 mm (results/optimise_steady_default_run.json),
 #: so a margin above it does not bind within a step. Without it, margins alike at every speed
-#: kept every point running (benchmarks/studies/bench_envelope_active_set.py, 2026-11-26)
+#: kept every point running (benchmarks/results/bench_envelope_active_set.json, 2026-11-26)
 CORNER_WATCH = 0.3e-3
 #: the dynamic corner constraint's statistic (`SteadySettings.corner_constraint`)
 CORNER_CONSTRAINTS = ("prediction", "mean")
@@ -787,7 +787,7 @@ CLEARANCE_EFFECT = {
     "+1.83e12 +- 0.95e12 Pa m/s per m, 95 % CI [-0.13e12, +3.79e12] (24 seeds, common-random-number "
     "central differences): not significant; up to about 2.3 % of J per 10 um is not excluded. "
     "Not significant at 80 mm / 1.6 deg and 70 mm / 1.8 deg either (8 seeds)",
-    "study": "benchmarks/studies/study_clearance_effect.py on one H200 (11 slices, 16 seeds, h = 0.01 mm, "
+    "study": "the clearance study (benchmarks/studies/README.md) on one H200 (11 slices, 16 seeds, h = 0.01 mm, "
     "results/study_clearance_effect.json, docs/figures/clearance_effect): 7 operating points (10,000, 20,000, "
     "30,000 rpm; 1 and 2 mrad; 500 and 4000 N) x 2 designs (100 mm / 1.4 deg and 94.3 mm / 1.84 deg, "
     "Delta_bf 0.15 mm). Never significantly negative: where the clearance matters, a larger one raises PV",

@@ -5,7 +5,7 @@ import os
 # (`jaxbearing.run._ensemble`), instead of two processes each spreading XLA's threads over both
 # CPUs. JAXBEARING_TEST_PIN=0 switches it off. And XLA's older CPU emitters instead of its fusion
 # emitters: a solve compiles in 14 s instead of 22-24 s and runs as fast, with the same numbers
-# (benchmarks/studies/diagnose_compile_flags.py), and compiling is about half of the suite's time.
+# (benchmarks/results/diagnose_compile_flags.json), and compiling is about half of the suite's time.
 # (XLA reads XLA_FLAGS up to the first token that is not a flag, such as the often-quoted
 # `intra_op_parallelism_threads=1`, and ignores the rest.)
 _WORKER = os.environ.get("PYTEST_XDIST_WORKER", "")

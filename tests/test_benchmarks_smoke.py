@@ -7,6 +7,7 @@ from __future__ import annotations
 import inspect
 import json
 import math
+import re
 import sys
 from pathlib import Path
 
@@ -61,13 +62,13 @@ def test_benchmarks_top_level_holds_only_maintained_scripts():
 
 def test_every_results_file_has_the_script_that_writes_it():
     """benchmarks/results/ holds results only (no patches), each named after the script that
-    writes it, or listed with its command in benchmarks/README.md's results table."""
-    readme = (BENCH_DIR / "README.md").read_text()
+    writes it, or listed with its command in benchmarks/README.md's results table or in
+    benchmarks/studies/README.md's index of removed studies."""
+    readme = (BENCH_DIR / "README.md").read_text() + (STUDIES_DIR / "README.md").read_text()
     scripts = [p.stem for d in (BENCH_DIR, STUDIES_DIR) for p in d.glob("*.py")]
     writers = {
         "throughput": "bench_throughput",
         "gradients": "bench_gradients",
-        "optimise_vs_grid": "bench_optimise_grid",
     }
     for path in sorted((BENCH_DIR / "results").iterdir()):
         assert path.suffix == ".json", f"{path.name}: not a results file"
@@ -78,6 +79,11 @@ def test_every_results_file_has_the_script_that_writes_it():
         assert named or f"`{path.name}`" in readme, f"{path.name}: no script writes it"
     for stem, script in writers.items():
         assert script in scripts
+    index = (STUDIES_DIR / "README.md").read_text()
+    for name in re.findall(r"`([\w.-]+\.json)`", index):
+        assert (BENCH_DIR / "results" / name).exists(), (
+            f"benchmarks/studies/README.md names {name}: not in results/"
+        )
 
 
 def test_write_json_is_strict_json_with_machine_info(tmp_path):
@@ -142,21 +148,6 @@ def _load(name, directory):
 def test_only_rejects_unknown_names(capsys):
     assert run_all.main(["--only", "no_such_bench"]) == 2
     assert "unknown benchmark" in capsys.readouterr().err
-
-
-def test_integrated_autocorrelation_time_of_ar1_is_its_closed_form():
-    """tau_int of an AR(1) series x_k = phi x_(k-1) + e_k is (1 + phi) / (1 - phi) (white noise:
-    1), the estimator `diagnose_axial_memory` reads the rollers' axial memory with."""
-    import numpy as np
-    from diagnose_axial_memory import integrated_autocorrelation_time
-    from scipy.signal import lfilter
-
-    rng = np.random.default_rng(0)
-    assert abs(integrated_autocorrelation_time(rng.normal(size=20_000)) - 1.0) < 0.1
-    for phi in (0.5, 0.9):
-        x = lfilter([1.0], [1.0, -phi], rng.normal(size=200_000))
-        exact = (1 + phi) / (1 - phi)
-        assert abs(integrated_autocorrelation_time(x) / exact - 1) < 0.1
 
 
 def test_long_studies_declare_their_own_time_limit():

@@ -5,7 +5,7 @@ and bounds that exclude the design zone, and the `optimise run` command line.
 The search and the grid share one small problem (reference bearing at 11 slices, 20,000 rpm and 1000 N,
 Delta_bf fixed at 0.2 mm, R_end x theta_f over the default bounds, 0.3 ms per evaluation), so
 every model evaluation reuses one compilation. The grid here is 5 x 5; the full >= 15 x 15
-comparison is benchmarks/studies/bench_optimise_grid.py (benchmarks/results/optimise_vs_grid.json)."""
+comparison is benchmarks/results/optimise_vs_grid.json."""
 
 import json
 import math
@@ -150,7 +150,7 @@ def test_search_no_worse_than_grid(searched):
     is lower is the rounding of an unloaded contact, not a ranking; what is claimed, and checked,
     is that the search reaches the floor the grid's best point is on. (It used to allow 1e-3
     GPa m/s, 4 000 times the values compared.) The full >= 15 x 15 comparison is
-    benchmarks/studies/bench_optimise_grid.py."""
+    benchmarks/results/optimise_vs_grid.json."""
     p, res = searched
     grid = opt.grid_search(p, 5, 5, CLEARANCE_MM * 1e-3, batch=GRID_BATCH)
     assert grid["best_design"] is not None and grid["num_model_evaluations"] > 0

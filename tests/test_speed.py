@@ -488,7 +488,7 @@ def test_start_up_transients_take_the_max_norm_and_settled_windows_the_per_rolle
     """`solve` (fixed-duration runs, sweeps, trajectory gradients) builds its error norm from
     `TRANSIENT_ERROR_NORM`: the max norm, raceway-normal x100, rotations not loosened (the
     per-roller RMS with the rotations 10x looser gives spurious corner impacts there,
-    benchmarks/studies/diagnose_peak_spread.py); `prepare_from` (settled windows) from the per-roller
+    benchmarks/results/diagnose_peak_spread.json); `prepare_from` (settled windows) from the per-roller
     RMS defaults."""
     from jaxbearing.run import (
         TRANSIENT_ERROR_NORM,

@@ -370,10 +370,10 @@ def test_frozen_load_estimator_agrees_with_crn_differences_on_settled_running(se
     The peak statistic (the p-mean of PV over contact time, p = 8) the same way (2026-11-26,
     2 workers): CRN FD -1.96e11 +- 2.0e10 per rad (9.7 standard errors), frozen load
     -1.57e11 +- 5.6e10, 20 % apart; at two further designs in
-    benchmarks/studies/bench_peak_gradient.py. The tail statistic (the mean of the worst 5 % of
+    benchmarks/results/bench_peak_gradient_12_mean_peak_tail.json. The tail statistic (the mean of the worst 5 % of
     PV over contact time, per revolution) likewise (2026-11-26, one process): CRN FD -2.72e11 +- 4.3e10 per rad (6.3
     standard errors), frozen load -2.03e11 +- 3.7e10, 25 % apart; at
-    the three designs with 8 seeds in benchmarks/studies/bench_peak_gradient.py --statistics tail.
+    the three designs with 8 seeds in benchmarks/results/bench_peak_gradient_tail_11slices_8seeds.json.
     In `make test`'s setting (the test processes' XLA flags, which change the last digits, and
     with them the chaotic runs; 2026-11-26, `pytest -rP tests/test_steady_gradient.py -k crn`
     with conftest's flags, one process): mean -8.84e10 +- 1.1e10 against -9.99e10 (13 %

@@ -267,7 +267,7 @@ def quasi_static(bearing: Bearing, op: OperatingPoint) -> QuasiStatic:
     check_model_inputs(bearing, op)
     # A bearing closed over by a caller's jit is a set of constants, and XLA then specialises
     # the Newton loops on them: a quasi-static start took 0.21 s instead of 0.036 s
-    # (benchmarks/studies/diagnose_atol_cost.py). The barrier makes them opaque values, as arguments are.
+    # (benchmarks/results/diagnose_atol_cost.json). The barrier makes them opaque values, as arguments are.
     bearing, op = jax.lax.optimization_barrier((bearing, op))
     z = bearing.num_rollers
     psi = 2 * jnp.pi * jnp.arange(z) / z

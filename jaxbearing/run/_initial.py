@@ -34,7 +34,7 @@ The skid start has two parts (docs/model.md 16):
    with tau_s lands short (-80 rpm of the 116 needed) and the settling loop used to need two or
    three. Cost: 2.45 cage revolutions of simulated time (17.2 ms at the reference point), through
    the run's own compiled `solve_from` (no compilation of its own). Measured there
-   (benchmarks/studies/bench_settling.py): revolution 1 of the run within 0.006 % of the window's cage
+   (benchmarks/results/bench_settling.json): revolution 1 of the run within 0.006 % of the window's cage
    speed. Deterministic per seed; not differentiated (a start, not a model output). If a burst
    fails, the static state is handed over (`pre_start_status` says why) and the settling loop's
    projective steps take over.

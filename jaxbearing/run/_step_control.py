@@ -26,7 +26,7 @@ Two error controls, one per kind of run:
 - start-up transients (`solve`: fixed-duration runs, sweeps, trajectory gradients) take
   `TRANSIENT_ERROR_NORM` = "max" with the raceway-normal tolerances 100x looser and the
   rotations not loosened, because the settled windows' control gives spurious roller-corner
-  impacts on the flange in a transient (`benchmarks/studies/diagnose_peak_spread.py`).
+  impacts on the flange in a transient (`benchmarks/results/diagnose_peak_spread.json`).
 
 The weighted components are combined per body (`DEFAULT_ERROR_NORM` = "body_rms"): the RMS
 over each roller's 12 coordinates, over the cage's and over the inner ring's, and the largest
@@ -34,7 +34,7 @@ of these (Hairer, Norsett & Wanner, Solving ODEs I, II.4, eq. 4.11, per body). N
 error hides among the other rollers' (one coordinate may exceed its tolerance by at most
 sqrt(12) = 3.5 when it alone errs), while the several coordinates of one roller that all held
 the step under the max norm (docs/performance.md) share one tolerance. Chosen by the settled
-work-precision benchmark and by the peak-PV check of `benchmarks/studies/diagnose_error_norms.py`
+work-precision benchmark and by the peak-PV check of `benchmarks/results/diagnose_error_norms.json`
 (docs/performance.md; docs/model.md 13):
 - "max", the max norm over every coordinate (the default until 2026-11-25, with the
   raceway-normal tolerances 100x looser): every statistic agrees with a tight reference;
@@ -48,7 +48,7 @@ work-precision benchmark and by the peak-PV check of `benchmarks/studies/diagnos
 
 Under the per-roller RMS the rotations held the step: each roller's orbital rate (its
 collisions with the cage pockets), its angular velocity (spin traction) and the cage's
-coordinates (benchmarks/studies/diagnose_step_control.py --norm body_rms). Their tolerances are
+coordinates (benchmarks/results/diagnose_step_control_body_rms.json). Their tolerances are
 `rotation_loosen` = 10 times looser in settled windows (`ROTATION_LOOSEN`): 1.25x fewer evaluations in
 settled running, every flange statistic and the cage slip agreeing with the tight reference
 on the seeds used to choose it and on others. The smooth peak PV of a start-up transient
@@ -83,8 +83,8 @@ from ..dynamics import State
 RACEWAY_NORMAL_LOOSEN = 10.0
 #: default loosening of the rotations' tolerances: each roller's orbital rate and angular
 #: velocity and the cage's coordinates. Under the per-roller RMS with the raceway-normal
-#: coordinates 10x looser, these held the step (benchmarks/studies/diagnose_step_control.py --norm
-#: body_rms: with everything else 100x looser, the roller's orbital rate alone kept 93 % of the
+#: coordinates 10x looser, these held the step (benchmarks/results/diagnose_step_control_body_rms.json:
+#: with everything else 100x looser, the roller's orbital rate alone kept 93 % of the
 #: evaluations). 10x looser: 1.25x fewer evaluations in settled running, every statistic
 #: agreeing with the tight reference on seeds 0-3 and on seeds 4-7 not used to choose it; 100x
 #: gains 1.5 % more (benchmarks/bench_work_precision_settled.py, rows 25-27). Settled windows
@@ -171,7 +171,7 @@ DEFAULT_ERROR_NORM = "body_rms"
 #: (smooth peak PV 8x the tight runs') that no run at rtol 2e-4 shows, and the other 3 come out
 #: 31 % low; the per-roller RMS alone gives 2 of 8, the max norm with the rotations 10x looser
 #: 2 of 8, this setting 0 of 8 within 2 % (to 3 %) of the tight median
-#: (benchmarks/studies/diagnose_peak_spread.py). Settled windows show no corner contact under their
+#: (benchmarks/results/diagnose_peak_spread.json). Settled windows show no corner contact under their
 #: error control (docs/performance.md).
 TRANSIENT_ERROR_NORM = "max"
 TRANSIENT_RACEWAY_LOOSEN = 100.0
