@@ -31,8 +31,8 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 REGISTRY = ROOT / "docs" / "figures.toml"
-#: what one `{}` of a quoting text matches: the rest of the line up to the next literal part
-_NUMBER = r"([^\n]+?)"
+#: what one `{}` of a quoting text matches: the line up to the next literal part, within a table cell
+_NUMBER = r"([^\n|]+?)"
 
 
 @dataclass(frozen=True)
@@ -138,7 +138,12 @@ def expected(figure: Figure, cache: dict[Path, object] | None = None) -> list[st
 
 
 def _pattern(text: str) -> re.Pattern:
-    return re.compile(_NUMBER.join(re.escape(part) for part in text.split("{}")))
+    """`text` with each `{}` a number; a table row (`| ... |`) matches whole lines only, so that a
+    row is not taken for the start of a longer one."""
+    body = _NUMBER.join(re.escape(part) for part in text.split("{}"))
+    if text.startswith("|") and text.endswith("|"):
+        return re.compile(rf"^{body}$", re.MULTILINE)
+    return re.compile(body)
 
 
 def check(figures: list[Figure], root: Path = ROOT, write: bool = False) -> list[str]:
