@@ -31,8 +31,9 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 REGISTRY = ROOT / "docs" / "figures.toml"
-#: what one `{}` of a quoting text matches: the line up to the next literal part, within a table cell
-_NUMBER = r"([^\n|]+?)"
+#: what one `{}` of a quoting text matches: a number as the formats write it (`-1,234.5`, `2e-3`,
+#: `19 min 41 s`, `10 min`, `58 s`)
+_NUMBER = r"(-?\d[\d,]*(?:\.\d+)?(?:e[-+]?\d+)?(?: min(?: \d+ s)?| s)?)"
 
 
 @dataclass(frozen=True)
