@@ -139,12 +139,10 @@ def expected(figure: Figure, cache: dict[Path, object] | None = None) -> list[st
 
 
 def _pattern(text: str) -> re.Pattern:
-    """`text` with each `{}` a number; a table row (`| ... |`) matches whole lines only, so that a
-    row is not taken for the start of a longer one."""
+    """`text` with each `{}` a number; a text that ends a table row (`... |`) matches only at the
+    end of a line, so that a row is not taken for the start of a longer one."""
     body = _NUMBER.join(re.escape(part) for part in text.split("{}"))
-    if text.startswith("|") and text.endswith("|"):
-        return re.compile(rf"^{body}$", re.MULTILINE)
-    return re.compile(body)
+    return re.compile(rf"{body}$" if text.endswith("|") else body, re.MULTILINE)
 
 
 def check(figures: list[Figure], root: Path = ROOT, write: bool = False) -> list[str]:
