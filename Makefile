@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test test-slow lint format bench install clean docs notebooks
+.PHONY: demo test test-slow lint format bench install clean docs notebooks figures
 
 $(BIN)/python:
 	@command -v $(PYTHON) >/dev/null 2>&1 || { echo "error: $(PYTHON) not found (set PYTHON=...)"; exit 1; }
@@ -52,6 +52,11 @@ docs: $(DOCS_STAMP)
 	$(BIN)/python docs/_execute_notebooks.py build/notebooks
 	JAXBEARING_DOCS_NOTEBOOKS=build/notebooks $(BIN)/mkdocs build --strict
 	@echo "site: build/site/index.html (or: $(BIN)/mkdocs serve)"
+
+# every measured figure quoted on the user pages rewritten from its results file (docs/figures.toml);
+# `python docs/_figures.py` without --write only checks them (tests/test_figures.py does too)
+figures: $(STAMP)
+	$(BIN)/python docs/_figures.py --write
 
 # JupyterLab on the notebooks (the notebooks extra); set JAXBEARING_NOTEBOOK_SHORT=1 for the short setting
 NOTEBOOKS_STAMP := $(VENV)/.installed-notebooks

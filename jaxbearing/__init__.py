@@ -86,7 +86,7 @@ from .sweep import (  # noqa: E402
     run_sweep,
 )
 
-__version__ = "0.1.0"
+__version__ = "0.4.0"
 
 __all__ = [
     # parameters (docs/model.md 1)
