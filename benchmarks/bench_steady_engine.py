@@ -94,12 +94,12 @@ def main(
 ) -> dict:
     import jax
 
-    from jaxbearing.run import SteadyOptions
+    from jaxbearing.run import SteadySettings
 
     started = time.perf_counter()
     speeds = [20000.0] if quick else [15000.0, 20000.0]
     seeds = 2
-    options = SteadyOptions(window_revs=2 if quick else 4, tolerance=2e-3)
+    options = SteadySettings(window_revs=2 if quick else 4, tolerance=2e-3)
     data = {
         "machine": _common.machine_info(),
         "backend": jax.default_backend(),
@@ -144,7 +144,7 @@ def _strategies(options, speeds, seeds) -> dict:
     ):
         _common.log(f"{NAME}: {label}: {len(members)} members")
         t0 = time.perf_counter()
-        engine = settle_members(members, options, strategy=strategy, workers=workers)
+        engine = settle_members(members, options.replace(strategy=strategy, workers=workers))
         end_to_end = time.perf_counter() - t0
         per_hour = len(members) / engine.wall_time_s * 3600
         results[strategy] = {
@@ -200,7 +200,7 @@ def _batch_sizes(options, sizes):
     for n in sizes:
         members = _members([20000.0], n)
         _common.log(f"{NAME}: vmapped batch of {n}")
-        engine = settle_members(members, options, strategy="vmap")
+        engine = settle_members(members, options.replace(strategy="vmap"))
         row = {
             "batch_size": n,
             "wall_s": engine.wall_time_s,

@@ -1,4 +1,4 @@
-"""Design search on steady running (issue 13): the default objective of `optimise run`.
+"""Design search on steady running: the default objective of `optimise run`.
 
 Objective. For a design x = (R_end, theta_f, Delta_bf), at every operating point k of the
 envelope, the smooth mean flange PV over contact time of settled running (`jaxbearing.design.
@@ -12,9 +12,8 @@ through (every seed's state at the start of its window and at its end: 2 x seeds
 invariant measure), plain trajectories of `gradient_window` seconds; at every saved state the
 flange PV is differentiated in the design at the loads the dynamics gave, through the ratio
 estimator. "window": the short-window forward-mode sensitivities of
-`jaxbearing.design.steady_gradient` over `gradient_window` seconds. benchmarks/studies/bench_steady_gradient
-measures both against common-random-number central differences (docs/how-to/design-search.md; the study in docs/performance-history.md, Design on steady
-running).
+`jaxbearing.design.steady_gradient` over `gradient_window` seconds. Both are measured against
+common-random-number central differences in docs/validation.md and docs/how-to/design-search.md.
 
 Constraints. The four static design-zone margins of `DesignProblem.constraints` and the
 dynamic corner-contact margin m_dyn = rho_lim - max(contact radius) - `corner_margin`, max
@@ -101,7 +100,7 @@ ESTIMATORS = ("frozen", "window")
 #: this [m] (`next_active`): one step of the default search moved the limited-circle margin by
 #: up to 0.25 mm and the dynamic corner margin by up to 0.28 mm (results/optimise_steady_default_run.json),
 #: so a margin above it does not bind within a step. Without it, margins alike at every speed
-#: kept every point running (benchmarks/results/bench_envelope_active_set.json, 2026-11-26)
+#: kept every point running (benchmarks/results/bench_envelope_active_set.json)
 CORNER_WATCH = 0.3e-3
 #: the dynamic corner constraint's statistic (`SteadySettings.corner_constraint`)
 CORNER_CONSTRAINTS = ("prediction", "mean")
@@ -778,7 +777,7 @@ def steady_search(
 #: what the search knows about the axial clearance's effect on its objective (result.json
 #: `axial_clearance_effect`; docs/model.md 17): the frozen-load estimator cannot see Delta_bf;
 #: common-random-number central differences of settled ensembles found it significant only
-#: with the inner ring misaligned by 2 mrad (issue 35, item 1)
+#: with the inner ring misaligned by 2 mrad
 CLEARANCE_EFFECT = {
     "estimator_sees_it": False,
     "why": "the frozen-load estimator moves the flange in its own plane at a fixed load: its dJ/dDelta_bf "
@@ -806,8 +805,7 @@ CLEARANCE_EFFECT = {
 
 def near_optimal_set(result: SteadySearchResult) -> list[dict]:
     """The feasible designs the search evaluated whose objective lies within the best design's
-    95 % interval (issue 35, item 7: the optimum is a ridge along a binding margin, not a
-    point; a designer chooses among these by other criteria), best first. Each: the design
+    95 % interval (the optimum is a ridge along a binding margin, not a point; a designer chooses among these by other criteria), best first. Each: the design
     (R_end, theta_f, Delta_bf in SI), its objective and interval, where it was evaluated
     (iteration, start), and its binding margin: the smallest of its static and dynamic margins
     (`CONSTRAINT_NAMES`) with its value [m]. Empty without a feasible design."""

@@ -174,8 +174,9 @@ if _COMPILE_LOG:
 
     _cc._build = _logged_build
 
+    import jaxbearing.run._dispatch as _dispatch
     import jaxbearing.run._initial as _initial
-    import jaxbearing.run._settle as _settle
+    import jaxbearing.run._member as _member
     import jaxbearing.run._start_cache as _start_cache
 
     _plain_skid = _initial._static_skid_start
@@ -188,7 +189,7 @@ if _COMPILE_LOG:
         per.setdefault("skid", []).append([key[:12], "read" if stored else "solved"])
         return _plain_skid(bearing, op, perturbation)
 
-    _initial._static_skid_start = _settle._static_skid_start = _logged_skid
+    _initial._static_skid_start = _member._static_skid_start = _dispatch._static_skid_start = _logged_skid
 
     import jax._src.compiler as _compiler
 

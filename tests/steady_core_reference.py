@@ -2,20 +2,47 @@
 skid start with the settling verdict, a settled 2-case x 2-seed ensemble, the steady design
 metrics, one frozen-load gradient and one iteration of the steady design search, all at reduced
 size (11 slices per raceway, 2-revolution windows). `python tests/steady_core_reference.py`
-writes `tests/data/steady_core_reference.json`; `tests/test_same_numbers.py` checks that the code
-gives them again, bit for bit (the traced computations are the same programs)."""
+writes `tests/data/steady_core_reference.json` with the setting that produced it (CPU, XLA
+flags, package versions); `tests/test_same_numbers.py` checks that the code gives them again."""
 
 from __future__ import annotations
 
 import dataclasses
 import json
+import os
 import pathlib
+import platform
 import sys
 import tempfile
 
 import numpy as np
 
 REFERENCE = pathlib.Path(__file__).parent / "data" / "steady_core_reference.json"
+
+
+def setting() -> dict:
+    """What the bits of a run depend on beyond the code: the CPU, the XLA flags, the versions."""
+    import diffrax
+    import equinox
+    import jax
+    import jaxlib
+
+    cpu = platform.processor()
+    try:
+        for line in pathlib.Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    return {
+        "cpu": cpu,
+        "xla_flags": os.environ.get("XLA_FLAGS", "").strip(),
+        "jax": jax.__version__,
+        "jaxlib": jaxlib.__version__,
+        "diffrax": diffrax.__version__,
+        "equinox": equinox.__version__,
+    }
 
 
 def _estimate(block) -> list:
@@ -26,15 +53,22 @@ def compute() -> dict:
     import jaxbearing as jb
     from jaxbearing.design import frozen_load_gradient, steady_design_metrics
     from jaxbearing.flange import DesignVariables
-    from jaxbearing.run import simulate_steady, simulate_steady_points, summarise_steady
-    from optimise import make_problem
+    from jaxbearing.run import (
+        SettleFixed,
+        SteadySettings,
+        simulate_steady,
+        simulate_steady_points,
+        summarise_steady,
+    )
     from optimise import _steady as steady
+    from optimise import make_problem
 
     b = dataclasses.replace(jb.reference_bearing(), num_slices=11)
     op = jb.reference_operating_point()
+    short = SteadySettings(settle=SettleFixed(0.005), window_revs=2, seeds=2)
     out = {}
 
-    auto = summarise_steady(simulate_steady(b, op, settle="auto", window_revs=2, seeds=1, workers=1))
+    auto = summarise_steady(simulate_steady(b, op, SteadySettings(window_revs=2)))
     out["settled_auto"] = {
         "settle_time_ms": auto["settle_time_ms"],
         "num_steps": auto["num_steps"],
@@ -44,18 +78,17 @@ def compute() -> dict:
     }
 
     op2 = dataclasses.replace(op, radial_load=np.asarray(2000.0))
-    points = simulate_steady_points(b, [op, op2], settle=0.005, window_revs=2, seeds=2, workers=1)
     out["two_cases_two_seeds"] = [
         {
             "cage_speed_rpm": _estimate(s["cage_speed_rpm"]),
             "flange_pv_mean": _estimate(s["flange_pv_Pa_m_s"]["mean"]),
             "num_steps": s["num_steps"],
         }
-        for s in map(summarise_steady, points)
+        for s in map(summarise_steady, simulate_steady_points(b, [op, op2], short))
     ]
 
     design = DesignVariables.of(b)
-    m = steady_design_metrics(b, op, design, settle=0.005, seeds=2, window_revs=2, workers=1)
+    m = steady_design_metrics(b, op, design, short)
     out["design_metrics"] = {"objective": _estimate(m.objective), "mean_pv": _estimate(m.mean_pv)}
     g = frozen_load_gradient(b, op, design, m.sample_states[:2])
     out["frozen_load_gradient"] = {"value": float(g.value), "gradient": np.asarray(g.gradient).tolist()}
@@ -76,6 +109,6 @@ if __name__ == "__main__":
     import jax
 
     jax.config.update("jax_enable_x64", True)
-    values = compute()
+    values = {"setting": setting(), **compute()}
     REFERENCE.write_text(json.dumps(values, indent=1) + "\n")
     print(json.dumps(values, indent=1), file=sys.stderr)

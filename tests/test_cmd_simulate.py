@@ -126,7 +126,7 @@ def test_solver_reaches_the_run(monkeypatch):
     seen.clear()
     with pytest.raises(SystemExit):
         main(["simulate", "--solver", "ros34pw2", "--end", "arc", "--no-progress"])
-    assert seen["solver"] == "ros34pw2"
+    assert seen["settings"].solver == "ros34pw2"  # a settled run: the solver is a setting
 
 
 def test_progress_of_a_fixed_run_keeps_the_program_cacheable(monkeypatch, capsys):

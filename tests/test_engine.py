@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 
 import jaxbearing as jb
-from jaxbearing.run import Member, SteadyOptions, settle_members, summarise_steady
+from jaxbearing.run import Member, SettleFixed, SteadySettings, settle_members, summarise_steady
 from jaxbearing.run._initial import kinematic_start
 
 SPEC = """
@@ -37,9 +37,9 @@ num_slices = 11
 end = ["arc", "corner"]
 "operating.speed_rpm" = [20000.0]
 """
-OPTIONS = SteadyOptions(window_revs=2, tolerance=2e-3)
+OPTIONS = SteadySettings(window_revs=2, tolerance=2e-3)
 #: the sweep's settling: a fixed 0.5 ms from the skid start, declared settled (module docstring)
-FIXED_SETTLE = dataclasses.replace(OPTIONS, settle=0.5)
+FIXED_SETTLE = OPTIONS.replace(settle=SettleFixed(0.5))
 
 
 @pytest.fixture(scope="module")
@@ -111,15 +111,13 @@ def test_vmapped_members_agree_with_the_sweep_within_their_intervals(settled_swe
     _, ds, _ = settled_sweep
     bearing, op = _small()
     members = [Member(bearing, op, jb.Perturbation(seed=k)) for k in range(2)]
-    engine = settle_members(members, FIXED_SETTLE, strategy="vmap")
+    engine = settle_members(members, FIXED_SETTLE.replace(strategy="vmap"))
     assert engine.strategy == "vmap" and engine.batch_times.rounds > 0
     assert all(r.settled and r.status == "ok" for r in engine.runs)
     result = jb.SteadyResult(
         runs=engine.runs,
-        settle=0.5,
-        window_revs=2,
-        tolerance=2e-3,
-        cap=0.3,
+        settings=FIXED_SETTLE,
+        settle_mode="fixed",
         start="skid",
         wall_time_s=engine.wall_time_s,
         compile_time_s=engine.compile_time_s,
@@ -145,14 +143,10 @@ def test_a_member_does_not_depend_on_its_batch_mates():
     agree to round-off. (A short run: 2 revolutions measured from the kinematic start.)"""
     bearing, op = _small()
     other = dataclasses.replace(op, inner_speed=op.inner_speed * 0.75)
-    options = dataclasses.replace(OPTIONS, settle="off", start="quasi-static")
+    options = OPTIONS.replace(settle="off", start="quasi-static", strategy="vmap")
     a = Member(bearing, op, jb.Perturbation(seed=0))
-    first = settle_members([a, Member(bearing, op, jb.Perturbation(seed=1))], options, strategy="vmap").runs[
-        0
-    ]
-    second = settle_members(
-        [Member(bearing, other, jb.Perturbation(seed=2)), a], options, strategy="vmap"
-    ).runs[1]
+    first = settle_members([a, Member(bearing, op, jb.Perturbation(seed=1))], options).runs[0]
+    second = settle_members([Member(bearing, other, jb.Perturbation(seed=2)), a], options).runs[1]
     assert first.status == second.status == "ok"
     np.testing.assert_allclose(first.revolution_speeds_rpm, second.revolution_speeds_rpm, rtol=1e-9)
     np.testing.assert_allclose(
@@ -189,7 +183,7 @@ def test_bad_settled_sweep_options_are_one_line(line, words, tmp_path, capsys):
 def test_engine_options_are_checked_in_one_line():
     bearing, op = _small()
     with pytest.raises(jb.UserInputError, match=r"^strategy = 'gpu': must be one of 'auto'"):
-        settle_members([Member(bearing, op)], OPTIONS, strategy="gpu")
+        settle_members([Member(bearing, op)], OPTIONS.replace(strategy="gpu"))
 
 
 def test_a_settled_sweep_missing_a_batch_resumes_exactly(settled_sweep, tmp_path):
@@ -248,7 +242,7 @@ def test_continuing_seeds_share_their_case_time_constant(monkeypatch):
     default) solve one static skid equilibrium per case, not one per seed: the verdict uses
     only its time constant, so both seeds' verdicts carry the same one. (A short run: from
     the quasi-static states, settling capped at 1 ms, a 2-revolution window.)"""
-    import jaxbearing.run._settle as settle
+    import jaxbearing.run._dispatch as settle
 
     bearing, op = _small()
     seeds = [jb.Perturbation(seed=k) for k in range(2)]
@@ -257,12 +251,12 @@ def test_continuing_seeds_share_their_case_time_constant(monkeypatch):
     continuing = [Member(bearing, op, p, kinematic_start(bearing, op, p)) for p in seeds]
     fresh = Member(bearing, op, jb.Perturbation(seed=5))
     assert settle._continuing_cases([fresh, *continuing], OPTIONS) == {1: 1, 2: 1}
-    assert settle._continuing_cases(continuing, dataclasses.replace(OPTIONS, settle="off")) == {}
+    assert settle._continuing_cases(continuing, OPTIONS.replace(settle="off")) == {}
     solved = []
     real = settle._static_skid_start
     monkeypatch.setattr(settle, "_static_skid_start", lambda *a: solved.append(a[2].seed) or real(*a))
-    capped = dataclasses.replace(OPTIONS, settle_cap_ms=1.0)
-    runs = settle_members(continuing, capped, strategy="sequential").runs
+    capped = OPTIONS.replace(settle_cap_ms=1.0, strategy="sequential")
+    runs = settle_members(continuing, capped).runs
     assert solved == [0]
     assert all(r.status == "ok" for r in runs)
     taus = [r.verdict.time_constant_s for r in runs]

@@ -87,7 +87,7 @@ def test_auto_settle_succeeds_and_reports_intervals(small_config, capsys):
     # the verdict, from the revolutions themselves: the settling revolutions are those before
     # the window (no projective step after a completed pre-start); the verdict holds at the last
     # of them and at no earlier one, with the run's own slow-mode time constant
-    from jaxbearing.run._settle import settling_verdict
+    from jaxbearing.run._verdict import settling_verdict
 
     speeds, ends = seed["revolution_cage_speed_rpm"], seed["revolution_end_ms"]
     n = len(speeds) - 2
@@ -211,13 +211,16 @@ def test_continuation_settles_whole_revolutions_of_its_own_cage():
     |omega_c| of the given state's cage speed, in ms (the unit of `settle`)."""
     from types import SimpleNamespace
 
-    from jaxbearing.run._settle import SteadyOptions, continuation_settle
+    from jaxbearing.run import SettleAuto, SettleFixed, SteadySettings
+    from jaxbearing.run._member import continuation_settle
 
     state = SimpleNamespace(cage=SimpleNamespace(speed=-800.0))  # rad/s; the sign is the direction
-    assert continuation_settle(SteadyOptions(settle="auto"), state) == "auto"
-    two = continuation_settle(SteadyOptions(settle="auto", continuation_settle_revs=2), state)
-    assert two == pytest.approx(2 * 2 * math.pi / 800.0 * 1e3, rel=1e-15)
-    assert continuation_settle(SteadyOptions(settle=5.0, continuation_settle_revs=0), state) == 0.0
+    assert continuation_settle(SteadySettings(settle="auto"), state) == SettleAuto()
+    two = continuation_settle(SteadySettings(settle="auto", continuation_settle_revs=2), state)
+    assert isinstance(two, SettleFixed) and two.ms == pytest.approx(2 * 2 * math.pi / 800.0 * 1e3, rel=1e-15)
+    assert continuation_settle(SteadySettings(settle=5.0, continuation_settle_revs=0), state) == SettleFixed(
+        0.0
+    )
 
 
 @pytest.mark.parametrize("value", [-1, 1.5])
@@ -254,7 +257,7 @@ def test_verdict_line_is_the_least_squares_fit():
     import numpy as np
     from scipy import stats
 
-    from jaxbearing.run._settle import VERDICT_MAX_REVS, VERDICT_MIN_REVS, settling_verdict
+    from jaxbearing.run._verdict import VERDICT_MAX_REVS, VERDICT_MIN_REVS, settling_verdict
 
     rng = np.random.default_rng(1)
     t = REV * (np.arange(12) + 0.5)
@@ -279,7 +282,7 @@ def test_verdict_slow_exponential_drift_does_not_pass():
     remaining offset A exp(-t/tau) is below half the tolerance it must."""
     import numpy as np
 
-    from jaxbearing.run._settle import settling_verdict
+    from jaxbearing.run._verdict import settling_verdict
 
     tau, plateau, tol = 0.1, 8420.0, 1e-3
     for offset, settled in ((0.005 * plateau, False), (0.4 * tol * plateau, True)):
@@ -307,7 +310,7 @@ def test_verdict_noisy_plateau_passes_in_four_to_six_revolutions():
     carries a Student-t quantile with 2 to 4 degrees of freedom)."""
     import numpy as np
 
-    from jaxbearing.run._settle import VERDICT_MIN_REVS, settling_verdict
+    from jaxbearing.run._verdict import VERDICT_MIN_REVS, settling_verdict
 
     rng = np.random.default_rng(0)
     t = REV * (np.arange(12) + 0.5)
@@ -360,7 +363,7 @@ def test_running_time_constant_is_conservative():
     static tau_s); a secant of the wrong sign is ignored."""
     from types import SimpleNamespace
 
-    from jaxbearing.run._settle import RUNNING_SLOW_MODE_FACTOR, running_time_constant
+    from jaxbearing.run._verdict import RUNNING_SLOW_MODE_FACTOR, running_time_constant
 
     def skid(tau_s, speeds=(), drifts=()):
         return SimpleNamespace(
@@ -423,10 +426,6 @@ def test_settled_options_reach_the_run(monkeypatch):
     args += ["--settle-cap-ms", "50", "--window-revs", "4", "--start", "quasi-static"]
     assert main(["simulate", "--end", "arc", *args, "--no-progress"]) == 130
     (kw,) = seen
-    assert (kw["settle"], kw["seeds"], kw["workers"]) == ("auto", 3, 2)
-    assert (kw["tolerance"], kw["settle_cap_ms"], kw["window_revs"], kw["start"]) == (
-        2e-3,
-        50.0,
-        4,
-        "quasi-static",
-    )
+    s = kw["settings"]
+    assert (s.settle, s.seeds, s.workers) == (run.SettleAuto(), 3, 2)
+    assert (s.tolerance, s.settle_cap_ms, s.window_revs, s.start) == (2e-3, 50.0, 4, "quasi-static")

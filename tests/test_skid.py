@@ -88,7 +88,8 @@ def _integrator(reference):
     """The settled run's own integrator (`solve_from` compiled with `simulate_steady`'s saves,
     step limit and tolerances), as `skid_start`'s pre-start takes it: the program of every
     11-slice settled run in the suite (tests/test_settle.py, notebook 03), compiled once."""
-    from jaxbearing.run._settle import SAVES_PER_REV, _integrator
+    from jaxbearing.run import SAVES_PER_REV
+    from jaxbearing.run._solve_from import _integrator
 
     params = Params(bearing=reference[0], operating=reference[1])
     return _integrator(params, SAVES_PER_REV, 2_000_000, 1e-3, 1e-6, [])

@@ -494,8 +494,8 @@ def test_start_up_transients_take_the_max_norm_and_settled_windows_the_per_rolle
         TRANSIENT_ERROR_NORM,
         TRANSIENT_RACEWAY_LOOSEN,
         TRANSIENT_ROTATION_LOOSEN,
-        _settle,
         _simulate,
+        _solve_from,
     )
 
     assert (TRANSIENT_ERROR_NORM, TRANSIENT_RACEWAY_LOOSEN, TRANSIENT_ROTATION_LOOSEN) == ("max", 100.0, 1.0)
@@ -511,7 +511,7 @@ def test_start_up_transients_take_the_max_norm_and_settled_windows_the_per_rolle
         built.append({k: v for k, v in bound.arguments.items() if k != "state"})
         raise Built
 
-    for module in (_simulate, _settle):
+    for module in (_simulate, _solve_from):
         original = module.raceway_normal_norm
         module.raceway_normal_norm = spy
         try:
@@ -520,7 +520,9 @@ def test_start_up_transients_take_the_max_norm_and_settled_windows_the_per_rolle
                     jax.eval_shape(lambda b: jb.run.solve(b, op, 1e-5, num_saves=2), bearing)
                 else:
                     start = kinematic_start(bearing, op, jb.Perturbation())
-                    _settle.prepare_from(jb.dynamics.Params(bearing=bearing, operating=op), start, 1e-3, 1e-6)
+                    _solve_from.prepare_from(
+                        jb.dynamics.Params(bearing=bearing, operating=op), start, 1e-3, 1e-6
+                    )
         finally:
             module.raceway_normal_norm = original
     transient, settled = ({k: v if k == "kind" else float(v) for k, v in b.items()} for b in built)

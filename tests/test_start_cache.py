@@ -15,8 +15,8 @@ import jaxbearing as jb
 import jaxbearing.run._initial as initial
 import jaxbearing.run._start_cache as start_cache
 from jaxbearing.dynamics import Functionals
-from jaxbearing.run import Perturbation
-from jaxbearing.run._settle import Member, SteadyOptions, member_steps, pre_start_key
+from jaxbearing.run import Member, Perturbation, SteadySettings
+from jaxbearing.run._member import member_steps, pre_start_key
 
 
 @pytest.fixture
@@ -54,37 +54,35 @@ def test_a_stored_static_start_is_the_solved_one_bit_for_bit(starts, monkeypatch
 
 
 def test_the_pre_start_key_moves_with_every_input_and_setting():
-    """What the pre-start's integration depends on (`_settle._integrator`) is in its key."""
+    """What the pre-start's integration depends on (`_solve_from._integrator`) is in its key."""
     b, op, p = _case()
-    options = SteadyOptions()
+    options = SteadySettings()
     base = pre_start_key(Member(b, op, p), options)
     changed = [
         pre_start_key(Member(b, op, Perturbation(seed=1)), options),
         pre_start_key(Member(b, op, dataclasses.replace(p, skew=2e-4)), options),
         pre_start_key(Member(dataclasses.replace(b, num_slices=13), op, p), options),
         pre_start_key(Member(b, op, p, rtol=5e-4), options),
-        pre_start_key(Member(b, op, p), dataclasses.replace(options, atol=1e-7)),
-        pre_start_key(
-            Member(b, op, p), dataclasses.replace(options, saves_per_rev=options.saves_per_rev + 1)
-        ),
-        pre_start_key(Member(b, op, p), dataclasses.replace(options, max_steps=options.max_steps + 1)),
-        pre_start_key(Member(b, op, p), dataclasses.replace(options, solver="ros34pw2")),
+        pre_start_key(Member(b, op, p), options.replace(atol=1e-7)),
+        pre_start_key(Member(b, op, p), options.replace(saves_per_rev=options.saves_per_rev + 1)),
+        pre_start_key(Member(b, op, p), options.replace(max_steps=options.max_steps + 1)),
+        pre_start_key(Member(b, op, p), options.replace(solver="ros34pw2")),
         pre_start_key(
             Member(b, op, p),
-            dataclasses.replace(options, functionals=Functionals(pv_exponent=1.0)),
+            options.replace(functionals=Functionals(pv_exponent=1.0)),
         ),
     ]
-    assert pre_start_key(Member(b, op, p), SteadyOptions()) == base  # deterministic
+    assert pre_start_key(Member(b, op, p), SteadySettings()) == base  # deterministic
     assert len({base, *changed}) == len(changed) + 1
     # not a setting of the pre-start: how the member settles and measures afterwards
-    assert pre_start_key(Member(b, op, p), dataclasses.replace(options, window_revs=7, settle=0.5)) == base
+    assert pre_start_key(Member(b, op, p), options.replace(window_revs=7, settle=0.5)) == base
 
 
 def test_a_member_with_a_stored_pre_start_starts_from_it(starts):
     """The member's first integration request continues from the stored start: no pre-start
     burst is integrated (its first burst would start from the static state)."""
     b, op, p = _case()
-    options = SteadyOptions(settle=0.5, window_revs=2)
+    options = SteadySettings(settle=0.5, window_revs=2)
     member = Member(b, op, p)
     static = initial._static_skid_start(b, op, p)
     moved = initial.along_slow_mode(static.state, 1.0)

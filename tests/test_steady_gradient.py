@@ -73,7 +73,8 @@ def running():
     tests/test_steady_design.py, notebook 05); then, while the first 0.1 ms from the state has
     no flange contact above 1 N, 0.5 ms more (the dynamics are chaotic: which instants have
     contact changes with the integrator's rounding, e.g. with its error norm)."""
-    from jaxbearing.run._settle import SAVES_PER_REV, _integrator
+    from jaxbearing.run import SAVES_PER_REV
+    from jaxbearing.run._solve_from import _integrator
 
     b = dataclasses.replace(jb.reference_bearing(), num_slices=11)
     op = jb.reference_operating_point()

@@ -418,3 +418,36 @@ def test_the_scheduling_tables_name_test_files():
     assert len(grouped) == len(set(grouped))
     named = set(FILE_SECONDS) | set(grouped)
     assert named <= names, named - names
+
+
+#: history in library code: a date, an issue or work-item number, a path into the one-off studies
+_HISTORY = (r"\b20\d\d-\d\d-\d\d\b", r"\b[Ii]ssue #?\d+", r"\bwork item\b", r"benchmarks/studies/")
+
+
+def _library_history(text: str) -> list[str]:
+    import re
+
+    return [line.strip() for line in text.splitlines() if any(re.search(p, line) for p in _HISTORY)]
+
+
+def test_library_code_carries_no_history():
+    """Docstrings and comments of the library say what and why, never when or in which work item:
+    no date, issue number or path into benchmarks/studies/ in jaxbearing/ or optimise/ (history
+    is the changelog's and git's). The example header of a measurements file is data."""
+    root = TESTS.parent
+    found = {}
+    for path in sorted(
+        [*root.joinpath("jaxbearing").rglob("*.py"), *root.joinpath("optimise").rglob("*.py")]
+    ):
+        lines = _library_history(path.read_text())
+        if path.name == "_measurements.py":
+            lines = [line for line in lines if not line.startswith("# test rig")]
+        if path.name == "_steady.py" and path.parent.name == "optimise":
+            lines = [line for line in lines if '"study": ' not in line]  # the clearance study's record
+        if lines:
+            found[str(path.relative_to(root))] = lines
+    assert not found, found
+    assert _library_history("measured 2026-11-26 (issue 13)\nbenchmarks/studies/x.py\nplain") == [
+        "measured 2026-11-26 (issue 13)",
+        "benchmarks/studies/x.py",
+    ]

@@ -110,10 +110,9 @@ def run(args) -> int:
     _check_out(args.out)
     steady = None
     if not args.transient:
-        from ..run import check_steady_options
+        from ..run import steady_settings
 
-        check_steady_options("auto", args.window_revs, 1, 1e-3, 300.0, {"window_revs": "--window-revs"})
-        steady = dict(settle="auto", window_revs=int(args.window_revs), seeds=1, start="skid")
+        steady = steady_settings({"window_revs": "--window-revs"}, window_revs=args.window_revs)
     print()
     results = run_cases(cfg, progress=True, steady=steady)
     summaries = {e: s for e, (_, s) in results.items()}

@@ -137,9 +137,9 @@ def _check_out(out: str | None) -> None:
         check_output_dir(out, "--out")
 
 
-def run_cases(cfg, progress: bool = True, steady: dict | None = None) -> dict:
-    """Run the configured end type(s); returns {end: (result, summary)}. `steady`: keyword
-    arguments of a settled run (`_steady.options`)."""
+def run_cases(cfg, progress: bool = True, steady=None) -> dict:
+    """Run the configured end type(s); returns {end: (result, summary)}. `steady`: the
+    `SteadySettings` of a settled run (`_steady.options`), None for a start-up transient."""
     from ..io import check_runnable
     from ..run import HostProgress, simulate, summarise
 
@@ -157,18 +157,12 @@ def run_cases(cfg, progress: bool = True, steady: dict | None = None) -> dict:
         # a fixed-duration run shows the host-side meter (`HostProgress`): the solve's own meter
         # is a host callback, which would make the program uncacheable (compiled in every process)
         meter = HostProgress() if progress and not steady else contextlib.nullcontext()
+        solver = dict(rtol=sim.rtol, atol=sim.atol, max_steps=sim.max_steps, solver=sim.solver)
         with meter:
-            res = simulate(
-                b,
-                op,
-                duration=sim.duration_ms * 1e-3,
-                rtol=sim.rtol,
-                atol=sim.atol,
-                max_steps=sim.max_steps,
-                progress=progress and bool(steady),
-                solver=sim.solver,
-                **(steady or {}),
-            )
+            if steady is None:
+                res = simulate(b, op, duration=sim.duration_ms * 1e-3, progress=False, **solver)
+            else:
+                res = simulate(b, op, settings=steady.replace(progress=progress, **solver))
         if isinstance(meter, HostProgress):
             meter.close(1.0 if res.ok else min(res.reached_time / (sim.duration_ms * 1e-3), 0.999))
         out[end] = (res, summarise(res))
@@ -242,7 +236,7 @@ def _film_line(end: str, s: dict) -> str:
     )
 
 
-def summary_document(results: dict, cfg=None, steady: dict | None = None) -> dict:
+def summary_document(results: dict, cfg=None, steady=None) -> dict:
     """summary.json: the statistics (one block, or one per end type), and what produced them
     (`jaxbearing.io.provenance`: package version, command line, the full configuration in
     engineering units, the seeds) and the unit of every quantity (`units`)."""
@@ -253,11 +247,11 @@ def summary_document(results: dict, cfg=None, steady: dict | None = None) -> dic
     if cfg is None:
         return doc
     first = next(iter(summaries.values()))
-    seeds = list(range(int(steady["seeds"]))) if steady else [0]  # fixed run: Perturbation(seed=0)
+    seeds = list(range(steady.seeds)) if steady else [0]  # fixed run: Perturbation(seed=0)
     meta = provenance(cfg, seeds=seeds)
     meta["ends"] = list(summaries)
     if steady:
-        meta["steady_options"] = dict(steady)
+        meta["steady_options"] = steady.record()
     meta["units"] = units_of(first)
     for key in ("seeds",):  # a settled run's block already lists its seeds (the same list)
         if key in doc:
@@ -268,7 +262,7 @@ def summary_document(results: dict, cfg=None, steady: dict | None = None) -> dic
     return {**doc, **meta}
 
 
-def write_outputs(out_dir: pathlib.Path, results: dict, cfg=None, steady: dict | None = None) -> None:
+def write_outputs(out_dir: pathlib.Path, results: dict, cfg=None, steady=None) -> None:
     """summary.json (`summary_document`), histories_<end>.npz and the plots into `out_dir`."""
     import numpy as np
 
@@ -282,7 +276,7 @@ def write_outputs(out_dir: pathlib.Path, results: dict, cfg=None, steady: dict |
     plot_run(out_dir, results)
 
 
-def save_outputs(prog: str, out: str, results: dict, cfg, steady: dict | None = None) -> int:
+def save_outputs(prog: str, out: str, results: dict, cfg, steady=None) -> int:
     """`write_outputs` into `out`, or into a fallback directory when that fails
     (`jaxbearing.io.write_or_fallback`); returns 0, or `EXIT_RESULTS_ELSEWHERE` after one line
     naming the fallback directory."""

@@ -15,6 +15,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..run import SteadySettings
+
 _ROWS = (
     ("flange_force_N", "flange force", "N", 1.0),
     ("flange_pressure_Pa", "peak pressure", "GPa", 1e-9),
@@ -42,19 +44,19 @@ def add_arguments(p) -> None:
     g.add_argument(
         "--window-revs",
         type=float,
-        default=8,
+        default=SteadySettings.window_revs,
         help="measurement window [cage revolutions] (default: %(default)g)",
     )
     g.add_argument(
         "--seeds",
         type=float,
-        default=1,
+        default=SteadySettings.seeds,
         help="independent seeded runs, seeds 0 .. N-1 (default: %(default)g: batch means)",
     )
     g.add_argument(
         "--settle-tolerance",
         type=float,
-        default=1e-3,
+        default=SteadySettings.tolerance,
         help="largest remaining drift of the cage speed, relative, that counts as settled: the drift of the "
         "last 4-8 revolution means times the slow mode's time constant (default: %(default)g)",
     )
@@ -66,19 +68,24 @@ def add_arguments(p) -> None:
     )
     g.add_argument(
         "--start",
-        default="skid",
+        default=SteadySettings.start,
         help='"skid" (skid equilibrium, projective steps of the cage speed) or "quasi-static" (default: %(default)s)',
     )
     g.add_argument(
-        "--settle-cap-ms", type=float, default=300.0, help="longest settling time [ms] (default: %(default)g)"
+        "--settle-cap-ms",
+        type=float,
+        default=SteadySettings.settle_cap_ms,
+        help="longest settling time [ms] (default: %(default)g)",
     )
 
 
-def options(args) -> dict | None:
-    """Keyword arguments of `simulate` for a settled run (the default), checked; None for a
-    start-up transient (`--transient` or `--settle off`). `--duration-ms` belongs to a
-    transient: given for a settled run, it is an error (one line), not silently ignored."""
+def options(args):
+    """The `SteadySettings` of a settled run (the default), checked (one line naming the
+    option); None for a start-up transient (`--transient` or `--settle off`). `--duration-ms`
+    belongs to a transient: given for a settled run, it is an error (one line), not silently
+    ignored."""
     from .._errors import UserInputError
+    from ..run import available_cpus, steady_settings
 
     transient = args.transient or args.settle == "off"
     if args.transient and args.settle not in (None, "off"):
@@ -92,39 +99,24 @@ def options(args) -> dict | None:
             f"--duration-ms = {args.duration_ms:g}: sets the length of a start-up transient; add "
             "--transient (a settled run lasts until settled, then --window-revs revolutions)"
         )
-    args.settle = "auto" if args.settle is None else args.settle
-    from ..run import check_steady_options
-
     names = {
         "settle": "--settle",
         "window_revs": "--window-revs",
         "seeds": "--seeds",
-        "tolerance": "--settle-tolerance",
-        "cap_ms": "--settle-cap-ms",
+        "settle_tolerance": "--settle-tolerance",
+        "settle_cap_ms": "--settle-cap-ms",
         "start": "--start",
         "workers": "--workers",
     }
-    from ..run import available_cpus
-
-    workers = available_cpus() if args.workers is None else args.workers
-    check_steady_options(
-        args.settle,
-        args.window_revs,
-        args.seeds,
-        args.settle_tolerance,
-        args.settle_cap_ms,
+    return steady_settings(
         names,
-        start=args.start,
-        workers=workers,
-    )
-    return dict(
-        settle=args.settle,  # "auto", "off" or a time in ms, as text: simulate_steady reads it
-        window_revs=int(args.window_revs),
-        seeds=int(args.seeds),
+        settle="auto" if args.settle is None else args.settle,
+        window_revs=args.window_revs,
+        seeds=args.seeds,
         tolerance=args.settle_tolerance,
         settle_cap_ms=args.settle_cap_ms,
         start=args.start,
-        workers=int(workers),
+        workers=available_cpus() if args.workers is None else args.workers,
     )
 
 

@@ -15,6 +15,7 @@ import csv
 import io
 import pathlib
 
+from ..run import SteadySettings
 from ._steady import _ci
 
 #: columns of validation.csv (units in the names)
@@ -68,7 +69,7 @@ def register(sub) -> None:
     p.add_argument(
         "--window-revs",
         type=float,
-        default=8,
+        default=SteadySettings.window_revs,
         help="measurement window [cage revolutions] (default: %(default)g)",
     )
     p.add_argument(
@@ -87,9 +88,10 @@ def register(sub) -> None:
 
 
 def _options(args) -> dict:
-    """The settled-run options, checked (one line naming the option)."""
+    """The settled-run options, checked (one line naming the option): the end type and the
+    `SteadySettings` of every point."""
     from .._errors import UserInputError
-    from ..run import SETTLE_CAP_MS, SETTLE_TOLERANCE, available_cpus, check_steady_options
+    from ..run import available_cpus, steady_settings
 
     if args.end not in ("arc", "corner"):
         raise UserInputError(f"--end = {args.end!r}: must be 'arc' or 'corner'")
@@ -99,16 +101,10 @@ def _options(args) -> dict:
         )
     workers = available_cpus() if args.workers is None else args.workers
     names = {"settle": "--settle", "window_revs": "--window-revs", "seeds": "--seeds", "workers": "--workers"}
-    check_steady_options(
-        args.settle, args.window_revs, args.seeds, SETTLE_TOLERANCE, SETTLE_CAP_MS, names, workers=workers
+    settings = steady_settings(
+        names, settle=args.settle, window_revs=args.window_revs, seeds=args.seeds, workers=workers
     )
-    return dict(
-        end=args.end,
-        settle=args.settle if args.settle == "auto" else float(args.settle),
-        seeds=int(args.seeds),
-        window_revs=int(args.window_revs),
-        workers=min(int(workers), int(args.seeds)),
-    )
+    return dict(end=args.end, settings=settings.replace(workers=min(settings.workers, settings.seeds)))
 
 
 def _pct(v) -> str:
@@ -161,10 +157,10 @@ def _write(directory: pathlib.Path, rows, cfg, opts, source, final: bool) -> Non
     doc = {
         "measurements": str(source),
         "end": opts["end"],
-        "settle": opts["settle"],
-        "window_revs": opts["window_revs"],
+        "settle": opts["settings"].settle.value,
+        "window_revs": opts["settings"].window_revs,
         "points": rows,
-        **provenance(cfg, seeds=list(range(opts["seeds"]))),
+        **provenance(cfg, seeds=list(range(opts["settings"].seeds))),
         "units": {
             "shaft_speed_rpm": "rpm",
             "radial_load_N": "N",
@@ -208,7 +204,7 @@ def run(args) -> int:
     rows = model_cage_speeds(
         cfg,
         points,
-        progress=not args.no_progress,
+        print_points=not args.no_progress,
         source=str(args.measurements),
         on_point=keep,
         **opts,

@@ -1,4 +1,4 @@
-"""The steady-running design objective (issue 13, item 1): what a design does in settled running.
+"""The steady-running design objective: what a design does in settled running.
 
 For a design (R_end, theta_f, Delta_bf; `flange.DesignVariables`) at one operating point,
 `steady_design_metrics` runs the bearing from the skid start until settled, measures a window of
@@ -65,6 +65,7 @@ from ..geometry import Bearing, OperatingPoint
 from ..io import require
 from ..run import (
     Perturbation,
+    SteadySettings,
     simulate_steady_points,
     student_t_interval,
     summarise_steady,
@@ -118,26 +119,17 @@ def steady_design_metrics(
     bearing: Bearing,
     op: OperatingPoint,
     design: DesignVariables,
+    settings: SteadySettings | None = None,
     *,
-    seeds: int = 4,
-    window_revs: int = 4,
-    settle="auto",
-    corner_margin: float = CORNER_MARGIN,
-    flange_load: float = DEFAULT_FLANGE_LOAD,
-    first_seed: int = 0,
     initial_states=None,
-    statistic: str = "mean",
-    **steady_kwargs,
+    **options,
 ) -> SteadyDesignMetrics:
-    """Settled flange statistics of `design` over `seeds` seeds (module docstring); further
-    keyword arguments go to `simulate_steady` (`workers`, `rtol`, `tolerance`, ...).
-    `first_seed` selects the seeds (first_seed .. first_seed + seeds - 1): a verification uses
-    seeds a search never saw. `initial_states`: continuation (module docstring)."""
-    forwarded = {
-        k: v for k, v in locals().items() if k not in ("bearing", "op", "initial_states", "steady_kwargs")
-    }
+    """Settled flange statistics of `design` over `settings.seeds` seeds (module docstring);
+    `options`: those of `steady_design_metrics_points` (`corner_margin`, `flange_load`,
+    `first_seed`, `statistic`) and keywords that change `settings`. `initial_states`:
+    continuation (module docstring)."""
     one = None if initial_states is None else [initial_states]
-    (metrics,) = steady_design_metrics_points(bearing, [op], initial_states=one, **forwarded, **steady_kwargs)
+    (metrics,) = steady_design_metrics_points(bearing, [op], design, settings, initial_states=one, **options)
     return metrics
 
 
@@ -145,22 +137,24 @@ def steady_design_metrics_points(
     bearing: Bearing,
     ops,
     design: DesignVariables | list[DesignVariables],
+    settings: SteadySettings | None = None,
     *,
-    seeds: int = 4,
-    window_revs: int = 4,
-    settle="auto",
     corner_margin: float = CORNER_MARGIN,
     flange_load: float = DEFAULT_FLANGE_LOAD,
     first_seed: int = 0,
     initial_states=None,
     statistic: str = "mean",
-    **steady_kwargs,
+    perturbation: Perturbation = Perturbation(),
+    **changes,
 ) -> list[SteadyDesignMetrics]:
     """`steady_design_metrics` at every operating point of `ops`, every point's seeds members of
     one call of the steady-running engine (`run.simulate_steady_points`: a design's whole
     envelope in one process pool, or one vmapped program on an accelerator). `design`: one
     design, or one per point (several designs in one call: every start of an iteration of a
-    design search). `initial_states`: None, or per point None or one state per seed."""
+    design search). `settings`: how the seeds settle and measure (`run.SteadySettings`, changed
+    by `changes`; its functionals are those of `statistic` unless `changes` sets them).
+    `first_seed` selects the seeds (first_seed .. first_seed + seeds - 1): a verification uses
+    seeds a search never saw. `initial_states`: None, or per point None or one state per seed."""
     ops = list(ops)
     designs = [design] * len(ops) if isinstance(design, DesignVariables) else list(design)
     if len(designs) != len(ops):
@@ -171,21 +165,14 @@ def steady_design_metrics_points(
         check_design(bearing, d)
     require("corner_margin", corner_margin, lambda v: np.isfinite(v) & (v >= 0), ">= 0 m")
     require("first_seed", first_seed, lambda v: (v >= 0) & (v == np.round(v)), "an integer >= 0")
+    changes.setdefault("functionals", _functionals(statistic))
+    settings = (settings if settings is not None else SteadySettings()).replace(**changes)
     bearings = [with_design(bearing, d.end_radius, d.layback_angle, d.axial_clearance) for d in designs]
-    pert = steady_kwargs.pop("perturbation", Perturbation())
-    pert = dataclasses.replace(pert, seed=int(first_seed))
-    steady_kwargs.setdefault("functionals", _functionals(statistic))
+    pert = dataclasses.replace(perturbation, seed=int(first_seed))
     results = simulate_steady_points(
-        bearings,
-        ops,
-        settle=settle,
-        window_revs=window_revs,
-        seeds=seeds,
-        perturbation=pert,
-        initial_states=initial_states,
-        **steady_kwargs,
+        bearings, ops, settings, initial_states=initial_states, perturbation=pert
     )
-    fn = steady_kwargs["functionals"]
+    fn = settings.functionals
     return [
         _metrics(
             result, d, np.asarray(zone_margins(b, d, flange_load=flange_load)), corner_margin, fn, statistic

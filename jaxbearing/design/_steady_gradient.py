@@ -1,4 +1,4 @@
-"""The gradient of the steady-running design objective (issue 13, item 2; docs/model.md 17).
+"""The gradient of the steady-running design objective (docs/model.md 17).
 
 Objective. The smooth mean flange PV over contact time of settled running,
 
@@ -14,7 +14,7 @@ count more.
 Why not the derivative of one long trajectory. Roller-flange impacts make the tangent dynamics
 grow: a design perturbation moves impact times, and the tangent of the state grows like
 exp(lambda t) with a finite-time Lyapunov exponent lambda of the order of 1e3-1e4 1/s here
-(`tangent_growth`, measured in benchmarks/studies/bench_steady_gradient.py). The derivative of a long
+(`tangent_growth`; docs/validation.md). The derivative of a long
 window average is then dominated by a few impacts and its variance grows like exp(2 lambda T)
 (Lea, Allen & Haine 2000, "Sensitivity analysis of the climate of a chaotic system", Tellus
 52A: 523, the same failure for the Lorenz system); the design trend is in the ensemble average.
@@ -30,9 +30,9 @@ three tangents), and differentiate the ratio estimator:
 Its standard error is the jackknife over the K samples (Efron & Stein 1981). The estimator
 neglects the slow part of the response (how the distribution of settled states moves with the
 design, e.g. the cage speed or the skew amplitude): its bias against the derivative of the
-settled mean is measured against common-random-number central differences of settled runs
-in benchmarks/studies/bench_steady_gradient.py, with the window length T and ensemble size K it
-was measured at (docs/how-to/design-search.md).
+settled mean is measured against common-random-number central differences of settled runs,
+with the window length T and ensemble size K it was measured at (docs/validation.md,
+docs/how-to/design-search.md).
 
 The tail statistic. The tail mean of PV over contact time, the mean of its worst
 1 - alpha = 5 % (the superquantile or conditional value at risk, `run.tail_mean`; the settled
@@ -98,7 +98,7 @@ STATISTICS = {
     "peak": Functionals(pv_exponent=PEAK_EXPONENT, contact_load=CONTACT_LOAD),
     "tail": STEADY_FUNCTIONALS,
 }
-#: default window of the short-window sensitivities [s] (benchmarks/studies/bench_steady_gradient.py)
+#: default window of the short-window sensitivities [s] (docs/validation.md)
 GRADIENT_WINDOW = 1.0e-3
 
 

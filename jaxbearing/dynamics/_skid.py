@@ -1,4 +1,4 @@
-"""Quasi-static skid start: the bearing's steady running speeds before the dynamic run (issue 11).
+"""Quasi-static skid start: the bearing's steady running speeds before the dynamic run.
 
 The quasi-static load distribution (`_quasistatic`, docs/model.md 12) starts every body at the
 kinematic (pure rolling) speeds. Drag, the cage lands and the pockets then slow the cage over

@@ -17,13 +17,15 @@
 - settled running: `simulate_steady` (settling detection over cage revolutions, a window,
   seeds), `simulate_steady_points` (the same at several operating points, one engine call),
   `summarise_steady`; the steady-running engine under it, `settle_members` (many
-  `Member`s, each a case and a seed, with `SteadyOptions`: one after another, one process per
+  `Member`s, each a case and a seed, with one `SteadySettings`: one after another, one process per
   core, or vmapped on accelerators, `STRATEGIES`, `choose_strategy`, `stack_trees`; an
   `EngineRun`) and `window_statistics`
   (`revolution_statistic_keys`); `solve_from` / `prepare_from` (continue from any state),
   `scaled_diffeqsolve` (diffrax's integration of the scaled state that `solve` and `solve_from`
-  run, for callers that build their own programs around it), `check_steady_options` and the
-  defaults `SETTLE_TOLERANCE`, `SETTLE_CAP_MS`;
+  run, for callers that build their own programs around it); `SteadySettings`, the one
+  definition of every setting of settled running and its defaults, with the settling modes
+  `SettleAuto`, `SettleFixed`, `SettleOff` (`settling` maps the command line's and the TOML
+  files' text onto them); a member's program speaks `Request` and `Answer` in its `Phase`s;
 - `plot_run`: the figures of one run;
 - against measurements: `model_cage_speeds` (a settled run at every measured operating point,
   the relative error with its interval) and its figure `plot_measured`;
@@ -50,10 +52,12 @@ from ._compile_cache import (
     enable_compilation_cache,
     program_cache_dir,
 )
+from ._dispatch import EngineRun, settle_members
 from ._engine import STRATEGIES, choose_strategy, stack_trees
 from ._ensemble import as_completed_map, available_cpus, parallel_map, shared_workers, simulate_ensemble
 from ._initial import STARTS, Perturbation, SkidStart, initial_state, skid_start
 from ._measured import model_cage_speeds
+from ._member import Answer, Member, Phase, Request, SeedRun
 from ._plots import plot_measured, plot_run
 from ._progress import HostProgress, SolveProgress
 from ._result import (
@@ -64,26 +68,28 @@ from ._result import (
     simulation_result,
     smooth_functionals,
 )
-from ._settle import (
+from ._settings import (
+    SAVES_PER_REV,
     SETTLE_CAP_MS,
     SETTLE_TOLERANCE,
-    WINDOW_REVS,
-    EngineRun,
-    Member,
-    SeedRun,
-    SteadyOptions,
+    SettleAuto,
+    SettleFixed,
+    SettleOff,
+    Settling,
+    SteadySettings,
+    settling,
+    steady_settings,
+)
+from ._settle import (
     SteadyResult,
-    check_steady_options,
-    prepare_from,
-    settle_members,
     simulate,
     simulate_steady,
     simulate_steady_points,
-    solve_from,
     summarise,
     summarise_steady,
 )
 from ._simulate import SolveArgs, flange_functionals, scaled_diffeqsolve, scaled_field, solve
+from ._solve_from import prepare_from, solve_from
 from ._start_cache import start_cache_dir
 from ._statistics import (
     TAIL_LEVEL,
@@ -152,7 +158,6 @@ __all__ = [
     "SteadyResult",
     "SolveArgs",
     "batch_means",
-    "check_steady_options",
     "confidence_intervals",
     "contact_events",
     "film_statistics",
@@ -183,11 +188,20 @@ __all__ = [
     "summarise_steady",
     "EngineRun",
     "Member",
-    "SteadyOptions",
+    "SteadySettings",
+    "SettleAuto",
+    "SettleFixed",
+    "SettleOff",
+    "Settling",
+    "settling",
+    "steady_settings",
+    "SAVES_PER_REV",
+    "Answer",
+    "Request",
+    "Phase",
     "STRATEGIES",
     "choose_strategy",
     "stack_trees",
-    "WINDOW_REVS",
     "settle_members",
     "simulate_steady_points",
     "revolution_statistic_keys",

@@ -110,12 +110,9 @@ def enable_compilation_cache(directory: str | os.PathLike | None = None) -> Path
         return None  # an unwritable cache location must not stop the model from running
     jax.config.update("jax_compilation_cache_dir", str(path))
     # every program, down to the single operations that eager code compiles one by one (30-50 ms
-    # each, thousands in a session): a second process compiles none of them again. Measured
-    # (2026-11-26, one core, the test processes' XLA flags): `taskset -c 1 pytest -q
-    # tests/test_contact_hertz.py tests/test_raceway.py tests/test_flange_contact.py` twice in an
-    # empty JAXBEARING_CACHE_DIR: the second run 42.3 s with JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS=1
-    # (programs above 1 s only), 20.0 s without it (every program); the first, cold run 58.4 and
-    # 55.7 s. A user's own JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS wins.
+    # each, thousands in a session): a second process compiles none of them again, about half the
+    # time of eager-heavy test files (docs/performance.md). A user's own
+    # JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS wins.
     if MIN_COMPILE_TIME_ENV not in os.environ:
         jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.0)
     return path

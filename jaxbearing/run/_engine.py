@@ -1,7 +1,7 @@
 """The steady-running engine's drivers: many members' runs as programs of integration requests,
 driven one at a time, one process per core, or together as one vmapped program (docs/model.md 16).
 
-A settled run (`_settle.member_steps`) is written once, as a Python generator: it yields an
+A settled run (`_member.member_steps`) is written once, as a Python generator: it yields an
 integration request `(state, duration)` (continue the dynamics from `state` for `duration`
 seconds), is sent the answer `(histories, final state, result code, steps)` of `solve_from`, and
 makes every host-side decision between requests itself (the skid start's pre-start bursts,
@@ -92,7 +92,7 @@ def batched_program(
     """`vmap(solve_from)` over stacked (params, state, duration, rtol, atol) with leading axis a
     multiple of len(devices), compiled: on one device the plain vmap (`compiled_program`: traced
     once per machine), on several `jax.shard_map` over the mesh axis "members". `solve_from`:
-    the integrator one member at a time uses (`_settle.solve_from`)."""
+    the integrator one member at a time uses (`_solve_from.solve_from`)."""
 
     def one(p, s, d, r, a):
         return solve_from(p, s, d, num_saves=num_saves, rtol=r, atol=a, max_steps=max_steps, solver=solver)

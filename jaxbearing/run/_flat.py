@@ -1,4 +1,4 @@
-"""The explicit solve on one flat vector (issue 12).
+"""The explicit solve on one flat vector.
 
 diffrax applies its stage sums, error estimate, interpolation and error norm leaf by leaf. The
 scaled `State` has 22 leaves (the rollers' coordinates, the cage, the inner ring and the

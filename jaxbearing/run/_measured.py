@@ -15,7 +15,8 @@ from __future__ import annotations
 import math
 
 from .._errors import UserInputError
-from ._settle import SETTLE_CAP_MS, SETTLE_TOLERANCE, WINDOW_REVS, simulate_steady, summarise_steady
+from ._settings import SteadySettings
+from ._settle import simulate_steady, summarise_steady
 
 
 def _point_config(cfg, point, source: str):
@@ -35,15 +36,10 @@ def _point_config(cfg, point, source: str):
 def model_cage_speeds(
     cfg,
     points,
+    settings: SteadySettings | None = None,
     *,
     end: str = "arc",
-    settle="auto",
-    seeds: int = 2,
-    window_revs: int = WINDOW_REVS,
-    tolerance: float = SETTLE_TOLERANCE,
-    settle_cap_ms: float = SETTLE_CAP_MS,
-    workers: int = 1,
-    progress: bool = False,
+    print_points: bool = False,
     source: str = "measurements",
     on_point=None,
 ) -> list[dict]:
@@ -51,36 +47,32 @@ def model_cage_speeds(
     `measured_cage_speed_rpm`, `model_cage_speed_rpm` ({value, ci95_low, ci95_high}),
     `relative_error` ((model - measured) / measured, with `relative_error_ci95_low/high` from
     the model's interval), `measurement_inside_ci`, `kinematic_cage_speed_rpm`, `cage_slip`,
-    `settled`, `settle_time_ms`, `window_ms`, `status`, `line`. `end`: "arc" or "corner" (flat
-    ends with the corner radius). Every point's configuration is checked before the first run.
-    `on_point(row)` is called as each point finishes (to keep finished work)."""
+    `settled`, `settle_time_ms`, `window_ms`, `status`, `line`. `settings`: how each point is
+    settled and measured (`SteadySettings`; the configuration's solver options replace its
+    tolerances, step limit and solver). `end`: "arc" or "corner" (flat ends with the corner
+    radius). `print_points`: a line as each point starts. Every point's configuration is checked
+    before the first run. `on_point(row)` is called as each point finishes (to keep finished
+    work)."""
     if end not in ("arc", "corner"):
         raise UserInputError(f"end = {end!r}: must be 'arc' or 'corner'")
+    settings = settings if settings is not None else SteadySettings()
     configs = [_point_config(cfg, p, source) for p in points]  # every point checked before any run
     rows = []
     for point, pcfg in zip(points, configs):
         bearing = pcfg.bearing()
         bearing = bearing.with_flat_ends() if end == "corner" else bearing
         sim = pcfg.simulation
-        if progress:
+        if print_points:
+            n = settings.seeds
             print(
                 f"[line {point.line}] {point.shaft_speed_rpm:g} rpm, {point.radial_load_N:g} N: settled run "
-                f"({seeds} seed{'s' if seeds != 1 else ''}) ...",
+                f"({n} seed{'s' if n != 1 else ''}) ...",
                 flush=True,
             )
         result = simulate_steady(
             bearing,
             pcfg.operating_point(),
-            settle=settle,
-            window_revs=window_revs,
-            seeds=seeds,
-            tolerance=tolerance,
-            settle_cap_ms=settle_cap_ms,
-            rtol=sim.rtol,
-            atol=sim.atol,
-            max_steps=sim.max_steps,
-            solver=sim.solver,
-            workers=workers,
+            settings.replace(rtol=sim.rtol, atol=sim.atol, max_steps=sim.max_steps, solver=sim.solver),
         )
         s = summarise_steady(result)
         est = s.get("cage_speed_rpm") or {}

@@ -1,4 +1,4 @@
-"""A linearly implicit Rosenbrock-W solver with a per-roller block-diagonal Jacobian (issue 12).
+"""A linearly implicit Rosenbrock-W solver with a per-roller block-diagonal Jacobian.
 
 Why. The explicit solve (Tsit5) of the whole bearing is held by the roller's vibration between
 its raceways (about 62 kHz, eigenvalue -5.6e4 +- 3.9e5 i at the reference point; unloaded

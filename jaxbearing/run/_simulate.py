@@ -9,7 +9,7 @@
   `dynamics.SCALED_UNITS`, docs/model.md 13), except that the raceway-normal coordinates
   (roller radial position and velocity, inner-ring centre) have tolerances `raceway_loosen` =
   100 times looser (their 62 kHz ringing need not be resolved to rtol) under the max norm
-  (`_step_control.TRANSIENT_ERROR_NORM`). Settled windows (`_settle.prepare_from`) loosen them
+  (`_step_control.TRANSIENT_ERROR_NORM`). Settled windows (`_solve_from.prepare_from`) loosen them
   10 times and the rotations 10 times under the largest RMS of a body's coordinates, which is
   faster there and wrong in the start-up transient (spurious roller-corner impacts);
   `max_steps` explicit. `solver="ros34pw2"` selects the linearly implicit
@@ -249,8 +249,7 @@ def solve(
     `optimistix.rms_norm`) replaces it. This is the error control of start-up transients; the
     settled windows' (`prepare_from`) is `error_norm="body_rms", raceway_loosen=10,
     rotation_loosen=10`, which in a start-up transient gives spurious roller-corner impacts
-    (`TRANSIENT_ERROR_NORM`). It was the default here too from 2026-11-25 (second session) to
-    the third.
+    (`TRANSIENT_ERROR_NORM`).
     `solver` (static): "tsit5" (default, explicit) or "ros34pw2" (linearly implicit
     Rosenbrock-W with every roller's Jacobian block implicit, `_rosenbrock`; slower at the
     tolerances measured so far: docs/performance.md).

@@ -16,14 +16,14 @@ would return, bit for bit:
 - every array of the inputs (bytes, dtype and shape) and their pytree structure: the bearing,
   the operating point, the seed and amplitudes of the scatter; for the pre-start also the
   functionals, the tolerances, the saves per revolution, the step cap and the solver, which
-  define the integration it runs (`_settle._integrator`);
+  define the integration it runs (`_solve_from._integrator`);
 - a digest of jaxbearing's source and of the versions of every package traced into the programs
   that solve it (`_compile_cache._code_digest`): a start of other code is never read;
 - the backend and device kind, 64-bit mode and `XLA_FLAGS` as this process started with them:
   XLA's options may change the last digits of a compiled program's results.
 
 Only the one-at-a-time path reads and writes starts (`_initial._static_skid_start`, and the
-pre-start of a member run in this process or one worker process, `_settle._run_one`); the
+pre-start of a member run in this process or one worker process, `_dispatch._run_one`); the
 vmapped members' starts (`static_skid_starts`, the batched pre-start) come from other programs,
 whose roundings differ in the last digits, and are never mixed with these.
 

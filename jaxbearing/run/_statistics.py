@@ -1,4 +1,4 @@
-"""Statistics of settled running with 95 % confidence intervals (issue 11, docs/model.md 16).
+"""Statistics of settled running with 95 % confidence intervals (docs/model.md 16).
 
 A dynamic run is a correlated time series: consecutive contact events and cage-speed samples are
 not independent, so the naive standard error of all samples is far too small. Two estimators:

@@ -7,7 +7,7 @@ norm decides which degrees of freedom the step size is spent on.
 The max norm over every component (`optimistix.max_norm`, jaxbearing's old default) lets the
 fastest mode of the model set the step: the radial vibration of a loaded roller between its
 raceways (about 62 kHz at the reference point, eigenvalue -5.6e4 +- 3.9e5 i; micrometre
-amplitude; issue 12). Its error estimate reaches the tolerance at steps of about 2-4 us, while
+amplitude). Its error estimate reaches the tolerance at steps of about 2-4 us, while
 the flange statistics do not depend on resolving its phase.
 
 `RacewayNormalNorm` weights the raceway-normal coordinates of every roller (radial position
@@ -20,7 +20,7 @@ cannot exceed the stability limit, about 7.5 us for Tsit5); what is no longer pa
 resolving its phase to rtol.
 
 Two error controls, one per kind of run:
-- settled windows (`_settle.prepare_from`: settled `simulate`, the steady design search, the
+- settled windows (`_solve_from.prepare_from`: settled `simulate`, the steady design search, the
   settled benchmark) take `DEFAULT_ERROR_NORM` = "body_rms" with `RACEWAY_NORMAL_LOOSEN` = 10
   and `ROTATION_LOOSEN` = 10 (below);
 - start-up transients (`solve`: fixed-duration runs, sweeps, trajectory gradients) take
@@ -36,8 +36,8 @@ sqrt(12) = 3.5 when it alone errs), while the several coordinates of one roller 
 the step under the max norm (docs/performance.md) share one tolerance. Chosen by the settled
 work-precision benchmark and by the peak-PV check of `benchmarks/results/diagnose_error_norms.json`
 (docs/performance.md; docs/model.md 13):
-- "max", the max norm over every coordinate (the default until 2026-11-25, with the
-  raceway-normal tolerances 100x looser): every statistic agrees with a tight reference;
+- "max", the max norm over every coordinate (with the raceway-normal tolerances 100x looser,
+  the error control of start-up transients): every statistic agrees with a tight reference;
 - "rms", the RMS over all 328 coordinates of the bodies (SciPy's and diffrax's default
   norm): 1.7x fewer evaluations than "max" in settled running, but the p95 flange PV failed
   against the reference on seeds not used to choose it, and the smooth peak PV of a start-up
@@ -164,7 +164,7 @@ DEFAULT_ERROR_NORM = "body_rms"
 
 #: The error control of start-up transients (`solve`: fixed-duration runs, sweeps, trajectory
 #: gradients): the max norm with the raceway-normal tolerances 100x looser, the rotations not
-#: loosened (the default of every solve until 2026-11-25). The settled windows' error control
+#: loosened. The settled windows' error control
 #: (`DEFAULT_ERROR_NORM`, `RACEWAY_NORMAL_LOOSEN`, `ROTATION_LOOSEN`; `prepare_from`) takes
 #: 1.4x fewer steps on the 4 ms start-up transient, but there, with only the step sequence
 #: changed (8 runs at rtols 1 % apart), 5 of 8 runs hold a roller-corner impact on the flange

@@ -278,20 +278,6 @@ def case_members(spec: SweepSpec, case: int) -> list:
     ]
 
 
-def steady_options(spec: SweepSpec):
-    """The `run.SteadyOptions` of a settled sweep."""
-    from ..run import SteadyOptions
-
-    return SteadyOptions(
-        settle=spec.settle,
-        window_revs=spec.window_revs,
-        tolerance=spec.settle_tolerance,
-        settle_cap_ms=spec.settle_cap_ms,
-        start=spec.start,
-        max_steps=spec.base.simulation.max_steps,
-    )
-
-
 def settle_batch(spec: SweepSpec, cases: Sequence[int], devices: Sequence | None = None) -> dict:
     """Settle and measure the cases `cases` (every seed of each a member of one call of the
     steady-running engine, `run.settle_members`: vmapped over `devices` on an accelerator, one
@@ -299,9 +285,7 @@ def settle_batch(spec: SweepSpec, cases: Sequence[int], devices: Sequence | None
     from ..run import settle_members
 
     members = [m for c in cases for m in case_members(spec, int(c))]
-    engine = settle_members(
-        members, steady_options(spec), devices=devices, reduce=_SweepReduce(spec.max_positions)
-    )
+    engine = settle_members(members, spec.steady, devices=devices, reduce=_SweepReduce(spec.max_positions))
     rows = []
     for k, case in enumerate(cases):
         runs = engine.runs[k * spec.seeds : (k + 1) * spec.seeds]

@@ -146,7 +146,7 @@ def build_spec(data: Mapping[str, Any], base_dir: str | os.PathLike | None = Non
 def _settled_fields(sweep: Mapping[str, Any]) -> dict[str, Any]:
     """The settled-running fields of [sweep] (`SETTLED_DEFAULTS`), checked as `jaxbearing
     simulate` checks its options: a bad value is one line naming the key."""
-    from ..run import check_steady_options
+    from ..run import steady_settings
 
     got = {k: sweep.get(k, v) for k, v in SETTLED_DEFAULTS.items()}
     for key, value in got.items():
@@ -158,14 +158,18 @@ def _settled_fields(sweep: Mapping[str, Any]) -> dict[str, Any]:
         raise SweepSpecError(
             "sweep.settle", f'{format_value(settle)} must be "auto", "off" or a settling time >= 0 ms'
         )
-    check_steady_options(
-        settle,
-        got["window_revs"],
-        got["seeds"],
-        got["settle_tolerance"],
-        got["settle_cap_ms"],
+    names = {
+        k: f"sweep.{k}"
+        for k in ("settle", "seeds", "window_revs", "settle_tolerance", "settle_cap_ms", "start")
+    }
+    steady_settings(
+        names,
+        settle=settle,
+        window_revs=got["window_revs"],
+        seeds=got["seeds"],
+        tolerance=got["settle_tolerance"],
+        settle_cap_ms=got["settle_cap_ms"],
         start=got["start"],
-        prefix="sweep.",
     )
     return {
         "settle": settle if isinstance(settle, str) else float(settle),

@@ -82,6 +82,7 @@ import numpy as np
 
 from .._errors import UserInputError
 from ..io import Config, format_value
+from ..run import SteadySettings
 
 #: format version of the batch files and the dataset (2: settled running and its options)
 FORMAT_VERSION = 2
@@ -109,13 +110,14 @@ _SWEEP_FIELDS = (
     "start",
 )
 #: the settled-running fields of [sweep] and their defaults (those of `jaxbearing simulate`)
+#: the settled-running keys of [sweep] and their defaults: those of `run.SteadySettings`
 SETTLED_DEFAULTS = {
-    "settle": "auto",
-    "seeds": 1,
-    "window_revs": 8,
-    "settle_tolerance": 1e-3,
-    "settle_cap_ms": 300.0,
-    "start": "skid",
+    "settle": SteadySettings.settle.value,
+    "seeds": SteadySettings.seeds,
+    "window_revs": SteadySettings.window_revs,
+    "settle_tolerance": SteadySettings.tolerance,
+    "settle_cap_ms": SteadySettings.settle_cap_ms,
+    "start": SteadySettings.start,
 }
 _RANGE_FIELDS = ("start", "stop", "num")
 
@@ -156,12 +158,25 @@ class SweepSpec:
     num_saves: int = 400
     max_positions: int = 500
     #: settled running (`SETTLED_DEFAULTS`; module docstring)
-    settle: object = "auto"
-    seeds: int = 1
-    window_revs: int = 8
-    settle_tolerance: float = 1e-3
-    settle_cap_ms: float = 300.0
-    start: str = "skid"
+    settle: object = SETTLED_DEFAULTS["settle"]
+    seeds: int = SETTLED_DEFAULTS["seeds"]
+    window_revs: int = SETTLED_DEFAULTS["window_revs"]
+    settle_tolerance: float = SETTLED_DEFAULTS["settle_tolerance"]
+    settle_cap_ms: float = SETTLED_DEFAULTS["settle_cap_ms"]
+    start: str = SETTLED_DEFAULTS["start"]
+
+    @property
+    def steady(self) -> SteadySettings:
+        """How every case's members settle and measure (its step limit the configuration's)."""
+        return SteadySettings(
+            settle=self.settle,
+            seeds=self.seeds,
+            window_revs=self.window_revs,
+            tolerance=self.settle_tolerance,
+            settle_cap_ms=self.settle_cap_ms,
+            start=self.start,
+            max_steps=self.base.simulation.max_steps,
+        )
 
     @property
     def settled(self) -> bool:
