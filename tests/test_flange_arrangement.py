@@ -130,7 +130,10 @@ def test_validate_bearing_checks_the_presence_pytree():
         validate_bearing(_with_presence(b, [1.0, 0.5, 1.0, 1.0]))
     msg = str(exc.value)
     assert "\n" not in msg
-    assert msg == "bearing.type (flange presence): 0.5 is out of range: must be 1.0 (there) or 0.0 (absent)"
+    assert (
+        msg
+        == "bearing.type: presence of flange inner+X = 0.5 is out of range: must be 1.0 (there) or 0.0 (absent)"
+    )
     with pytest.raises(
         ConfigError, match=r'^bearing.type: \["inner-X", "outer-X"\] has no flange on the \+X'
     ):

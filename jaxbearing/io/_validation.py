@@ -196,7 +196,7 @@ def validate_bearing(bearing, op=None, *, traced: str = "error") -> None:
         if k.kind is bool and k.path != "operating.gravity":
             _check_switch(k.path, np.broadcast_to(arrays[k.path].astype(float), shape), shape)
     for path, a in vectors.items():  # flange presence: 1.0 (there) or 0.0 (absent)
-        _check_switch(f"{path} (flange presence)", a, shape, ("there", "absent"))
+        _check_presence(path, a, shape)
     for idx in np.ndindex(shape):
         values = dict(REFERENCE_VALUES)
         for k in keys:
@@ -229,16 +229,29 @@ def _check_gravity(g: np.ndarray, shape: tuple) -> None:
         )
 
 
-def _check_switch(path: str, v: np.ndarray, shape: tuple, words: tuple[str, str] = ("true", "false")) -> None:
-    """Every element of `v` (batch `shape`, then any axes of the key's own) is 1.0 or 0.0."""
+def _check_switch(path: str, v: np.ndarray, shape: tuple) -> None:
     bad = ~((v == 0.0) | (v == 1.0))
     if bad.any():
         idx = tuple(int(i) for i in np.argwhere(bad)[0])
-        where = f"(batch element {idx[: len(shape)]}) " if shape else ""
+        where = f"(batch element {idx}) " if shape else ""
+        raise ConfigError(
+            path, f"{where}{format_value(float(v[idx]))} is out of range: must be 1.0 (true) or 0.0 (false)"
+        )
+
+
+def _check_presence(path: str, v: np.ndarray, shape: tuple) -> None:
+    """Each flange's presence (`Bearing.flange_presence`, last axis in the order `FLANGES`,
+    after the batch `shape`) is 1.0 (there) or 0.0 (absent)."""
+    from ..geometry import FLANGES
+
+    bad = ~((v == 0.0) | (v == 1.0))
+    if bad.any():
+        idx = tuple(int(i) for i in np.argwhere(bad)[0])
+        where = f"(batch element {idx[:-1]}) " if shape else ""
         raise ConfigError(
             path,
-            f"{where}{format_value(float(v[idx]))} is out of range: must be 1.0 ({words[0]}) "
-            f"or 0.0 ({words[1]})",
+            f"{where}presence of flange {FLANGES[idx[-1]]} = {format_value(float(v[idx]))} is out of "
+            "range: must be 1.0 (there) or 0.0 (absent)",
         )
 
 
