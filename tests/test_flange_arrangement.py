@@ -266,3 +266,23 @@ def test_nj_carries_an_axial_load_along_x_as_nup_does():
         assert np.array_equal(np.asarray(h), np.asarray(nj.histories[name]), equal_nan=True), name
     late = q_nj[-SAVES // 5 :].sum(axis=1).mean(axis=0)
     assert late[0] > 100.0 and late[3] > 100.0 and late[2] == 0.0
+
+
+def test_design_zone_is_the_same_for_every_flange():
+    """The aligned roller seated on either raceway against either side: contact radius and
+    height, interference and principal radii identical to the last bit, so the design zone
+    (computed at the inner +X flange) holds for whichever flanges a type has."""
+    from jaxbearing.flange import flange_geometry
+
+    b = jb.reference_bearing()
+    x, ring = jnp.array([1.0, 0.0, 0.0]), jnp.zeros(3)
+    d = b.roller.diameter
+    seats = [(b.inner_raceway_radius, 1.0, b.inner_raceway_radius + d / 2)] * 2
+    seats += [(b.outer_raceway_radius, -1.0, b.outer_raceway_radius - d / 2)] * 2
+    fields = ("contact_radius", "contact_height", "interference", "radius_meridian", "radius_parallel")
+    rows = []
+    for (radius, ring_sign, centre), side in zip(seats, (-1.0, 1.0, -1.0, 1.0)):
+        geo = flange_geometry(b, radius, side, ring_sign, jnp.array([0.0, 0.0, 1.0]) * centre, x, ring)
+        rows.append([float(getattr(geo, f)) for f in fields])
+    assert all(row == rows[0] for row in rows), rows
+    assert rows[0][1] == float(jb.design_zone(b).contact_height)
