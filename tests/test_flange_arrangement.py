@@ -74,7 +74,10 @@ def test_toml_round_trip(arrangement):
     [
         ('"NX"', '"NX" is not one of "NUP", "NU", "N", "NJ" or a list of distinct names from "inner-X"'),
         ('"nu"', '"nu" is not one of "NUP", "NU", "N", "NJ"'),
-        ('["outer-X", "outer+Y"]', '"outer+Y" is not one of "NUP"'),
+        (
+            '["outer-X", "outer+Y"]',
+            '"outer+Y" is not one of the names "inner-X", "inner+X", "outer-X", "outer+X"',
+        ),
         ('["outer-X", "outer-X", "outer+X"]', 'names "outer-X" twice'),
         (
             '["outer-X", "inner-X"]',

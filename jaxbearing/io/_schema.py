@@ -179,9 +179,9 @@ def _axial_load_carried(v) -> str | None:
     (`geometry.carries_axial_load`). A floating bearing (NU, N; NJ along -X) carries none: in a
     machine the shaft's locating bearing does, and the ring would slide away here."""
     f, t = v["operating.axial_load_N"], v["bearing.type"]
-    if f == 0.0 or carries_axial_load(flange_presence(t), f):
-        return None
     presence = flange_presence(t)
+    if f == 0.0 or carries_axial_load(presence, f):
+        return None
     need = '"inner-X" and "outer+X"' if f > 0 else '"inner+X" and "outer-X"'
     valid = {(True, False): ">= 0", (False, True): "<= 0"}.get(
         (carries_axial_load(presence, 1.0), carries_axial_load(presence, -1.0)), "0"

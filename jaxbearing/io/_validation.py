@@ -112,7 +112,9 @@ def _check_members(key: Key, v: tuple) -> None:
     unknown = [m for m in v if m not in key.members]
     if unknown:
         raise ConfigError(
-            key.path, f"{format_value(v)}: {format_value(unknown[0])} is not {key.range_text()}"
+            key.path,
+            f"{format_value(v)}: {format_value(unknown[0])} is not one of the names "
+            + ", ".join(format_value(m) for m in key.members),
         )
     twice = [m for m in v if v.count(m) > 1]
     if twice:
