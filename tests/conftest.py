@@ -45,6 +45,7 @@ FILE_SECONDS = {
     "test_validate.py": 25,
     "test_sweep.py": 24,
     "test_dynamics.py": 23,
+    "test_flange_arrangement.py": 21,  # one process, the full-size simulate program compiled
     "test_quasistatic.py": 19,
     "test_flange_lubrication.py": 18,
     "test_misalignment.py": 17,
@@ -66,7 +67,7 @@ FILE_SECONDS = {
 #: 0-2 of the 11-slice reference that its settled ensemble stored (the start cache,
 #: `jaxbearing.run._start_cache`) and loads its frozen-load programs.
 #: test_cmd_simulate compiles the full-size `simulate` with 4000 saves, which test_dynamics,
-#: test_misalignment_trend, test_outputs and notebooks 01 and 02 (in the first group, which
+#: test_misalignment_trend, test_flange_arrangement, test_outputs and notebooks 01 and 02 (in the first group, which
 #: reaches them after test_settle and test_steady_gradient) load; test_outputs compiles the reference sweep batch, which
 #: test_sweep and test_sweep_distributed load.
 PROGRAM_GROUPS = (
@@ -75,6 +76,7 @@ PROGRAM_GROUPS = (
         "test_cmd_simulate.py",
         "test_dynamics.py",
         "test_misalignment_trend.py",
+        "test_flange_arrangement.py",
         "test_outputs.py",
         "test_sweep.py",
         "test_sweep_distributed.py",

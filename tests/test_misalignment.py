@@ -225,6 +225,35 @@ def test_axial_load_is_carried_by_the_inner_flanges():
     assert np.all(np.asarray(loads.flange.force_on_roller)[:, 0, 0] > 0)
 
 
+def test_nu_inner_ring_floats_under_axial_load():
+    """The same axial load on an NU bearing (`bearing.type = "NU"`: no inner flanges; the
+    configuration rejects it, docs/model.md 5.3, so this is the model's own answer): at every
+    axial position of the ring, from centred to 0.3 mm, its inner flanges exert exactly nothing
+    and the ring's axial force is F_a plus the raceways' axial traction alone, positive
+    throughout: no position balances it, the ring floats. The NUP at 0.3 mm pushes it back."""
+    b = jb.reference_bearing()
+    nu = eqx.tree_at(lambda b: b.flange_presence, b, jnp.array([0.0, 0.0, 1.0, 1.0]))
+    f_a = 300.0
+    op = _op(axial_load=f_a, axial_freedom=1)
+    y = kinematic_start(b, op, jb.Perturbation(axial=0.0, skew=0.0))  # no scatter
+
+    def axial(bearing, x):
+        s = eqx.tree_at(lambda s: s.inner_ring.axial, y, jnp.asarray(x, dtype=float))
+        params = Params(bearing=bearing, operating=op)
+        return float(_rates(0.0, s, params).inner_ring.axial_velocity * b.inner_ring_mass), _loads(s, params)
+
+    for x in (0.0, 0.1e-3, 0.2e-3, 0.3e-3):
+        net, loads = axial(nu, x)
+        fl = loads.flange
+        assert np.all(np.asarray(fl.normal_force)[:, :2] == 0.0)
+        assert np.all(np.asarray(fl.force_on_ring)[:, :2] == 0.0)
+        raceway = float(np.sum(np.asarray(loads.inner.force_on_ring)[:, 0]))
+        assert net == pytest.approx(f_a + raceway, rel=1e-12)
+        assert net > 0.99 * f_a
+    net_nup, loads_nup = axial(b, 0.3e-3)
+    assert net_nup < 0 and np.sum(np.asarray(loads_nup.flange.force_on_ring)[:, 0, 0]) < -f_a
+
+
 def test_axial_and_tilt_rates_follow_the_equations():
     """x_i'' = F.X / m_i and the gyroscopic tilt coupling I_t psi'' = M_perp + I_a omega_i (-psi_z', psi_y')."""
     b = jb.reference_bearing()

@@ -174,6 +174,18 @@ def bad_pytrees(draw, op_fields: bool = True):
         )
     elif key.kind is bool:  # a switch: anything but 0.0 and 1.0
         value = draw(st.one_of(st.floats().filter(lambda x: x not in (0.0, 1.0)), st.just(math.nan)))
+    elif key.convert is not None:  # the flanges of bearing.type, in the pytree: presence per flange
+        side_bare = [(0.0, a, 0.0, b) for a in (0.0, 1.0) for b in (0.0, 1.0)]
+        side_bare += [(a, 0.0, b, 0.0) for a in (0.0, 1.0) for b in (0.0, 1.0)]
+        value = draw(
+            st.one_of(
+                st.sampled_from(side_bare),  # a side without flanges: the rollers not located
+                st.lists(st.floats(), min_size=4, max_size=4).filter(
+                    lambda v: any(x not in (0.0, 1.0) for x in v)
+                ),
+            )
+        )
+        return eqx.tree_at(lambda b: b.flange_presence, BEARING, np.asarray(value, dtype=float)), OP, key.path
     else:
         value = draw(_config_value_invalid(key))
     bearing, op = _with_value(BEARING, OP, key, value)

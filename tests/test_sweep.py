@@ -113,6 +113,7 @@ BAD_SPECS = [
     ('"bearing.num_rollers" = [20, 26]', "bearing.num_rollers", "changes array shapes"),
     ('"simulation.max_steps" = [10, 20]', "simulation.max_steps", "static"),
     ('"bearing.flange_lubrication" = ["dry", "mixed"]', "bearing.flange_lubrication", "static"),
+    ('"bearing.type" = ["NU", "NUP"]', "bearing.type", "one sweep per type"),
     ('end = ["arc", "flat"]', "end", "not a roller end type"),
     ('"operating.speed_rpm" = [1e4, 1e4]', "operating.speed_rpm", "appears twice"),
 ]

@@ -3,7 +3,8 @@
 - flange face and end pose: `flange_geometry` (tangent plane of the flange cone at the roller's
   azimuth, extreme point of the end body, interference, contact height, principal radii);
 - the contact: `roller_flange_contact` (one roller, one flange), `all_flange_contacts` (every
-  roller against the four flanges, shape (Z, 4)), `FlangeContact`;
+  roller against the four flanges, shape (Z, 4); absent flanges of the bearing type carry
+  nothing, `without_absent_flanges`), `FlangeContact`;
 - its lubrication: `contact_point_velocity`, `flange_film` (entrainment, Hamrock-Dowson film,
   Lambda), `FlangeFilm`, `flange_friction_coefficient` (dry or mixed, `FLANGE_LUBRICATION_MODES`);
 - the static design zone of an aligned roller: `design_zone`, `design_zone_grid`, `DesignZone`,
@@ -18,7 +19,13 @@ May import: `jaxbearing._errors`, `contact`, `geometry`, `io`.
 """
 
 from ._checks import DEFAULT_FLANGE_LOAD, check_design
-from ._contact import FLANGE_ORDER, FlangeContact, all_flange_contacts, roller_flange_contact
+from ._contact import (
+    FLANGE_ORDER,
+    FlangeContact,
+    all_flange_contacts,
+    roller_flange_contact,
+    without_absent_flanges,
+)
 from ._design import DesignVariables, with_design
 from ._geometry import FlangeGeometry, flange_effective_modulus, flange_geometry
 from ._lubrication import (
@@ -51,5 +58,6 @@ __all__ = [
     "flange_geometry",
     "roller_flange_contact",
     "with_design",
+    "without_absent_flanges",
     "zone_margins",
 ]

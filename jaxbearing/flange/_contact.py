@@ -245,6 +245,9 @@ def all_flange_contacts(
     (-X/+X: the side along each ring's own axis, X unless `inner_ring_axis` /
     `outer_ring_axis` is given).
     Lifted with `jax.vmap` over flanges and rollers (no Python loop over rollers).
+
+    Absent flanges (`Bearing.flange_presence` k_f = 0, the bearing type; docs/model.md 5.3)
+    carry nothing: `without_absent_flanges`.
     """
     ring_sign = jnp.array([f[0] for f in FLANGE_ORDER])
     side = jnp.array([f[1] for f in FLANGE_ORDER])
@@ -261,7 +264,7 @@ def all_flange_contacts(
         return roller_flange_contact(bearing, rad, sd, sg, p, e, v, w, c, vr, wr, ring_axis=ar)
 
     per_roller = jax.vmap(one, in_axes=(0,) * 7 + (None,) * 4)
-    return jax.vmap(per_roller, in_axes=(None,) * 7 + (0, 0, 0, 0))(
+    contacts = jax.vmap(per_roller, in_axes=(None,) * 7 + (0, 0, 0, 0))(
         radius,
         side,
         ring_sign,
@@ -273,4 +276,38 @@ def all_flange_contacts(
         roller_axis,
         roller_velocity,
         roller_angular_velocity,
+    )
+    return without_absent_flanges(contacts, bearing.flange_presence)
+
+
+def without_absent_flanges(contacts: FlangeContact, presence: Float[Array, "*batch 4"]) -> FlangeContact:
+    """`contacts` (leading shape (Z, 4)) with the loads of absent flanges set to zero.
+
+    Every load-carrying quantity of flange f is multiplied by its presence k_f (1 there, 0
+    absent): normal force Q, peak pressure, PV, contact ellipse, and the forces and moments on
+    roller and ring (normal and friction), so an absent flange exerts nothing on a roller or a
+    ring and enters no contact event, statistic over contact time (all select Q above a
+    threshold) or smooth functional (all weighted by Q / (Q + Q_0)). Multiplying by 1.0 is
+    exact: a flange that is there gives its numbers bit for bit. The geometric quantities
+    (interference, contact point and height, film) stay as computed, as for an open gap.
+    """
+    k = jnp.asarray(presence)
+
+    def scaled(x):
+        return x * k.reshape((4,) + (1,) * (x.ndim - 2))
+
+    return eqx.tree_at(_loads, contacts, tuple(scaled(x) for x in _loads(contacts)))
+
+
+def _loads(c: FlangeContact) -> tuple:
+    """The load-carrying fields of a FlangeContact (`without_absent_flanges`)."""
+    return (
+        c.normal_force,
+        c.peak_pressure,
+        c.pv,
+        c.ellipse_semi_axes,
+        c.force_on_roller,
+        c.moment_on_roller,
+        c.force_on_ring,
+        c.moment_on_ring,
     )

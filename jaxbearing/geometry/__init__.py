@@ -1,6 +1,7 @@
 """Bearing geometry: parameter pytrees, derived mass properties, the roller end body.
 
 Owns: `Bearing` and its parts (`Roller`, `Flange`, `Cage`, `Material`, `Lubricant`), the
+flange arrangement of the bearing types (`FLANGES`, `BEARING_TYPES`, `flange_presence`), the
 `OperatingPoint`, the reference bearing (docs/model.md 1), unit conversions, the mass properties
 derived from geometry, the inner ring's tilted axis (`ring_axis`), and the shape of the roller end (corner torus and spherical cap, docs/model.md
 4: support function, limited circle, arc protrusion, principal curvatures).
@@ -11,6 +12,14 @@ need it (the arc cap changes the volume), and mass properties sit below every co
 May import: `jaxbearing._errors`. Nothing above it.
 """
 
+from ._arrangement import (
+    BEARING_TYPES,
+    FLANGES,
+    arrangement_of,
+    carries_axial_load,
+    flange_presence,
+    locates_rollers,
+)
 from ._inertia import cage_mass_properties, inner_ring_inertia, roller_mass_properties
 from ._params import (
     Bearing,
@@ -39,6 +48,8 @@ from ._roller_end import (
 )
 
 __all__ = [
+    "BEARING_TYPES",
+    "FLANGES",
     "LIMITED_CIRCLE_BAND",
     "SIN_ALPHA_FLOOR",
     "Bearing",
@@ -51,13 +62,17 @@ __all__ = [
     "arc_half_length",
     "arc_protrusion",
     "arc_weight",
+    "arrangement_of",
+    "carries_axial_load",
     "cage_mass_properties",
     "end_curvature",
     "end_principal_curvatures",
     "end_support",
+    "flange_presence",
     "inner_ring_inertia",
     "kinematic_cage_speed",
     "limited_circle_radius",
+    "locates_rollers",
     "rad_s_to_rpm",
     "ring_axis",
     "ring_tilt_angular_velocity",

@@ -122,7 +122,8 @@ class Lubricant(eqx.Module):
 
 
 class Bearing(eqx.Module):
-    """A whole cylindrical roller bearing: geometry, materials, lubricant, friction.
+    """A whole cylindrical roller bearing: geometry, materials, lubricant, friction, and which
+    flanges it has (`flange_presence`, the bearing type).
 
     `num_rollers` (Z) and `num_slices` (N_s) are static: they fix array shapes.
     """
@@ -144,6 +145,10 @@ class Bearing(eqx.Module):
     #: roller-end/flange friction law (static: it selects the compiled law): "dry" = constant
     #: `flange_traction`; "mixed" = film-dependent mixed-lubrication traction (docs/model.md 5.1)
     flange_lubrication: str = eqx.field(static=True, default="dry")
+    #: presence of each flange, 1.0 there or 0.0 absent, in the order inner -X, inner +X,
+    #: outer -X, outer +X (`geometry.FLANGES`); data, not static: the bearing type
+    #: (`geometry.BEARING_TYPES`, docs/model.md 5.3). All four there: an NUP bearing.
+    flange_presence: Float[Array, "*batch 4"] = eqx.field(converter=_f, default=(1.0, 1.0, 1.0, 1.0))
 
     # -- derived geometry ----------------------------------------------------------------
     @property

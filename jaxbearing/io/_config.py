@@ -315,7 +315,10 @@ class Config:
 
 
 def _toml_line(key: Key, value: Any) -> str:
-    """`name = value` with the value written by tomli_w (floats as repr: exact round trip)."""
+    """`name = value` with the value written by tomli_w (floats as repr: exact round trip); a
+    list of names (`bearing.type`'s flanges) on one line."""
+    if isinstance(value, tuple):
+        return f"{key.name} = [" + ", ".join(tomli_w.dumps({"v": v})[4:].rstrip("\n") for v in value) + "]"
     return tomli_w.dumps({key.name: value}).rstrip("\n")
 
 

@@ -51,6 +51,8 @@ def format_value(value: Any, digits: int = 12) -> str:
         return repr(float(f"{v:.{digits}g}"))
     if isinstance(value, str):
         return json.dumps(value)
+    if isinstance(value, (list, tuple)):  # TOML array spelling
+        return "[" + ", ".join(format_value(v, digits) for v in value) + "]"
     return repr(value)
 
 
@@ -113,11 +115,24 @@ class Extra:
 
 
 @dataclasses.dataclass(frozen=True)
+class Convert:
+    """The conversion of a key whose value has no unit to convert: its value as written in the
+    file to the pytree leaf (`to_si`) and back (`from_si`), e.g. a bearing type to the presence
+    of its flanges."""
+
+    to_si: Callable[[Any], Any]
+    from_si: Callable[[Any], Any]
+
+
+@dataclasses.dataclass(frozen=True)
 class Key:
     """One configuration key.
 
     `attr` is the pytree field it maps onto: "pitch_diameter", "roller.diameter" (fields of
     `Bearing`) or "op.inner_speed" (fields of `OperatingPoint`); None for simulation settings.
+    A string key with `choices` takes one of them; with `members` as well it also takes a list
+    of distinct members (a TOML array, kept as a tuple): the flange arrangement
+    `bearing.type`, a bearing type or a set of flanges. `convert` replaces the unit conversion.
     """
 
     path: str
@@ -131,6 +146,8 @@ class Key:
     attr: str | None = None
     allow_inf: bool = False
     choices: tuple[str, ...] = ()
+    members: tuple[str, ...] = ()
+    convert: Convert | None = None
     extras: tuple[Extra, ...] = ()
     note: str = ""
 
@@ -153,15 +170,24 @@ class Key:
         return tuple(dict.fromkeys(d for d in out if d != self.path))
 
     def to_si(self, value):
+        if self.convert is not None:
+            return self.convert.to_si(value)
         return _UNITS.get(self.unit, (_identity, _identity))[0](value)
 
     def from_si(self, value):
+        if self.convert is not None:
+            return self.convert.from_si(value)
         return _UNITS.get(self.unit, (_identity, _identity))[1](value)
 
     def range_text(self, values: Mapping[str, Any] | None = None) -> str:
         """'in (0, diameter_mm/2 = 3.75)' (values given) or 'in (0, diameter_mm/2)'."""
         if self.choices:
-            return "one of " + ", ".join(format_value(c) for c in self.choices)
+            text = "one of " + ", ".join(format_value(c) for c in self.choices)
+            if self.members:
+                text += " or a list of distinct names from " + ", ".join(
+                    format_value(m) for m in self.members
+                )
+            return text
         if self.kind is bool:
             return "true or false"
 

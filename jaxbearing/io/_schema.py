@@ -25,6 +25,7 @@ Schema (ranges; "(" open, "[" closed; symbols as in docs/model.md and the source
 | bearing.inner_ring_mass_kg | m_i | (0, 1e5] |
 | bearing.flange_traction, pocket_friction | mu_f, mu_p | [0, 1] |
 | bearing.flange_lubrication | | "dry" (constant mu_f) or "mixed" (film-dependent) |
+| bearing.type | | "NUP", "NU", "N", "NJ" or a list of flanges from "inner-X", "inner+X", "outer-X", "outer+X" with one on each side |
 | roller.diameter_mm | D | (0, pitch_diameter_mm/2) |
 | roller.corner_radius_mm | R_cor | (0, diameter_mm/2) |
 | roller.length_mm | L_b1 | (2 corner_radius_mm, 10 diameter_mm] |
@@ -58,7 +59,7 @@ Schema (ranges; "(" open, "[" closed; symbols as in docs/model.md and the source
 | operating.radial_load_N | F_r | [0, 1e8] |
 | operating.gravity | g | true / false (9.81 m/s^2 along +Z) |
 | operating.misalignment_mrad | psi_m | [-10, 10] (inner-ring tilt about +Y) |
-| operating.axial_load_N | F_a | [-1e8, 1e8] (along +X); 0 unless inner_ring_axial_freedom |
+| operating.axial_load_N | F_a | [-1e8, 1e8] (along +X); 0 unless inner_ring_axial_freedom and a flange path (bearing.type) |
 | operating.inner_ring_axial_freedom, inner_ring_tilt_freedom | | true / false |
 | simulation.end | | "arc", "corner" or "both" |
 | simulation.duration_ms | | (0, 10000] |
@@ -76,7 +77,15 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from ._keys import Extra, Key, constant_bound, format_derived, format_value, make_key, relative_bound
+from ..geometry import (
+    BEARING_TYPES,
+    FLANGES,
+    arrangement_of,
+    carries_axial_load,
+    flange_presence,
+    locates_rollers,
+)
+from ._keys import Convert, Extra, Key, constant_bound, format_derived, format_value, make_key, relative_bound
 
 
 # -- extra checks ------------------------------------------------------------------------------
@@ -147,6 +156,40 @@ def _axial_load_held(v) -> str | None:
     return (
         f"{format_value(f)} N needs operating.inner_ring_axial_freedom = true (the ring is held "
         "axially, so the load would do nothing): must be 0 N while the axial freedom is off"
+    )
+
+
+def _rollers_located(v) -> str | None:
+    """A flange on each side (-X and +X, either ring): otherwise nothing locates the rollers
+    axially and they leave the raceway (docs/model.md 5.3)."""
+    t = v["bearing.type"]
+    presence = flange_presence(t)
+    if locates_rollers(presence):
+        return None
+    side = "-X" if not (presence[0] or presence[2]) else "+X"
+    return (
+        f"{format_value(t)} has no flange on the {side} side, so nothing locates the rollers "
+        f'axially: add "inner{side}" or "outer{side}"'
+    )
+
+
+def _axial_load_carried(v) -> str | None:
+    """An axial load on the inner ring needs a flange path to the outer ring: along +X the
+    inner -X and the outer +X flange, along -X the inner +X and the outer -X flange
+    (`geometry.carries_axial_load`). A floating bearing (NU, N; NJ along -X) carries none: in a
+    machine the shaft's locating bearing does, and the ring would slide away here."""
+    f, t = v["operating.axial_load_N"], v["bearing.type"]
+    presence = flange_presence(t)
+    if f == 0.0 or carries_axial_load(presence, f):
+        return None
+    need = '"inner-X" and "outer+X"' if f > 0 else '"inner+X" and "outer-X"'
+    valid = {(True, False): ">= 0", (False, True): "<= 0"}.get(
+        (carries_axial_load(presence, 1.0), carries_axial_load(presence, -1.0)), "0"
+    )
+    return (
+        f"{format_value(f)} N has no flange path in bearing.type = {format_value(t)} (along "
+        f"{'+X' if f > 0 else '-X'} it needs the flanges {need}): must be {valid} N (in a "
+        "machine the shaft's locating bearing carries it)"
     )
 
 
@@ -286,6 +329,23 @@ KEYS: tuple[Key, ...] = (
             "dry = constant flange_traction (the source paper); mixed = film-dependent "
             "mixed-lubrication traction from the Hamrock-Dowson film (docs/model.md 5.1)"
         ),
+    ),
+    make_key(
+        "bearing.type",
+        str,
+        "NUP",
+        "",
+        "",
+        "bearing type: which flanges the rings have",
+        choices=tuple(BEARING_TYPES),
+        members=FLANGES,
+        convert=Convert(flange_presence, arrangement_of),
+        attr="flange_presence",
+        note=(
+            "flanges of NUP: both rings; NU: the outer ring (the inner ring floats); N: the inner "
+            "ring; NJ: the outer ring and inner -X (docs/model.md 5.3)"
+        ),
+        extras=(Extra(("bearing.type",), _rollers_located, "a flange on each side (-X and +X)"),),
     ),
     make_key(
         "bearing.pocket_friction",
@@ -724,6 +784,11 @@ KEYS: tuple[Key, ...] = (
                 ("operating.inner_ring_axial_freedom",),
                 _axial_load_held,
                 "non-zero only with inner_ring_axial_freedom = true",
+            ),
+            Extra(
+                ("bearing.type",),
+                _axial_load_carried,
+                "and a flange path (bearing.type): +X needs inner-X and outer+X, -X inner+X and outer-X",
             ),
         ),
     ),

@@ -57,8 +57,11 @@ def coerce(key: Key, value: Any) -> Any:
         if not is_bool:
             raise ConfigError(key.path, f"expected true or false, {got}")
         return bool(value)
+    if key.members and isinstance(value, (list, tuple)) and all(isinstance(v, str) for v in value):
+        return tuple(value)  # a set of members (the flanges of `bearing.type`), hashable
     if not isinstance(value, str):
-        raise ConfigError(key.path, f"expected a string ({key.range_text()}), {got}")
+        what = "a string or a list of strings" if key.members else "a string"
+        raise ConfigError(key.path, f"expected {what} ({key.range_text()}), {got}")
     return value
 
 
@@ -67,7 +70,9 @@ def check_key(key: Key, values: Mapping[str, Any]) -> None:
     """Range and extra checks of one key; `values` holds it and the keys it depends on."""
     v = values[key.path]
     unit = f" {key.unit}" if key.unit else ""
-    if key.choices:
+    if key.members and isinstance(v, tuple):
+        _check_members(key, v)
+    elif key.choices:
         if v not in key.choices:
             raise ConfigError(key.path, f"{format_value(v)} is not {key.range_text()}")
     elif key.kind in (float, int):
@@ -100,6 +105,22 @@ def check_key(key: Key, values: Mapping[str, Any]) -> None:
         msg = extra.check(values)
         if msg is not None:
             raise ConfigError(key.path, msg)
+
+
+def _check_members(key: Key, v: tuple) -> None:
+    """A list value of a key with `members`: every name a member, none twice."""
+    unknown = [m for m in v if m not in key.members]
+    if unknown:
+        raise ConfigError(
+            key.path,
+            f"{format_value(v)}: {format_value(unknown[0])} is not one of the names "
+            + ", ".join(format_value(m) for m in key.members),
+        )
+    twice = [m for m in v if v.count(m) > 1]
+    if twice:
+        raise ConfigError(
+            key.path, f"{format_value(v)} names {format_value(twice[0])} twice: must be {key.range_text()}"
+        )
 
 
 def _culprit(key: Key, values: Mapping[str, Any]) -> str | None:
@@ -144,7 +165,8 @@ def validate_bearing(bearing, op=None, *, traced: str = "error") -> None:
     must be in (diameter_mm/2 = 3.75, inf] mm``). Stacked (batched) pytrees are checked element
     by element. Gravity, a bool in configuration files, must here be finite and in [0, 100]
     m/s^2; the switches (`axial_freedom`, `tilt_freedom`, booleans in configuration files) must
-    be 1.0 (true) or 0.0 (false).
+    be 1.0 (true) or 0.0 (false), and so must each flange's presence (`flange_presence`, the
+    flanges of `bearing.type`).
 
     Leaves must be concrete: under `jax.jit`/`grad`/`vmap` they are tracers, which raise
     TypeError (`traced="error"`, the default) or, with `traced="skip"` (what the model's entry
@@ -164,16 +186,25 @@ def validate_bearing(bearing, op=None, *, traced: str = "error") -> None:
     checked = [k.path for k in keys if not set(k.deps) & skipped]
     # counts and choices (static pytree fields) are one Python value for the whole batch
     arrays = {k.path: np.asarray(leaves[k.path]) for k in keys if k.kind not in (int, str)}
-    shape = np.broadcast_shapes(*(a.shape for a in arrays.values())) if arrays else ()
+    # converted keys (the flange presence of `bearing.type`) have one trailing axis of their own
+    vectors = {k.path: np.asarray(leaves[k.path], dtype=float) for k in keys if k.convert is not None}
+    shape = np.broadcast_shapes(
+        *(a.shape for a in arrays.values()), *(a.shape[:-1] for a in vectors.values())
+    )
+    vectors = {p: np.broadcast_to(a, shape + a.shape[-1:]) for p, a in vectors.items()}
     if op is not None and not _traced(op.gravity):
         _check_gravity(np.broadcast_to(np.asarray(op.gravity, dtype=float), shape), shape)
     for k in keys:  # switches (inner-ring freedoms): 1.0 (true) or 0.0 (false)
         if k.kind is bool and k.path != "operating.gravity":
             _check_switch(k.path, np.broadcast_to(arrays[k.path].astype(float), shape), shape)
+    for path, a in vectors.items():  # flange presence: 1.0 (there) or 0.0 (absent)
+        _check_presence(path, a, shape)
     for idx in np.ndindex(shape):
         values = dict(REFERENCE_VALUES)
         for k in keys:
-            if k.kind in (int, str):
+            if k.convert is not None:
+                values[k.path] = k.from_si(vectors[k.path][idx])
+            elif k.kind in (int, str):
                 values[k.path] = coerce(k, leaves[k.path])
             elif k.kind is bool:  # gravity
                 values[k.path] = bool(np.broadcast_to(arrays[k.path], shape)[idx] > 0)
@@ -207,6 +238,22 @@ def _check_switch(path: str, v: np.ndarray, shape: tuple) -> None:
         where = f"(batch element {idx}) " if shape else ""
         raise ConfigError(
             path, f"{where}{format_value(float(v[idx]))} is out of range: must be 1.0 (true) or 0.0 (false)"
+        )
+
+
+def _check_presence(path: str, v: np.ndarray, shape: tuple) -> None:
+    """Each flange's presence (`Bearing.flange_presence`, last axis in the order `FLANGES`,
+    after the batch `shape`) is 1.0 (there) or 0.0 (absent)."""
+    from ..geometry import FLANGES
+
+    bad = ~((v == 0.0) | (v == 1.0))
+    if bad.any():
+        idx = tuple(int(i) for i in np.argwhere(bad)[0])
+        where = f"(batch element {idx[:-1]}) " if shape else ""
+        raise ConfigError(
+            path,
+            f"{where}presence of flange {FLANGES[idx[-1]]} = {format_value(float(v[idx]))} is out of "
+            "range: must be 1.0 (there) or 0.0 (absent)",
         )
 
 

@@ -91,6 +91,7 @@ _STATIC_KEYS = {
     "bearing.num_rollers": "it changes array shapes (static); run one sweep per value",
     "bearing.num_slices": "it changes array shapes (static); run one sweep per value",
     "bearing.flange_lubrication": "it selects the compiled flange friction law (static); run one sweep per value",
+    "bearing.type": "axes take numbers and the bearing type is a name or a list of flanges; run one sweep per type",
     "simulation.max_steps": "it is a static argument of the compiled solve; set it in [base.simulation]",
     "simulation.progress": "progress is not a model parameter",
     "simulation.end": 'use the special axis "end" = ["arc", "corner"]',
