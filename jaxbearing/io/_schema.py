@@ -25,6 +25,7 @@ Schema (ranges; "(" open, "[" closed; symbols as in docs/model.md and the source
 | bearing.inner_ring_mass_kg | m_i | (0, 1e5] |
 | bearing.flange_traction, pocket_friction | mu_f, mu_p | [0, 1] |
 | bearing.flange_lubrication | | "dry" (constant mu_f) or "mixed" (film-dependent) |
+| bearing.type | | "NUP" (default), "NU", "N" or "NJ" |
 | roller.diameter_mm | D | (0, pitch_diameter_mm/2) |
 | roller.corner_radius_mm | R_cor | (0, diameter_mm/2) |
 | roller.length_mm | L_b1 | (2 corner_radius_mm, 10 diameter_mm] |
@@ -286,6 +287,16 @@ KEYS: tuple[Key, ...] = (
             "dry = constant flange_traction (the source paper); mixed = film-dependent "
             "mixed-lubrication traction from the Hamrock-Dowson film (docs/model.md 5.1)"
         ),
+    ),
+    make_key(
+        "bearing.type",
+        str,
+        "NUP",
+        "",
+        "",
+        "bearing type (ISO designation of the flange arrangement)",
+        choices=("NUP", "NU", "N", "NJ"),
+        note="the model's four flanges are an NUP bearing",
     ),
     make_key(
         "bearing.pocket_friction",
