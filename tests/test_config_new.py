@@ -146,7 +146,7 @@ def test_uncertainty_table_round_trips_and_is_checked():
         (
             ["--bore-mm", "130", "--outside-diameter-mm", "125", "--width-mm", "24"],
             "--outside-diameter-mm",
-            "(bore_mm = 130",
+            "(bore = 130",
         ),
         (
             ["--bore-mm", "70", "--outside-diameter-mm", "125", "--width-mm", "0"],
@@ -161,7 +161,7 @@ def test_uncertainty_table_round_trips_and_is_checked():
         (
             ["--series", "02", "--bore-mm", "70", "--roller-length-mm", "30"],
             "--roller-length-mm",
-            "width_mm = 24.0)",
+            "width = 24.0)",
         ),
         (
             ["--series", "02", "--bore-mm", "70", "--roller-diameter-mm", "30"],

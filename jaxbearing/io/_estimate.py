@@ -164,14 +164,14 @@ def _require(
 def _check_dimensions(dim: BoundaryDimensions) -> None:
     d, do, b = dim.bore_mm, dim.outside_diameter_mm, dim.width_mm
     _require("bore_mm", d, 0.0, 10000.0, "0", "10000")
-    _require("outside_diameter_mm", do, d, 20000.0 - d, f"bore_mm = {format_value(d)}", "20000 - bore_mm")
+    _require("outside_diameter_mm", do, d, 20000.0 - d, f"bore = {format_value(d)}", "20000 - bore")
     _require(
         "width_mm",
         b,
         0.0,
         10.0 * (do - d),
         "0",
-        f"10 (outside_diameter_mm - bore_mm) = {format_derived(10 * (do - d))}",
+        f"10 (outside diameter - bore) = {format_derived(10 * (do - d))}",
     )
 
 
@@ -211,7 +211,7 @@ def _roller_set(
             0.0,
             section,
             "0",
-            f"(outside_diameter_mm - bore_mm)/2 = {format_derived(section)}, the ring section",
+            f"(outside diameter - bore)/2 = {format_derived(section)}, the ring section",
         )
         out["roller.diameter_mm"] = (float(diameter), None)
     corner = _ratio("roller.corner_radius_mm", "roller.diameter_mm") * diameter
@@ -225,9 +225,7 @@ def _roller_set(
         )
     else:
         hi = min(b, 10.0 * diameter)
-        hi_label = (
-            f"width_mm = {format_value(b)}" if hi == b else f"10 roller diameters = {format_derived(hi)}"
-        )
+        hi_label = f"width = {format_value(b)}" if hi == b else f"10 roller diameters = {format_derived(hi)}"
         _require(
             "roller_length_mm",
             length,
