@@ -55,6 +55,7 @@ FILE_SECONDS = {
     "test_contact_hertz.py": 15,
     "test_flange_contact.py": 15,
     "test_program_cache.py": 10,
+    "test_config_new.py": 30,  # measured alone (34 s at load 6, warm cache), not in that run
 }
 
 #: files that compile the same programs, run by one process in this order (`make test`, the
@@ -62,7 +63,8 @@ FILE_SECONDS = {
 #: two processes each compiled the same program (20-45 s each). test_settle compiles the
 #: 11-slice skid start and settled members, which notebook 05 (checked: after test_settle it
 #: stores no skid start or settled-member program of its own), test_steady_design and
-#: test_steady_gradient load (test_engine's settled sweep too, later, from the other process).
+#: test_steady_gradient load (test_engine's settled sweep too, later, from the other process;
+#: test_config_new's settled run of a catalogue bearing with 26 rollers and 11 slices, last).
 #: test_steady_gradient before the notebooks: notebook 05 then reads the skid starts of seeds
 #: 0-2 of the 11-slice reference that its settled ensemble stored (the start cache,
 #: `jaxbearing.run._start_cache`) and loads its frozen-load programs.
@@ -71,7 +73,13 @@ FILE_SECONDS = {
 #: reaches them after test_settle and test_steady_gradient) load; test_outputs compiles the reference sweep batch, which
 #: test_sweep and test_sweep_distributed load.
 PROGRAM_GROUPS = (
-    ("test_settle.py", "test_steady_gradient.py", "test_notebooks.py", "test_steady_design.py"),
+    (
+        "test_settle.py",
+        "test_steady_gradient.py",
+        "test_notebooks.py",
+        "test_steady_design.py",
+        "test_config_new.py",
+    ),
     (
         "test_cmd_simulate.py",
         "test_dynamics.py",

@@ -257,6 +257,7 @@ _STEADY_CLI = "test_optimise_steady.py::test_killed_run_resumes_with_the_same_re
 _OPT_FILE = "test_optimise.py::test_cli_settings_from_a_file_and_options_reach_the_problem"
 _TWO_PROCESSES = "test_sweep_distributed.py::test_two_processes_match_single_process"
 _VALIDATE = "test_validate.py::test_validate_writes_the_comparison"
+_NEW = "test_config_new.py::test_config_new_writes_once_and_show_marks_estimates"
 CLI_CHECKS = {
     ("jaxbearing", "demo", "--window-revs"): [
         "test_cmd_simulate.py::test_demo_settled_passes_its_window_to_the_run"
@@ -266,6 +267,21 @@ CLI_CHECKS = {
     ("jaxbearing", "demo", "--out"): [_DEMO],
     ("jaxbearing", "demo", "--summary-only"): ["test_params.py::test_cli_demo_prints_summary"],
     ("jaxbearing", "config show", "--config"): ["test_config.py::test_config_show_merges_file"],
+    **{
+        ("jaxbearing", "config new", option): [_NEW]
+        for option in (
+            "--bore-mm",
+            "--outside-diameter-mm",
+            "--width-mm",
+            "--series",
+            "--type",
+            "--num-rollers",
+            "--roller-diameter-mm",
+            "--roller-length-mm",
+        )
+    },
+    ("jaxbearing", "config new", "--out"): [_NEW],
+    ("jaxbearing", "config new", "--force"): [_NEW],
     ("jaxbearing", "validate", "--config"): [_VALIDATE],
     ("jaxbearing", "validate", "--end"): [_VALIDATE],
     ("jaxbearing", "validate", "--settle"): [_VALIDATE],

@@ -9,8 +9,10 @@ every model entry point calls before tracing), the checks a configuration needs 
 `write_json`, `dumps_strict`), pytrees in data-only files (`save_tree`, `load_tree`: `.npz`
 with `allow_pickle=False` and JSON, never a pickle), the lock on an output directory (`acquire_lock`), and output directories checked before
 work and results kept in a fallback directory when writing fails (`check_output_dir`,
-`write_or_fallback`), and measured cage speeds from a CSV file with units in its header
-(`read_cage_speed_measurements`).
+`write_or_fallback`), measured cage speeds from a CSV file with units in its header
+(`read_cage_speed_measurements`), the `[uncertainty]` table of values known only roughly
+(`Uncertainty`, `Config.uncertainty`), and a configuration of a catalogue bearing estimated
+from its boundary dimensions (`estimate_config`, the ISO 15 table `dimension_series`).
 
 May import: `jaxbearing._errors`, `jaxbearing.geometry`.
 """
@@ -41,6 +43,14 @@ from ._config import (
     reference_config,
     reference_operating_point,
 )
+from ._estimate import (
+    BEARING_TYPES,
+    DIMENSION_SERIES,
+    BoundaryDimensions,
+    EstimatedConfig,
+    dimension_series,
+    estimate_config,
+)
 from ._extras import optional_import, pyplot
 from ._files import (
     NULL_REASONS,
@@ -63,9 +73,17 @@ from ._lock import DirectoryInUse, DirectoryLock, acquire_lock
 from ._measurements import CageSpeedMeasurement, read_cage_speed_measurements
 from ._schema import KEY_BY_PATH, KEYS
 from ._tree import TreeFileError, check_like, load_tree, save_tree, tree_bytes, tree_from_bytes
+from ._uncertainty import Uncertainty
 from ._validation import IMPLAUSIBLY_SMALL, plausibility_warnings, validate_bearing
 
 __all__ = [
+    "BEARING_TYPES",
+    "BoundaryDimensions",
+    "DIMENSION_SERIES",
+    "EstimatedConfig",
+    "Uncertainty",
+    "dimension_series",
+    "estimate_config",
     "CageSpeedMeasurement",
     "FUNCTIONALS_FIELDS",
     "IMPLAUSIBLY_SMALL",

@@ -15,6 +15,8 @@ its meaning, symbol and valid range. The schema and the ranges are `jaxbearing.i
     [operating]          speed_rpm, radial_load_N, gravity, misalignment_mrad, axial_load_N,
                          inner_ring_axial_freedom, inner_ring_tilt_freedom
     [simulation]         end, duration_ms, rtol, atol, max_steps, progress, solver
+    [uncertainty]        optional: "dotted.key" = { plus_minus = ..., estimated = "rule" }
+                         for values known only roughly (`_uncertainty.py`)
 
 Missing keys take the reference value (docs/model.md section 1); unknown keys and sections are
 errors with a "did you mean ...?" suggestion; wrong types and out-of-range values are errors
@@ -44,6 +46,8 @@ from .._errors import ConfigError
 from ..geometry import Bearing, Cage, Flange, Lubricant, Material, OperatingPoint, Roller
 from ._keys import GRAVITY, Key, format_value, type_name
 from ._schema import KEY_BY_PATH, KEYS, REFERENCE_VALUES
+from ._uncertainty import SECTION as _UNCERTAINTY
+from ._uncertainty import Uncertainty, parse_uncertainty, uncertainty_toml
 from ._validation import check_values, coerce
 
 _HEADER = """\
@@ -183,12 +187,20 @@ class Config:
 
     `cfg["roller.end_radius_mm"]` reads one value; `to_dict()`/`to_toml()` write all of them;
     `bearing()`, `operating_point()` and `simulation` give the model's inputs (SI pytrees).
+    `uncertainty` is the optional `[uncertainty]` table: the keys whose values are estimated or
+    known only roughly, each with its stated uncertainty (`Uncertainty`); it is data only and
+    changes no model input.
     """
 
-    __slots__ = ("_values",)
+    __slots__ = ("_values", "_uncertainty")
 
     def __init__(self, data: Mapping[str, Any] | None = None):
+        uncertainty: dict[str, Uncertainty] = {}
+        if isinstance(data, Mapping) and _UNCERTAINTY in data:
+            data = dict(data)
+            uncertainty = parse_uncertainty(data.pop(_UNCERTAINTY), _unknown_path)
         object.__setattr__(self, "_values", types.MappingProxyType(_values_from(data)))
+        object.__setattr__(self, "_uncertainty", types.MappingProxyType(uncertainty))
 
     def __setattr__(self, name, value):
         raise dataclasses.FrozenInstanceError(f"Config is immutable; use replace() (set {name!r})")
@@ -207,8 +219,15 @@ class Config:
         """Dotted keys in schema order."""
         return tuple(self._values)
 
+    @property
+    def uncertainty(self) -> Mapping[str, Uncertainty]:
+        """{dotted key: Uncertainty} of the `[uncertainty]` table, in schema order (empty when
+        the file has none): each key's stated uncertainty and, if estimated, its rule."""
+        return self._uncertainty
+
     def to_dict(self) -> dict[str, Any]:
-        """Nested {section: {key: value}} (the TOML layout), every key, engineering units."""
+        """Nested {section: {key: value}} (the TOML layout), every key, engineering units; the
+        `[uncertainty]` table as {dotted key: {plus_minus, estimated}} when it is not empty."""
         out: dict[str, Any] = {}
         for path, value in self._values.items():
             node = out
@@ -216,6 +235,8 @@ class Config:
             for s in sections:
                 node = node.setdefault(s, {})
             node[name] = value
+        if self._uncertainty:
+            out[_UNCERTAINTY] = {p: u.to_dict() for p, u in self._uncertainty.items()}
         return out
 
     def changed(self) -> dict[str, Any]:
@@ -223,8 +244,8 @@ class Config:
         return {p: v for p, v in self._values.items() if v != REFERENCE_VALUES[p]}
 
     def replace(self, changes: Mapping[str, Any] | None = None, /, **dotted: Any) -> Config:
-        """A new configuration with dotted keys changed, re-validated:
-        ``cfg.replace(**{"roller.end_radius_mm": 90})``."""
+        """A new configuration with dotted keys changed, re-validated, the `[uncertainty]` table
+        kept: ``cfg.replace(**{"roller.end_radius_mm": 90})``."""
         updates = {**(changes or {}), **dotted}
         data = self.to_dict()
         for path, value in updates.items():
@@ -281,10 +302,21 @@ class Config:
         )
 
     # -- writing --------------------------------------------------------------------------------
-    def to_toml(self, *, comments: bool = True) -> str:
-        """Every key as TOML, in schema order; with `comments`, a line per key giving its
-        meaning, symbol, unit and valid range. Loading the text gives an equal `Config`."""
-        lines = [_HEADER.rstrip("\n")] if comments else []
+    def to_toml(
+        self,
+        *,
+        comments: bool = True,
+        header: str | None = None,
+        notes: Mapping[str, str] | None = None,
+    ) -> str:
+        """Every key as TOML, in schema order, then the `[uncertainty]` table if any; with
+        `comments`, a line per key giving its meaning, symbol, unit and valid range, a line
+        "ESTIMATED (+/- ...): rule" or "UNCERTAIN (+/- ...)" above each key of the uncertainty
+        table, and the line `notes[key]` where given. `header` replaces the opening comment.
+        Loading the text gives an equal `Config`."""
+        notes = notes or {}
+        top = _HEADER if header is None else header
+        lines = [top.rstrip("\n")] if comments and top else []
         for section in _SECTIONS:
             if lines:
                 lines.append("")
@@ -294,17 +326,29 @@ class Config:
                     continue
                 if comments:
                     lines.append(f"# {key.doc()}")
+                    if key.path in self._uncertainty:
+                        lines.append(f"# {self._uncertainty[key.path].comment(key.unit)}")
+                    if key.path in notes:
+                        lines.append(f"# {notes[key.path]}")
                 lines.append(_toml_line(key, self._values[key.path]))
+        table = uncertainty_toml(self._uncertainty)
+        if table:
+            lines.append("")
+            if comments:
+                lines.append(
+                    "# Values known only roughly: +/- plus_minus in the key's unit; estimated = the rule."
+                )
+            lines.extend(table)
         return "\n".join(lines) + "\n"
 
     # -- dunder ---------------------------------------------------------------------------------
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, Config):
             return NotImplemented
-        return self._values == other._values
+        return self._values == other._values and self._uncertainty == other._uncertainty
 
     def __hash__(self) -> int:
-        return hash(tuple(self._values.items()))
+        return hash((tuple(self._values.items()), tuple(self._uncertainty.items())))
 
     def __repr__(self) -> str:
         changed = self.changed()
