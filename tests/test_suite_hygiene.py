@@ -463,7 +463,8 @@ def test_library_code_carries_no_history():
         if lines:
             found[str(path.relative_to(root))] = lines
     assert not found, found
-    assert _library_history("measured 2026-11-26 (issue 13)\nbenchmarks/studies/x.py\nplain") == [
+    study = "benchmarks/" + "studies/a_study"
+    assert _library_history(f"measured 2026-11-26 (issue 13)\n{study}\nplain") == [
         "measured 2026-11-26 (issue 13)",
-        "benchmarks/studies/x.py",
+        study,
     ]
