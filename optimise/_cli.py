@@ -19,6 +19,7 @@ could not be written to --out and were kept in the fallback directory printed.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
 import pathlib
 import sys
@@ -568,6 +569,8 @@ def run_steady(args, problem, options, settings, out, meta=None) -> int:
     """`optimise run --objective steady` (the default): `_steady.steady_search` with progress,
     checkpoint and resume in `out`, verification, result.json and the search-path plot."""
 
+    from jaxbearing.run import MemberProgress
+
     from ._plot import plot_search
     from ._steady import CHECKPOINT, CONSTRAINT_NAMES, steady_search
 
@@ -591,9 +594,12 @@ def run_steady(args, problem, options, settings, out, meta=None) -> int:
 
     progress = _progress(args.quiet, start_line)
 
-    res = steady_search(
-        problem, settings, directory=out, callback=progress, verify=not args.no_verify, **options
-    )
+    # a line at least every 30 s while members settle: an evaluation takes minutes
+    heartbeat = contextlib.nullcontext() if args.quiet else MemberProgress(30.0, label="   ")
+    with heartbeat:
+        res = steady_search(
+            problem, settings, directory=out, callback=progress, verify=not args.no_verify, **options
+        )
     if res.resumed_from >= 0 and not args.quiet:
         print(f"(resumed after iteration {res.resumed_from} from {out / CHECKPOINT})")
     result = {**_steady_result_json(problem, options, settings, res), **(meta or {})}

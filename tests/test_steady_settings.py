@@ -122,3 +122,43 @@ def test_a_settled_simulate_takes_settings_or_their_fields():
     b, op = jb.reference_bearing(), jb.reference_operating_point()
     with pytest.raises(UserInputError, match=r"^window: not a setting of settled running"):
         jb.simulate(b, op, settings=SteadySettings(), window=3)
+
+
+def test_member_progress_counts_members_and_prints_on_time():
+    """`MemberProgress`: while active, the dispatcher's member programs (`_reporting`) and the
+    process pool (`parallel_map(on_done=...)`) count finished members; its thread prints the
+    count, the elapsed time and an estimate of what remains at least every `interval` s."""
+    import threading
+
+    from jaxbearing.run import MemberProgress, parallel_map
+    from jaxbearing.run._dispatch import _reporting
+    from jaxbearing.run._member_progress import active_progress
+
+    def program():
+        answer = yield "request"
+        return answer * 2
+
+    lines = []
+    printed = threading.Event()
+
+    def say(line):
+        lines.append(line)
+        printed.set()
+
+    assert active_progress() is None
+    with MemberProgress(interval=0.05, label="  ", say=say) as progress:
+        assert active_progress() is progress
+        progress.started(3)
+        assert progress.line().startswith("  members settled 0 of 3") and "no estimate" in progress.line()
+        wrapped = _reporting(program())
+        assert next(wrapped) == "request"
+        with pytest.raises(StopIteration) as stop:
+            wrapped.send(21)
+        assert stop.value.value == 42 and progress.done == 1
+        assert parallel_map(abs, [-1, -2], workers=1, on_done=progress.finished) == [1, 2]
+        assert progress.done == 3 and "s left" in progress.line()
+        assert printed.wait(60)  # the thread prints however loaded the machine is
+    assert active_progress() is None
+    assert lines and all(line.startswith("  members settled ") for line in lines)
+    with pytest.raises(UserInputError, match=r"^interval = 0.0: must be > 0 s$"):
+        MemberProgress(interval=0)

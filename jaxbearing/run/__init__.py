@@ -25,7 +25,9 @@
   run, for callers that build their own programs around it); `SteadySettings`, the one
   definition of every setting of settled running and its defaults, with the settling modes
   `SettleAuto`, `SettleFixed`, `SettleOff` (`settling` maps the command line's and the TOML
-  files' text onto them); a member's program speaks `Request` and `Answer` in its `Phase`s;
+  files' text onto them); a member's program speaks `Request` and `Answer` in its `Phase`s; `MemberProgress`
+  (a `with` block: members settled of the total, elapsed, an estimate of what remains, every
+  30 s while the engine runs);
 - `plot_run`: the figures of one run;
 - against measurements: `model_cage_speeds` (a settled run at every measured operating point,
   the relative error with its interval) and its figure `plot_measured`;
@@ -58,6 +60,7 @@ from ._ensemble import as_completed_map, available_cpus, parallel_map, shared_wo
 from ._initial import STARTS, Perturbation, SkidStart, initial_state, skid_start
 from ._measured import model_cage_speeds
 from ._member import Answer, Member, Phase, Request, SeedRun
+from ._member_progress import MemberProgress
 from ._plots import plot_measured, plot_run
 from ._progress import HostProgress, SolveProgress
 from ._result import (
@@ -199,6 +202,7 @@ __all__ = [
     "Answer",
     "Request",
     "Phase",
+    "MemberProgress",
     "STRATEGIES",
     "choose_strategy",
     "stack_trees",

@@ -22,8 +22,19 @@ from ._engine import BatchTimes, choose_strategy, drive, drive_batched
 from ._ensemble import parallel_map
 from ._initial import _static_skid_start, static_skid_starts
 from ._member import Member, SeedRun, member_steps
+from ._member_progress import active_progress
 from ._settings import SettleAuto, SteadySettings
 from ._solve_from import _integrator, solve_from
+
+
+def _reporting(program):
+    """`program` (a member's requests), telling the active `MemberProgress` when it has finished
+    (in this process: the one-member and the vmapped drivers)."""
+    result = yield from program
+    progress = active_progress()
+    if progress is not None:
+        progress.finished()
+    return result
 
 
 def _run_one(member: Member, settings: SteadySettings, reduce=None, static=None) -> tuple[SeedRun, float]:
@@ -40,7 +51,7 @@ def _run_one(member: Member, settings: SteadySettings, reduce=None, static=None)
         compiled,
         settings.solver,
     )
-    run = drive(member_steps(member, settings, reduce, static, stored_start=True), integrate)
+    run = drive(_reporting(member_steps(member, settings, reduce, static, stored_start=True)), integrate)
     return run, sum(compiled)
 
 
@@ -126,12 +137,18 @@ def settle_members(
     members = list(members)
     chosen = choose_strategy(settings.strategy, min(settings.workers, len(members)), devices)
     wall0 = time.perf_counter()
+    progress = active_progress()
+    if progress is not None:
+        progress.started(len(members))
     if chosen == "vmap":
         return _settle_vmapped(members, settings, devices, reduce, wall0)
     statics = _shared_time_constants(members, settings)
     if chosen == "processes" and len(members) > 1:
         items = [(m, statics.get(i)) for i, m in enumerate(members)]
-        outs = parallel_map(_MemberJob(settings, reduce), items, workers=min(settings.workers, len(members)))
+        done = None if progress is None else progress.finished
+        outs = parallel_map(
+            _MemberJob(settings, reduce), items, workers=min(settings.workers, len(members)), on_done=done
+        )
         compile_time = max(c for _, c in outs)
         # the pool's wall time less its longest compilation (the workers compile side by side)
         return EngineRun(
@@ -156,7 +173,7 @@ def _settle_vmapped(members, settings: SteadySettings, devices, reduce, wall0: f
         statics = _batched_statics(members, idx, settings)
         times.host_s += time.perf_counter() - h0
         outs = drive_batched(
-            [member_steps(members[i], quiet, reduce, statics.get(i)) for i in idx],
+            [_reporting(member_steps(members[i], quiet, reduce, statics.get(i))) for i in idx],
             [settings.params(members[i]) for i in idx],
             [settings.tolerances(members[i]) for i in idx],
             solve_from=solve_from,

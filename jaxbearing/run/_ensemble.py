@@ -94,23 +94,25 @@ def parallel_map(
     *,
     workers: int | None = None,
     threads_per_worker: int | None = None,
+    on_done: Callable[[], None] | None = None,
 ) -> list:
-    """[function(item) for item in items], one process per worker (module docstring)."""
+    """[function(item) for item in items], one process per worker (module docstring);
+    `on_done()` is called in this process as each item finishes (e.g. a progress count)."""
     items = list(items)
     if workers is None:
         workers = available_cpus()
     workers = max(1, min(int(workers), len(items)))
     if workers == 1:
-        return [function(item) for item in items]
+        return [_reported(function(item), on_done) for item in items]
     flags = os.environ.get("XLA_FLAGS", "")
     if threads_per_worker == 1:
         flags = _with_flags(flags, _ONE_THREAD_FLAGS)
     shared = _SHARED.get(flags)
     try:
         if shared is not None and shared[0] >= workers:
-            return list(shared[1].map(function, items))
+            return _mapped(shared[1], function, items, on_done)
         with _environment(XLA_FLAGS=flags), _pool(workers) as pool:
-            return list(pool.map(function, items))
+            return _mapped(pool, function, items, on_done)
     except BrokenProcessPool:
         _SHARED.pop(flags, None)
         raise _worker_died(workers) from None
@@ -137,6 +139,22 @@ def as_completed_map(function: Callable[[Any], Any], items: Sequence[Any], *, wo
             yield futures[future], result
     finally:
         pool.shutdown(wait=True, cancel_futures=True)
+
+
+def _reported(result, on_done):
+    if on_done is not None:
+        on_done()
+    return result
+
+
+def _mapped(pool, function, items: list, on_done) -> list:
+    """`pool.map(function, items)` as a list, calling `on_done()` as each item finishes."""
+    if on_done is None:
+        return list(pool.map(function, items))
+    futures = [pool.submit(function, item) for item in items]
+    for future in futures:
+        future.add_done_callback(lambda _: on_done())
+    return [future.result() for future in futures]
 
 
 def _worker_died(workers: int) -> UserInputError:
