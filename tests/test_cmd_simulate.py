@@ -302,7 +302,9 @@ def test_demo_settled_passes_its_window_to_the_run(tmp_path, capsys, monkeypatch
     monkeypatch.setattr(simulate_cli, "run_cases", stand_in)
     out = tmp_path / "demo"
     assert main(["demo", "--window-revs", "3", "--out", str(out)]) == 130
-    assert seen == [("both", dict(settle="auto", window_revs=3, seeds=1, start="skid"))]
+    from jaxbearing.run import SteadySettings
+
+    assert seen == [("both", SteadySettings(window_revs=3))]  # settle auto, one seed, the skid start
     assert not out.exists()
     capsys.readouterr()
     assert main(["demo", "--window-revs", "2.5", "--out", str(out)]) == 2
@@ -323,15 +325,16 @@ def test_simulate_settles_by_default_and_a_transient_is_explicit(monkeypatch, ca
 
     monkeypatch.setattr(run, "simulate", fake)
     for args, settle in (
-        ([], "auto"),
-        (["--settle", "5"], "5"),
+        ([], run.SettleAuto()),
+        (["--settle", "5"], run.SettleFixed(5.0)),
         (["--transient"], None),
         (["--settle", "off"], None),
     ):
         seen.clear()
         with pytest.raises(SystemExit):
             main(["simulate", "--end", "arc", "--no-progress", *args])
-        assert seen[0].get("settle") == settle, (args, seen[0])
+        settings = seen[0].get("settings")
+        assert (None if settings is None else settings.settle) == settle, (args, seen[0])
     capsys.readouterr()
     for args, words in (
         (
