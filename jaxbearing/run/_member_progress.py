@@ -20,13 +20,14 @@ from collections.abc import Callable
 import numpy as np
 
 from ..io import require
+from ._progress import Ticker
 
 _ACTIVE: contextvars.ContextVar[MemberProgress | None] = contextvars.ContextVar(
     "member_progress", default=None
 )
 
 
-class MemberProgress:
+class MemberProgress(Ticker):
     """Print the members' progress every `interval` seconds while the `with` block runs, through
     `say` (default: print). `label` starts every line."""
 
@@ -38,8 +39,6 @@ class MemberProgress:
         self.total = 0
         self.done = 0
         self._lock = threading.Lock()
-        self._stop = threading.Event()
-        self._thread: threading.Thread | None = None
         self._token = None
         self.start = time.perf_counter()
 
@@ -63,24 +62,17 @@ class MemberProgress:
         )
         return f"{self.label}members settled {done} of {total}, {elapsed:.0f} s elapsed, {left}"
 
-    def _tick(self) -> None:
-        while not self._stop.wait(self.interval):
-            self.say(self.line())
+    def tick(self) -> None:
+        self.say(self.line())
 
     def __enter__(self) -> MemberProgress:
-        self.start = time.perf_counter()
-        self._stop = threading.Event()
+        super().__enter__()
         self._token = _ACTIVE.set(self)
-        self._thread = threading.Thread(target=self._tick, name="member-progress", daemon=True)
-        self._thread.start()
         return self
 
     def __exit__(self, *exc) -> None:
-        self._stop.set()
-        if self._thread is not None:
-            self._thread.join()
-        if self._token is not None:
-            _ACTIVE.reset(self._token)
+        super().__exit__(*exc)
+        _ACTIVE.reset(self._token)
 
 
 def active_progress() -> MemberProgress | None:

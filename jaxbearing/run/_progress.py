@@ -87,7 +87,32 @@ def _close(idx, latest) -> None:
         print(closing_line(p, time.perf_counter() - meter["start"]), flush=True)
 
 
-class HostProgress:
+class Ticker:
+    """A daemon thread that calls `tick()` every `interval` seconds while the `with` block runs
+    (`start`: when the block began, `time.perf_counter()`)."""
+
+    interval: float = 10.0
+
+    def tick(self) -> None:  # pragma: no cover - every subclass has its own
+        raise NotImplementedError
+
+    def _loop(self) -> None:
+        while not self._stop.wait(self.interval):
+            self.tick()
+
+    def __enter__(self):
+        self.start = time.perf_counter()
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._loop, name=type(self).__name__, daemon=True)
+        self._thread.start()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self._stop.set()
+        self._thread.join()
+
+
+class HostProgress(Ticker):
     """The progress of a solve that runs without `SolveProgress` (module docstring): while the
     `with` block runs, a daemon thread prints the elapsed wall time every `interval` seconds;
     `close(fraction)` prints the closing line, `fraction` being the simulated time reached over
@@ -96,25 +121,10 @@ class HostProgress:
     def __init__(self, interval: float = 10.0):
         require("interval", interval, lambda v: np.isfinite(v) & (v > 0), "> 0 s")
         self.interval = float(interval)
-        self._stop = threading.Event()
-        self._thread: threading.Thread | None = None
         self.start = time.perf_counter()
 
-    def _tick(self) -> None:
-        while not self._stop.wait(self.interval):
-            print(f"{_INDENT}{time.perf_counter() - self.start:.0f} s elapsed", flush=True)
-
-    def __enter__(self) -> HostProgress:
-        self.start = time.perf_counter()
-        self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._tick, name="host-progress", daemon=True)
-        self._thread.start()
-        return self
-
-    def __exit__(self, *exc) -> None:
-        self._stop.set()
-        if self._thread is not None:
-            self._thread.join()
+    def tick(self) -> None:
+        print(f"{_INDENT}{time.perf_counter() - self.start:.0f} s elapsed", flush=True)
 
     def close(self, fraction: float) -> None:
         print(closing_line(float(fraction), time.perf_counter() - self.start), flush=True)
