@@ -54,6 +54,10 @@ def test_not_enough_data_gives_the_rule_of_three():
     assert r.method == "not enough data" and r.probability == 0.0 and r.lower == 0.0
     assert r.upper == pytest.approx(1 - 0.1 ** (1 / 40), rel=1e-12)
     assert MIN_TAIL_REVOLUTIONS == 100
+    # 200 revolutions, but the top 50 tied: nothing distinct above a threshold to fit
+    tied = np.concatenate([np.linspace(0.0, 0.5, 150), np.full(50, 0.9)]).reshape(4, 50)
+    r = corner_risk(tied, 1.0)
+    assert r.method == "not enough data" and r.upper == pytest.approx(1 - 0.05 ** (1 / 200))
 
 
 @pytest.mark.parametrize("level, confidence", [(1e-3, 0.95), (1e-2, 0.95), (1e-4, 0.99), (0.05, 0.9)])
