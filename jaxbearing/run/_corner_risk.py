@@ -175,6 +175,8 @@ class CornerRisk:
 def _members(name: str, values) -> list[np.ndarray]:
     """`values` as one float array per member: a 2-D array (members x revolutions), a sequence of
     1-D sequences (members of different lengths), or one 1-D sequence (one member)."""
+    if np.ndim(values) == 0 and not isinstance(values, (list, tuple)):
+        raise UserInputError(f"{name}: a single value: must be an array of members x revolutions")
     try:
         ragged = (
             not isinstance(values, np.ndarray)
