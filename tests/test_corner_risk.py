@@ -282,3 +282,23 @@ def test_few_members_cover_the_rate_of_many_on_fresh_dynamics(tmp_path):
     assert a["brute_force"]["exceedances"] > 0
     for block in a["few"]:
         assert block["covering"] == len(block["groups"])
+
+
+def test_tail_piling_up_at_an_edge_falls_back_to_counting():
+    """Maxima whose density rises towards an edge (70 % spread below 0.9, 30 % within 5e-3 of
+    1: the contact radius running to the arc's edge) are unlike any GPD the fit allows: the shape
+    sits at its bound and the upper bound is at least the counting bound, whatever the
+    extrapolation says; with
+    `method="tail"` the fit is also reported where revolutions passed the limit."""
+    rng = np.random.default_rng(11)
+    x = np.concatenate([rng.uniform(0.0, 0.9, 280), rng.uniform(0.995, 1.0, 120)]).reshape(4, 100)
+    e = corner_risk(x, 1.0 + 1e-6)
+    assert e.method == "tail" and e.tail.at_shape_bound
+    assert e.upper >= e.counting_upper
+    x[0, :3] = 1.0 + 2e-6
+    forced = corner_risk(x, 1.0 + 1e-6, method="tail")
+    assert forced.method == "tail" and forced.exceedances == 3 and forced.tail is not None
+    with pytest.raises(UserInputError, match="^maxima: 8 revolutions"):
+        corner_risk(np.ones(8), 1.0, method="tail")
+    with pytest.raises(UserInputError, match="^method = 'fit'"):
+        corner_risk(np.ones(8), 1.0, method="fit")

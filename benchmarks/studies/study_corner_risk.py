@@ -13,6 +13,7 @@ flange PV (`jaxbearing.run.revolution_maxima`). Then:
 * the few: the members split into disjoint groups of `--few`, each group's `corner_risk` with
   its bounds (one-sided 95 % each: a two-sided 90 % interval), and whether it covers the
   brute-force rate;
+* the tail model at the limit over every member (`method="tail"`), beside the counts;
 * the tail model at pseudo-limits: radii r below rho_lim where the pooled rate is observed
   (`--levels`, pooled exceedance rates), each group's estimate of P(M > r) against the pooled
   rate, with the method each group used (the tail fit extrapolates where a group saw none).
@@ -110,6 +111,7 @@ def analyse(data: dict, few, levels) -> dict:
     stored members (module docstring)."""
     import numpy as np
 
+    from jaxbearing._errors import UserInputError
     from jaxbearing.run import corner_risk
 
     members = [m for m in data["members"] if m["status"] == "ok" and m["contact_radius_max_m"]]
@@ -167,8 +169,13 @@ def analyse(data: dict, few, levels) -> dict:
                 "covered": sum(x["covers"] for x in rows),
             }
         )
+    try:  # the tail model at the limit over every member, beside the counts
+        tail_model = corner_risk(maxima, rho_lim, method="tail").as_dict()
+    except UserInputError as e:
+        tail_model = {"error": str(e)}
     return {
         "members_used": len(members),
+        "tail_model_at_the_limit": tail_model,
         "revolutions": int(pooled.size),
         "brute_force": many.as_dict(),
         "few": few_blocks,

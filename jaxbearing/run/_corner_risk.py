@@ -43,7 +43,11 @@ two-sided interval at 2 confidence - 1). Three methods, chosen by the data (`cor
   rho_lim (p^ = 0): its upper bound is the largest p the data do not exclude. xi is kept in
   [-0.5, 1] (the range where maximum likelihood is regular, Smith 1985, Biometrika 72:67; below
   -1 the likelihood is unbounded; a lighter fitted tail would set p = 0 on little evidence, and
-  xi >= 1 is not physical for a bounded contact radius). Dependence between revolutions scales
+  xi >= 1 is not physical for a bounded contact radius). A fit with xi at -0.5 says the tail is
+  lighter than any GPD allowed, or unlike one: a density that rises towards an edge, as the
+  contact radius does where the contact runs to the arc's edge and jumps onto the corner (the
+  settled dynamics near the corner, docs/model.md 16). The extrapolation is then not trusted and
+  the upper bound is the counting bound (`TailFit.at_shape_bound`). Dependence between revolutions scales
   the deviance threshold by deff >= 1 (the magnitude adjustment of the independence likelihood;
   Chandler & Bate 2007, Biometrika 94:167), deff the larger of the threshold-exceedance
   indicator's design effect over members (as above) and (1 + r1)/(1 - r1), r1 its lag-1
@@ -82,6 +86,8 @@ MAX_TAIL_FRACTION = 0.30
 MIN_TAIL_REVOLUTIONS = math.ceil(MIN_TAIL_EXCEEDANCES / MAX_TAIL_FRACTION)
 #: the range of the GPD shape xi in the fit
 SHAPE_RANGE = (-0.5, 1.0)
+#: a fitted shape within this of the lower end of SHAPE_RANGE is "at the bound"
+SHAPE_BOUND_TOLERANCE = 0.01
 #: the smallest probability the profile search resolves; a bound below it is reported as 0
 PROFILE_FLOOR = 1e-15
 #: the relative precision of a profile bound (on log p)
@@ -103,9 +109,15 @@ class TailFit:
     exceedance_rate: float
     endpoint_m: float
     design_effect: float
+    #: the fitted shape at the lower end of `SHAPE_RANGE`: the tail is lighter than, or unlike,
+    #: any GPD the fit allows; the upper bound is then the counting bound (module docstring)
+    at_shape_bound: bool = False
 
     def as_dict(self) -> dict:
-        return {k: (v if math.isfinite(v) else None) for k, v in dataclasses.asdict(self).items()}
+        return {
+            k: (v if isinstance(v, bool) or math.isfinite(v) else None)
+            for k, v in dataclasses.asdict(self).items()
+        }
 
 
 @dataclasses.dataclass(frozen=True)
@@ -314,9 +326,10 @@ def _fit_gpd(excess):
     for xi0 in (-0.5, -0.2, 0.1):
         # a start inside the support: sigma > -xi max(y)
         s0 = max(mean * (1 - xi0), -xi0 * top * 1.05, 1e-300)
-        r = _opt.minimize(
-            nll, [math.log(s0), xi0], method="Nelder-Mead", options={"xatol": 1e-10, "fatol": 1e-10}
-        )
+        with np.errstate(invalid="ignore"):  # inf - inf of simplex points outside the support
+            r = _opt.minimize(
+                nll, [math.log(s0), xi0], method="Nelder-Mead", options={"xatol": 1e-10, "fatol": 1e-10}
+            )
         if best is None or r.fun < best.fun:
             best = r
     return (math.exp(best.x[0]), float(best.x[1])), float(best.fun)
@@ -363,7 +376,8 @@ class _Profile:
         q0 = math.log(max(zeta0 - p, 1e-300) / max(1 - zeta0, 1e-300)) if zeta0 > p else 5.0
         best = None
         for start in ([q0, self.start[1]], [q0, self.shape]):
-            r = _opt.minimize(negll, start, method="Nelder-Mead", options={"xatol": 1e-4, "fatol": 1e-5})
+            with np.errstate(invalid="ignore"):  # inf - inf of simplex points outside the support
+                r = _opt.minimize(negll, start, method="Nelder-Mead", options={"xatol": 1e-4, "fatol": 1e-5})
             if np.isfinite(r.fun) and (best is None or r.fun < best.fun):
                 best = r
             if best is not None:
@@ -390,6 +404,8 @@ def _tail(rows, rho_lim, confidence, n):
     zeta = k / n
     (sigma, shape), nll = _fit_gpd(excess)
     z = rho_lim - u
+    if z <= 0:  # the threshold lies beyond the limit (method "tail" with many revolutions there)
+        return None
     p_hat = zeta * _survival(z, sigma, shape)
     ll_hat = _binomial_ll(k, n, zeta) - nll
     # dependence: the design effect of the threshold-exceedance indicator over members and the
@@ -423,8 +439,13 @@ def _tail(rows, rho_lim, confidence, n):
             return end
         while True:
             b = min(a + step, end) if step > 0 else max(a + step, end)
-            if b == end or excess_deviance(b) > 0:
-                return _opt.brentq(excess_deviance, min(a, b), max(a, b), xtol=BOUND_RTOL)
+            if excess_deviance(b) > 0:
+                try:
+                    return _opt.brentq(excess_deviance, min(a, b), max(a, b), xtol=BOUND_RTOL)
+                except ValueError:  # the warm-started profile moved between evaluations
+                    return b
+            if b == end:
+                return end
             a = b
 
     upper = math.exp(crossing(math.log(10.0), log_top))
@@ -436,7 +457,10 @@ def _tail(rows, rho_lim, confidence, n):
         found = crossing(-math.log(10.0), log_floor)
         lower = 0.0 if found <= log_floor else math.exp(found)
     endpoint = u - sigma / shape if shape < 0 else math.inf
-    fit = TailFit(float(u), float(sigma), float(shape), k, float(zeta), float(endpoint), float(deff))
+    at_bound = shape <= SHAPE_RANGE[0] + SHAPE_BOUND_TOLERANCE
+    fit = TailFit(
+        float(u), float(sigma), float(shape), k, float(zeta), float(endpoint), float(deff), bool(at_bound)
+    )
     return float(p_hat), float(lower), float(upper), fit
 
 
@@ -455,7 +479,7 @@ def _conditional_peak(rows, pv, rho_lim, confidence):
 
 
 def corner_risk(
-    maxima, rho_lim: float, confidence: float = CORNER_RISK_CONFIDENCE, *, peak_pv=None
+    maxima, rho_lim: float, confidence: float = CORNER_RISK_CONFIDENCE, *, peak_pv=None, method: str = "auto"
 ) -> CornerRisk:
     """The probability per cage revolution that a roller-flange contact reaches the limited
     circle, with one-sided bounds at `confidence` (module docstring).
@@ -464,8 +488,12 @@ def corner_risk(
     flange, members x revolutions (a 2-D array, or one sequence per member; 0 for a revolution
     without flange contact); `rho_lim` [m]: the limited-circle radius; `peak_pv` [Pa m/s]: the
     revolutions' peak flange PV, same layout (optional; gives the expected peak PV of a revolution
-    that reached the corner)."""
+    that reached the corner). `method`: "auto" (by the data, module docstring) or "tail" (the
+    tail fit also where revolutions reached the corner, to compare the model with the counts;
+    needs `MIN_TAIL_REVOLUTIONS` and a threshold below `rho_lim`)."""
     rows, pv = _check(maxima, rho_lim, confidence, peak_pv)
+    if method not in ("auto", "tail"):
+        raise UserInputError(f"method = {method!r}: must be 'auto' or 'tail'")
     rho_lim, confidence = float(rho_lim), float(confidence)
     n = int(sum(r.size for r in rows))
     members = int(sum(r.size > 0 for r in rows))
@@ -482,18 +510,33 @@ def corner_risk(
         largest_m=largest,
         counting_upper=counting_upper,
     )
-    if x > 0:
-        peak = _conditional_peak(rows, pv, rho_lim, confidence) if pv is not None else None
+    peak = _conditional_peak(rows, pv, rho_lim, confidence) if pv is not None and x > 0 else None
+    if x > 0 and method == "auto":
         return CornerRisk(
             p, lower, upper, method="count", design_effect=deff, peak_pv_given_contact=peak, **common
         )
-    if n < MIN_TAIL_REVOLUTIONS or np.unique(np.concatenate(rows)).size < MIN_TAIL_EXCEEDANCES + 1:
-        return CornerRisk(0.0, 0.0, counting_upper, method="not enough data", **common)
-    tail = _tail(rows, rho_lim, confidence, n)
+    few = n < MIN_TAIL_REVOLUTIONS or np.unique(np.concatenate(rows)).size < MIN_TAIL_EXCEEDANCES + 1
+    tail = None if few else _tail(rows, rho_lim, confidence, n)
+    if tail is None and method == "tail":
+        raise UserInputError(
+            f"maxima: {n} revolutions: the tail fit needs at least {MIN_TAIL_REVOLUTIONS} with "
+            f"{MIN_TAIL_EXCEEDANCES} distinct values above a threshold below rho_lim"
+        )
     if tail is None:
         return CornerRisk(0.0, 0.0, counting_upper, method="not enough data", **common)
     p, lower, upper, fit = tail
-    return CornerRisk(p, lower, upper, method="tail", design_effect=fit.design_effect, tail=fit, **common)
+    if fit.at_shape_bound:  # a tail the GPD family does not fit: the counting bound, model-free
+        upper = max(upper, counting_upper)
+    return CornerRisk(
+        p,
+        lower,
+        upper,
+        method="tail",
+        design_effect=fit.design_effect,
+        tail=fit,
+        peak_pv_given_contact=peak,
+        **common,
+    )
 
 
 # -- the data of a settled run -----------------------------------------------------------------
