@@ -100,7 +100,8 @@ METHODS = ("count", "tail", "not enough data")
 class TailFit:
     """The generalised Pareto tail above the threshold u (module docstring): `threshold_m` u,
     `scale_m` sigma, `shape` xi, `exceedances` k, `exceedance_rate` zeta_u = k/n, `endpoint_m`
-    u - sigma/xi for xi < 0 (inf otherwise), `design_effect` the deviance scaling."""
+    u - sigma/xi for xi < 0 (inf otherwise), `design_effect` the deviance scaling,
+    `profile_upper` the profile-likelihood upper bound of p."""
 
     threshold_m: float
     scale_m: float
@@ -112,6 +113,8 @@ class TailFit:
     #: the fitted shape at the lower end of `SHAPE_RANGE`: the tail is lighter than, or unlike,
     #: any GPD the fit allows; the upper bound is then the counting bound (module docstring)
     at_shape_bound: bool = False
+    #: the profile likelihood's upper bound itself (the reported bound may be the counting one)
+    profile_upper: float = math.nan
 
     def as_dict(self) -> dict:
         return {
@@ -459,7 +462,15 @@ def _tail(rows, rho_lim, confidence, n):
     endpoint = u - sigma / shape if shape < 0 else math.inf
     at_bound = shape <= SHAPE_RANGE[0] + SHAPE_BOUND_TOLERANCE
     fit = TailFit(
-        float(u), float(sigma), float(shape), k, float(zeta), float(endpoint), float(deff), bool(at_bound)
+        float(u),
+        float(sigma),
+        float(shape),
+        k,
+        float(zeta),
+        float(endpoint),
+        float(deff),
+        bool(at_bound),
+        float(upper),
     )
     return float(p_hat), float(lower), float(upper), fit
 
