@@ -269,7 +269,8 @@ def test_settled_summary_reports_the_corner_risk():
 @pytest.mark.slow
 def test_few_members_cover_the_rate_of_many_on_fresh_dynamics(tmp_path):
     """The corner-risk study run afresh at a small size (11 slices, 6 members of 8 revolutions
-    at 106.9 mm / 1.616 deg / 0.15 mm, 20,000 rpm; about 10 minutes on 2 cores): the corner is
+    at 106.9 mm / 1.616 deg / 0.15 mm, 20,000 rpm; 6 min 6 s on the 2-core machine beside another
+    process): the corner is
     reached, and every pair's bounds and both groups of three cover the rate of all six."""
     import importlib.util
 
@@ -302,3 +303,31 @@ def test_tail_piling_up_at_an_edge_falls_back_to_counting():
         corner_risk(np.ones(8), 1.0, method="tail")
     with pytest.raises(UserInputError, match="^method = 'fit'"):
         corner_risk(np.ones(8), 1.0, method="fit")
+
+
+def test_steady_corner_risk_of_a_settled_result():
+    """`steady_corner_risk` reads every measured member's per-revolution statistics and the
+    bearing's limited circle; a result without a measured member is a one-line error."""
+    import types
+
+    import jaxbearing as jb
+    from jaxbearing.geometry import limited_circle_radius
+    from jaxbearing.run import SeedRun, steady_corner_risk
+
+    b, op = jb.reference_bearing(), jb.reference_operating_point()
+    rho = float(limited_circle_radius(b.roller))
+
+    def member(seed, radii, status="ok"):
+        per_rev = {
+            "cage_speed_rpm": np.full(len(radii), 8400.0),
+            "contact_radius_m.max_in_contact": np.asarray(radii),
+            "flange_pv_Pa_m_s.max": np.full(len(radii), 6e9),
+        }
+        return SeedRun(seed, {}, np.zeros(0), 0.0, True, [], [], status, 0, per_revolution=per_rev)
+
+    runs = [member(0, [3.0e-3, rho + 1e-7]), member(1, [3.1e-3, 3.2e-3]), member(2, [rho + 1e-7], "failed")]
+    result = types.SimpleNamespace(runs=runs, bearing=b, operating=op)
+    risk = steady_corner_risk(result)
+    assert (risk.revolutions, risk.members, risk.exceedances, risk.method) == (4, 2, 1, "count")
+    with pytest.raises(UserInputError, match="^result: no member"):
+        steady_corner_risk(types.SimpleNamespace(runs=runs[2:], bearing=b, operating=op))
