@@ -53,6 +53,7 @@ def test_not_enough_data_gives_the_rule_of_three():
     r = corner_risk(x, 2.0, confidence=0.9)
     assert r.method == "not enough data" and r.probability == 0.0 and r.lower == 0.0
     assert r.upper == pytest.approx(1 - 0.1 ** (1 / 40), rel=1e-12)
+    assert r.bounded_below(0.06) and not r.bounded_below(0.05)
     assert MIN_TAIL_REVOLUTIONS == 100
     # 200 revolutions, but the top 50 tied: nothing distinct above a threshold to fit
     tied = np.concatenate([np.linspace(0.0, 0.5, 150), np.full(50, 0.9)]).reshape(4, 50)

@@ -138,7 +138,8 @@ class ConditionalPeak:
 class CornerRisk:
     """The corner-contact risk per cage revolution (module docstring).
 
-    `probability` p^; `lower`, `upper`: one-sided bounds at `confidence` each; `method`: one of
+    `probability` p^; `lower`, `upper`: bounds, each one-sided at `confidence` (the counts) or
+    at (1 + confidence)/2 (the tail's profile likelihood); `method`: one of
     `METHODS`; `revolutions` n, `members` N, `exceedances` x (revolutions beyond `rho_lim_m`);
     `counting_upper`: the Clopper-Pearson upper bound of the counts alone; `design_effect`: the
     between-revolution dependence factor applied (1: none); `tail`: the `TailFit` (method
