@@ -56,18 +56,12 @@ from ._compile_cache import (
     program_cache_dir,
 )
 from ._corner_risk import (
-    CORNER_RISK_CONFIDENCE,
-    MIN_TAIL_REVOLUTIONS,
     ConditionalPeak,
     CornerRisk,
     RevolutionMaxima,
-    TailFit,
-    clopper_pearson,
-    cluster_design_effect,
     corner_risk,
     corner_risk_of_revolutions,
     revolution_maxima,
-    revolutions_needed,
 )
 from ._engine import STRATEGIES, choose_strategy, stack_trees
 from ._ensemble import as_completed_map, available_cpus, parallel_map, shared_workers, simulate_ensemble
@@ -75,6 +69,7 @@ from ._initial import STARTS, Perturbation, SkidStart, initial_state, skid_start
 from ._measured import model_cage_speeds
 from ._plots import plot_measured, plot_run
 from ._progress import HostProgress, SolveProgress
+from ._proportions import CORNER_RISK_CONFIDENCE, clopper_pearson, cluster_design_effect, revolutions_needed
 from ._result import (
     RESULT_NAMES,
     SimulationResult,
@@ -132,6 +127,7 @@ from ._step_control import (
     raceway_normal_norm,
 )
 from ._summary import CONTACT_THRESHOLD, FILM_KEYS, contact_events, film_statistics
+from ._tail_fit import MIN_TAIL_REVOLUTIONS, TailFit
 
 __all__ = [
     "CONTACT_THRESHOLD",
