@@ -13,7 +13,12 @@
   `batch_means`, `student_t_interval`, `Estimate`, `tail_mean` (the mean above the
   `TAIL_LEVEL` quantile); how often the contact reached the corner,
   with upper bounds: `corner_contact_bound`, `upper_probability_bound`; the prediction bound
-  of one revolution's largest contact radius: `max_contact_radius_bound`;
+  of one revolution's largest contact radius: `max_contact_radius_bound`; the corner-contact
+  risk per revolution with its confidence bounds (counting, or a generalised Pareto tail with a
+  profile-likelihood interval): `corner_risk` (`CornerRisk`, `TailFit`, `ConditionalPeak`),
+  from a settled run `steady_corner_risk` (or its members' statistics,
+  `corner_risk_of_revolutions`; in the summary as `corner_risk`), its data `revolution_maxima` (`RevolutionMaxima`),
+  `revolutions_needed`, `clopper_pearson`, `cluster_design_effect`;
 - settled running: `simulate_steady` (settling detection over cage revolutions, a window,
   seeds), `simulate_steady_points` (the same at several operating points, one engine call),
   `summarise_steady`; the steady-running engine under it, `settle_members` (many
@@ -54,6 +59,14 @@ from ._compile_cache import (
     enable_compilation_cache,
     program_cache_dir,
 )
+from ._corner_risk import (
+    ConditionalPeak,
+    CornerRisk,
+    RevolutionMaxima,
+    corner_risk,
+    corner_risk_of_revolutions,
+    revolution_maxima,
+)
 from ._dispatch import EngineRun, settle_members
 from ._engine import STRATEGIES, choose_strategy, stack_trees
 from ._ensemble import as_completed_map, available_cpus, parallel_map, shared_workers, simulate_ensemble
@@ -63,6 +76,7 @@ from ._member import Answer, Member, Phase, Request, SeedRun
 from ._member_progress import MemberProgress
 from ._plots import plot_measured, plot_run
 from ._progress import HostProgress, SolveProgress
+from ._proportions import CORNER_RISK_CONFIDENCE, clopper_pearson, cluster_design_effect, revolutions_needed
 from ._result import (
     RESULT_NAMES,
     SimulationResult,
@@ -103,6 +117,7 @@ from ._statistics import (
     max_contact_radius_bound,
     revolution_statistic_keys,
     revolution_statistics,
+    steady_corner_risk,
     steady_statistics,
     student_t_interval,
     tail_mean,
@@ -121,6 +136,7 @@ from ._step_control import (
     raceway_normal_norm,
 )
 from ._summary import CONTACT_THRESHOLD, FILM_KEYS, contact_events, film_statistics
+from ._tail_fit import MIN_TAIL_REVOLUTIONS, TailFit
 
 __all__ = [
     "CONTACT_THRESHOLD",
@@ -187,6 +203,19 @@ __all__ = [
     "corner_contact_bound",
     "max_contact_radius_bound",
     "upper_probability_bound",
+    "CORNER_RISK_CONFIDENCE",
+    "MIN_TAIL_REVOLUTIONS",
+    "ConditionalPeak",
+    "CornerRisk",
+    "RevolutionMaxima",
+    "TailFit",
+    "clopper_pearson",
+    "cluster_design_effect",
+    "corner_risk",
+    "corner_risk_of_revolutions",
+    "revolution_maxima",
+    "revolutions_needed",
+    "steady_corner_risk",
     "summarise",
     "summarise_steady",
     "EngineRun",

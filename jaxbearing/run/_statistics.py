@@ -37,7 +37,9 @@ import dataclasses
 import numpy as np
 from scipy import stats as _sp_stats
 
+from .._errors import UserInputError
 from ..geometry import kinematic_cage_speed, limited_circle_radius, rad_s_to_rpm
+from ._corner_risk import CORNER_RISK_CONFIDENCE, CornerRisk, corner_risk_of_revolutions
 from ._summary import _EVENT_QUANTITIES, CONTACT_THRESHOLD, FILM_KEYS, contact_events, film_statistics
 
 CONFIDENCE = 0.95
@@ -313,6 +315,28 @@ def steady_statistics(
     block["ci_method"] = method
     block["corner_contact_bound"] = corner_contact_bound(per_rev, rho_lim)
     block["max_contact_radius_bound"] = max_contact_radius_bound(per_rev)
+    risk = corner_risk_of_revolutions(per_rev, rho_lim)
+    block["corner_risk"] = risk.as_dict() if risk is not None else None
     block["limited_circle_radius_m"] = rho_lim
     block["kinematic_cage_speed_rpm"] = float(rad_s_to_rpm(kin))
     return block
+
+
+def steady_corner_risk(result, confidence: float = CORNER_RISK_CONFIDENCE) -> CornerRisk:
+    """`corner_risk` of a settled run (`SteadyResult`): every measured member's revolutions, the
+    bearing's limited circle, the peak PV given corner contact."""
+    per_rev = [
+        r.per_revolution
+        if r.per_revolution is not None
+        else window_statistics(r.window, r.edges, result.bearing, result.operating)
+        for r in result.runs
+        if r.measured
+    ]
+    risk = corner_risk_of_revolutions(
+        per_rev, float(limited_circle_radius(result.bearing.roller)), confidence
+    )
+    if risk is None:
+        raise UserInputError(
+            "result: no member has a measured revolution: nothing to estimate the corner risk from"
+        )
+    return risk
