@@ -4,9 +4,9 @@ static skid equilibrium's cage slip over speed x radial load, its balance of ter
 to the traction curve and the oil fraction, the cage torque with the rollers in balance against
 the cage speed (`dynamics.balanced_cage_torque`), and settled runs (2 seeds, 95 % intervals).
 
-    taskset -c 1 python benchmarks/studies/study_skid_regime.py            # statics, 4.5 min
-    taskset -c 1 python benchmarks/studies/study_skid_regime.py --curves   # M(omega_c)
-    taskset -c 1 python benchmarks/studies/study_skid_regime.py --settled  # settled runs
+    taskset -c 1 python benchmarks/studies/study_skid_regime.py            # statics, 3.6 min on one core
+    taskset -c 1 python benchmarks/studies/study_skid_regime.py --curves   # M(omega_c), about 1 min
+    taskset -c 1 python benchmarks/studies/study_skid_regime.py --settled  # settled runs, 9.5 min
     python benchmarks/studies/study_skid_regime.py --plot   # docs/figures/skid_regime/skid_regime.png
 """
 
