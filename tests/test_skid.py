@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import jaxbearing as jb
-from jaxbearing.dynamics import Params, contact_loads, physical_rates
+from jaxbearing.dynamics import Params, contact_loads, physical_rates, skid_balance, skid_zones
 from jaxbearing.geometry import kinematic_cage_speed
 from jaxbearing.run import Perturbation, skid_start
 from jaxbearing.run._initial import kinematic_start
@@ -71,6 +71,49 @@ def test_skid_equilibrium_balances_the_slow_equations(reference, reference_skid)
     pocket = jax.jit(contact_loads)(reference_skid.state, params).pocket
     assert np.all(np.asarray(jnp.sum(jnp.abs(pocket.force_on_roller), axis=-1)) > 1e-3)
     assert 0.005 < float(reference_skid.time_constant) < 0.5  # s: the slow mode of the cage
+
+
+def test_skid_balance_resolves_the_equations_and_caps_the_drive(reference, reference_skid):
+    """`skid_balance` splits the vector field's own sums: per roller, the orbit torques add up to
+    m_b r^2 theta'' and the spin moments to I_a (d omega/dt).e; the cage torques to I_p omega_c'
+    (all three near zero at the equilibrium). Past the traction peak (20,000 rpm: several m/s of
+    sliding on the inner raceway) the traction coefficient is its asymptote D to 1e-6
+    (kappa(du) - D = (A + B du) exp(-C du)), so the inner-raceway drive of each loaded roller is
+    the closed form D Q_i r_j: to 1 % per roller (the displaced inner ring's contact normals lean
+    by about 1e-4 rad, so the normal force adds +/-0.4 % of the traction on the two flanks of the
+    load zone) and to 1e-3 summed over the zone, where the two flanks cancel."""
+    b, op = reference
+    eq = reference_skid.equilibrium
+    t = skid_balance(eq.state, Params(bearing=b, operating=op))
+    r = np.asarray(eq.state.rollers.radial)
+    orbit = sum(
+        np.asarray(getattr(t, k))
+        for k in ("orbit_inner", "orbit_outer", "orbit_flange", "orbit_pocket", "orbit_drag", "orbit_gravity")
+    )
+    spin = sum(
+        np.asarray(getattr(t, k))
+        for k in ("spin_inner", "spin_outer", "spin_flange", "spin_pocket", "spin_drag")
+    )
+    scale = float(np.max(np.abs(t.orbit_pocket)))
+    np.testing.assert_allclose(
+        orbit, float(b.roller_mass) * r**2 * np.asarray(eq.orbit_residual), atol=1e-9 * scale
+    )
+    np.testing.assert_allclose(
+        spin, float(b.roller_inertia[0]) * np.asarray(eq.spin_residual), atol=1e-9 * scale
+    )
+    cage = float(t.cage_pocket + t.cage_land + t.cage_drag)
+    assert cage == pytest.approx(float(b.cage_inertia[0] * eq.cage_torque_residual), abs=1e-9 * scale)
+    assert np.max(np.abs(orbit)) < 1e-6 * scale and abs(cage) < 1e-6 * abs(float(t.cage_pocket))
+    loaded = np.asarray(t.loaded)
+    assert 3 <= loaded.sum() < b.num_rollers and float(np.min(t.inner_sliding[loaded])) > 2.0  # m/s
+    d = float(b.lubricant.traction_d)
+    closed = d * np.asarray(t.inner_load)[loaded] * r[loaded]
+    np.testing.assert_allclose(np.asarray(t.orbit_inner)[loaded], closed, rtol=1e-2)
+    z = skid_zones(t)  # by zone: the roller set's terms add up to minus the pocket term
+    rollers = z.inner_traction_loaded + z.outer_traction_loaded + z.outer_traction_unloaded
+    rollers = rollers + z.roller_drag + z.flange + z.gravity
+    assert float(rollers) == pytest.approx(-float(z.pocket_on_rollers), abs=1e-6 * scale)
+    assert float(z.inner_traction_loaded) == pytest.approx(float(np.sum(closed)), rel=1e-3)
 
 
 def test_no_start_up_step_from_the_skid_start(reference, reference_skid):

@@ -8,7 +8,9 @@
   ring, with `contact_loads` (every contact of one state) and the smooth `Functionals`;
 - the start (docs/model.md 12): `quasi_static` (load distribution with centrifugal force) and
   `skid_equilibrium` (the speeds of steady running at those positions) with the
-  `cage_time_constant` of the cage speed's slow approach to it.
+  `cage_time_constant` of the cage speed's slow approach to it; `skid_balance` (the terms of
+  its roller and cage balances, resolved by contact), `skid_zones` (summed by zone) and
+  `balanced_cage_torque` (the cage torque with the rollers in balance, at any cage speed).
 
 May import: `jaxbearing._errors`, `contact`, `geometry`, `io`, `flange`, `forces`.
 """
@@ -25,7 +27,16 @@ from ._field import (
 )
 from ._quasistatic import QuasiStatic, quasi_static
 from ._rigid_body import angular_momentum, axisymmetric_body_rates, kinetic_energy
-from ._skid import SkidEquilibrium, cage_time_constant, skid_equilibrium
+from ._skid import (
+    SkidBalance,
+    SkidEquilibrium,
+    SkidZones,
+    balanced_cage_torque,
+    cage_time_constant,
+    skid_balance,
+    skid_equilibrium,
+    skid_zones,
+)
 from ._state import (
     SCALED_UNITS,
     Accumulators,
@@ -52,10 +63,13 @@ __all__ = [
     "RingState",
     "RollerState",
     "Scaling",
+    "SkidBalance",
     "SkidEquilibrium",
+    "SkidZones",
     "State",
     "angular_momentum",
     "axisymmetric_body_rates",
+    "balanced_cage_torque",
     "cage_time_constant",
     "contact_loads",
     "inner_ring_pose",
@@ -63,7 +77,9 @@ __all__ = [
     "physical_rates",
     "quasi_static",
     "radial_unit",
+    "skid_balance",
     "skid_equilibrium",
+    "skid_zones",
     "state_scales",
     "tangential_unit",
 ]

@@ -31,9 +31,13 @@ no tangential stiffness):
   rollers at once by bisection on brackets that contain the root (the spin between 0 and 1.5
   times the faster of the outer- and inner-raceway rolling spins, the offset across the pocket clearance plus a margin),
   alternately (block Gauss-Seidel; the coupling is the pocket friction moment);
-- the cage torque, with the rollers in equilibrium, decreases with the cage speed (a faster cage
-  drives its rollers faster than the raceways roll them, the traction brakes them and they push
-  back on the pockets): the Illinois regula falsi on omega_c in [0.2, 1.02] x kinematic;
+- the cage torque, with the rollers in equilibrium, mostly decreases with the cage speed (a
+  faster cage drives its rollers faster than the raceways roll them, the traction brakes them
+  and they push back on the pockets): the Illinois regula falsi on omega_c in [0.2, 1.02] x
+  kinematic. Near the skid onset it need not be monotone: where the traction peak can carry the
+  rollers at nearly pure rolling it has three roots (skid, unstable, near rolling; at 20,000 rpm
+  and 1000 N, docs/validation.md "The skid regime"), and the regula falsi returns the skid root,
+  where the dynamics started from pure rolling settle too (`balanced_cage_torque` scans it);
 - the cage centre: Newton's method on the 2-vector force balance with the rollers riding along
   with their pockets (smooth: the Ocvirk land film), the step capped inside the guiding
   clearance; cage speed and centre alternate twice.
@@ -62,7 +66,8 @@ import jax
 import jax.numpy as jnp
 from jaxtyping import Array, Float
 
-from ._field import Params, physical_rates
+from ..forces import cage_drag_torque, cage_land_forces, roller_drag
+from ._field import Params, contact_loads, physical_rates
 from ._state import CageState, RollerState, State, tangential_unit
 
 #: bisection steps for each roller's spin and pocket offset (bracket / 2^48 is far below rounding
@@ -284,3 +289,148 @@ def cage_time_constant(equilibrium: SkidEquilibrium, params: Params, relative_st
     spin_slope = (hi[0] - lo[0]) / (2 * dw)
     inertia = i_c + jnp.sum(b.roller_mass * s.rollers.radial**2 + i_a * jnp.abs(spin_slope))
     return inertia / -torque_slope
+
+
+class SkidBalance(eqx.Module):
+    """The terms of the skid balance at one state, each from the vector field's own force laws.
+
+    Orbit torques [N m] about the bearing axis on roller j, r_j F.e_tan (r_j its orbit radius,
+    e_tan its tangential unit): from the inner and outer raceway traction (all slices), the four
+    flange contacts, the pocket, the oil-air drag (`forces.roller_drag`) and gravity. Their sum
+    is r_j m_b (r_j theta_j'' + 2 r_j' theta_j'), zero in the orbit balance.
+    Spin moments [N m] about roller j's axis e_j, M.e_j: the same contacts and the drag's spin
+    torque; their sum is I_a (d omega_j/dt).e_j, zero in the spin balance.
+    Cage torques [N m] about the bearing axis: all pockets, the guiding-land film
+    (`forces.cage_land_forces`) and churning (`forces.cage_drag_torque`); their sum is
+    I_p omega_c', zero in the cage balance.
+    `loaded`: the rollers with an inner-raceway load (the loaded zone); `inner_sliding`,
+    `outer_sliding` [m/s]: each roller's load-weighted mean sliding speed on the raceway
+    (the argument du of the traction curve kappa(du), docs/model.md 8); `inner_load`,
+    `outer_load` [N]: the raceway normal loads Q."""
+
+    loaded: Array
+    inner_load: Float[Array, " Z"]
+    outer_load: Float[Array, " Z"]
+    inner_sliding: Float[Array, " Z"]
+    outer_sliding: Float[Array, " Z"]
+    orbit_inner: Float[Array, " Z"]
+    orbit_outer: Float[Array, " Z"]
+    orbit_flange: Float[Array, " Z"]
+    orbit_pocket: Float[Array, " Z"]
+    orbit_drag: Float[Array, " Z"]
+    orbit_gravity: Float[Array, " Z"]
+    spin_inner: Float[Array, " Z"]
+    spin_outer: Float[Array, " Z"]
+    spin_flange: Float[Array, " Z"]
+    spin_pocket: Float[Array, " Z"]
+    spin_drag: Float[Array, " Z"]
+    cage_pocket: Float[Array, ""]
+    cage_land: Float[Array, ""]
+    cage_drag: Float[Array, ""]
+
+
+def skid_balance(state: State, params: Params) -> SkidBalance:
+    """The terms of the roller orbit, roller spin and cage torque balances at `state`
+    (`SkidBalance`), e.g. at `skid_equilibrium(...).state`: the same contacts as
+    `physical_rates` (`contact_loads`, `roller_drag`, `cage_land_forces`, `cage_drag_torque`),
+    resolved by body, direction and contact instead of summed."""
+    b = params.bearing
+    r = state.rollers
+    loads = contact_loads(state, params)
+    e = r.axis / jnp.linalg.norm(r.axis, axis=-1, keepdims=True)
+    spin = jnp.sum(r.angular_velocity * e, axis=-1)
+    drag_f, drag_m = jax.vmap(roller_drag, in_axes=(None, 0, 0))(b, r.velocity, spin)
+    lever = r.radial[:, None] * tangential_unit(r.azimuth)
+
+    def orbit(force):
+        return jnp.sum(force * lever, axis=-1)
+
+    def about_axis(moment):
+        return jnp.sum(moment * e, axis=-1)
+
+    weight = b.roller_mass * params.operating.gravity * jnp.array([0.0, 0.0, 1.0])
+    fl = loads.flange
+    cage = state.cage
+    cage_c = jnp.concatenate([jnp.zeros(1), cage.centre])
+    cage_v = jnp.concatenate([jnp.zeros(1), cage.velocity])
+    _, land_m = cage_land_forces(b, cage_c, cage_v, cage.speed)
+    return SkidBalance(
+        loaded=loads.inner.normal_load > 0,
+        inner_load=loads.inner.normal_load,
+        outer_load=loads.outer.normal_load,
+        inner_sliding=loads.inner.mean_sliding_speed,
+        outer_sliding=loads.outer.mean_sliding_speed,
+        orbit_inner=orbit(loads.inner.force_on_roller),
+        orbit_outer=orbit(loads.outer.force_on_roller),
+        orbit_flange=orbit(jnp.sum(fl.force_on_roller, axis=1)),
+        orbit_pocket=orbit(loads.pocket.force_on_roller),
+        orbit_drag=orbit(drag_f),
+        orbit_gravity=orbit(jnp.broadcast_to(weight, drag_f.shape)),
+        spin_inner=about_axis(loads.inner.moment_on_roller),
+        spin_outer=about_axis(loads.outer.moment_on_roller),
+        spin_flange=about_axis(jnp.sum(fl.moment_on_roller, axis=1)),
+        spin_pocket=about_axis(loads.pocket.moment_on_roller),
+        spin_drag=drag_m,
+        cage_pocket=jnp.sum(loads.pocket.moment_on_cage[:, 0]),
+        cage_land=land_m,
+        cage_drag=cage_drag_torque(b, cage.speed),
+    )
+
+
+def balanced_cage_torque(state: State, params: Params, cage_speed) -> tuple[Array, SkidBalance]:
+    """M(omega_c): the cage torque [N m] about the bearing axis with every roller in its spin and
+    orbit balance at cage speed `cage_speed` (the function whose root `skid_equilibrium` seeks),
+    at the positions and cage centre of `state` (e.g. the equilibrium's), and its `SkidBalance`.
+
+    The regula falsi of `skid_equilibrium` takes M as decreasing in omega_c. Where the traction
+    curve's peak lets the loaded rollers carry the drag at nearly pure rolling, M also has roots
+    near the kinematic speed (docs/validation.md, "The skid regime"): scanning M over omega_c
+    shows every balance, stable where M falls through zero."""
+    params, state = jax.lax.stop_gradient((params, state))
+    z = state.rollers.azimuth.shape[0]
+    offset0 = state.rollers.azimuth - 2 * jnp.pi * jnp.arange(z) / z
+    spin, offset, _, _ = _roller_balance(params, state, cage_speed, state.cage.centre, offset0)
+    balanced = _with_unknowns(state, cage_speed, spin, offset, state.cage.centre)
+    terms = skid_balance(balanced, params)
+    return terms.cage_pocket + terms.cage_land + terms.cage_drag, terms
+
+
+class SkidZones(eqx.Module):
+    """A `SkidBalance` summed by zone: torques [N m] about the bearing axis on the roller set
+    (the loaded zone: rollers with an inner-raceway load) and on the cage, and the loaded
+    rollers' mean raceway sliding speeds [m/s]. The roller-set terms add up to minus the
+    pocket term (the roller orbit balance), the cage terms to zero (the cage balance)."""
+
+    inner_traction_loaded: Float[Array, ""]
+    outer_traction_loaded: Float[Array, ""]
+    outer_traction_unloaded: Float[Array, ""]
+    roller_drag: Float[Array, ""]
+    flange: Float[Array, ""]
+    gravity: Float[Array, ""]
+    pocket_on_rollers: Float[Array, ""]
+    cage_pocket: Float[Array, ""]
+    cage_land: Float[Array, ""]
+    cage_drag: Float[Array, ""]
+    inner_load: Float[Array, ""]  # sum_j Q_i,j [N]
+    inner_sliding_loaded: Float[Array, ""]
+    outer_sliding_loaded: Float[Array, ""]
+
+
+def skid_zones(t: SkidBalance) -> SkidZones:
+    """`SkidZones` of the balance `t` (sums over the loaded and unloaded rollers)."""
+    ld = t.loaded
+    return SkidZones(
+        inner_traction_loaded=jnp.sum(jnp.where(ld, t.orbit_inner, 0.0)),
+        outer_traction_loaded=jnp.sum(jnp.where(ld, t.orbit_outer, 0.0)),
+        outer_traction_unloaded=jnp.sum(jnp.where(ld, 0.0, t.orbit_outer)),
+        roller_drag=jnp.sum(t.orbit_drag),
+        flange=jnp.sum(t.orbit_flange),
+        gravity=jnp.sum(t.orbit_gravity),
+        pocket_on_rollers=jnp.sum(t.orbit_pocket),
+        cage_pocket=t.cage_pocket,
+        cage_land=t.cage_land,
+        cage_drag=t.cage_drag,
+        inner_load=jnp.sum(t.inner_load),
+        inner_sliding_loaded=jnp.sum(jnp.where(ld, t.inner_sliding, 0.0)) / jnp.sum(ld),
+        outer_sliding_loaded=jnp.sum(jnp.where(ld, t.outer_sliding, 0.0)) / jnp.sum(ld),
+    )
