@@ -7,7 +7,7 @@ objective. Slow (`make test-slow`): the forward-mode short-window sensitivities 
 differences of the same window integrals from the same states, and the tangent growth, the
 studied alternatives to the frozen-load estimator (notebook 05 runs `tangent_growth` and
 asserts the same of it in the default suite). The bias of the estimators against the
-derivative of the settled mean is measured in benchmarks/studies/bench_steady_gradient.py."""
+derivative of the settled mean is measured in benchmarks/results/bench_steady_gradient.json."""
 
 import dataclasses
 
@@ -350,7 +350,7 @@ def _crn_ensembles(settled, crn_runs, statistic):
 
 @pytest.mark.parametrize("statistic", ["mean", "peak", "tail"])
 def test_frozen_load_estimator_agrees_with_crn_differences_on_settled_running(settled, crn_runs, statistic):
-    """The acceptance check of benchmarks/studies/bench_steady_gradient.py at reduced size (11 slices,
+    """The acceptance check of the gradient study (benchmarks/results/bench_steady_gradient.json) at reduced size (11 slices,
     3 seeds, theta_f at the reference design), in the default suite: running from the skid start
     (which lands on the plateau, tests/test_skid.py), then a common-random-number central
     difference of the ensemble objective (both designs continue from the same states and measure
@@ -366,7 +366,7 @@ def test_frozen_load_estimator_agrees_with_crn_differences_on_settled_running(se
     cold alone on the 2-core machine): CRN FD -1.233e11 +- 2.2e10 per rad (5.6 standard errors),
     frozen load -9.70e10 +- 2.1e9, 21 % apart. The settling times are in ms: 0.005 ms from the
     skid start and 0.0035 ms after the design change, i.e. none to speak of. The full-size
-    study is benchmarks/studies/bench_steady_gradient.py.
+    study is benchmarks/results/bench_steady_gradient.json (its script is listed in benchmarks/studies/README.md).
 
     The peak statistic (the p-mean of PV over contact time, p = 8) the same way (2026-11-26,
     2 workers): CRN FD -1.96e11 +- 2.0e10 per rad (9.7 standard errors), frozen load
