@@ -197,6 +197,7 @@ OPTIMISE_TOML_KEYS = {
         "clearance_step_mm",
         "statistic",
         "verify_seeds",
+        "corner_risk_level",
         "workers",
     ),
 }
@@ -214,7 +215,7 @@ def load_optimise_toml(path: str) -> dict:
         [search]       objective = "steady" | "startup", starts, iterations, learning_rate,
                        rtol; steady: seeds, window_revs, settle, gradient_window_ms, estimator,
                        corner_margin_mm, corner_constraint, clearance_step_mm, statistic,
-                       verify_seeds, workers;
+                       verify_seeds, corner_risk_level, workers;
                        startup: duration_ms, atol
 
     Returns a flat dict {key: value}; unknown sections or keys raise UserInputError."""

@@ -79,7 +79,7 @@ from jaxbearing.design import (
 )
 from jaxbearing.flange import MARGIN_NAMES, DesignVariables
 from jaxbearing.io import TreeFileError, check_like, load_tree, require, save_tree
-from jaxbearing.run import available_cpus, shared_workers
+from jaxbearing.run import available_cpus, revolutions_needed, shared_workers
 
 from ._problem import MARGIN_SCALE, PV_SCALE, DesignProblem, any_feasible
 from ._search import _Hyper, start_points
@@ -153,6 +153,10 @@ class SteadySettings:
     #: of one revolution's largest contact radius: it holds for a further revolution with 95 %
     #: probability) or "mean" (on its expectation per revolution: holds on average)
     corner_constraint: str = "prediction"
+    #: the corner-contact risk per cage revolution the verification must bound at every
+    #: operating point (its upper 95 % bound, `run.corner_risk`), else the design is reported
+    #: unverified in the tail (`tail_verification`)
+    corner_risk_level: float = 1e-3
     #: the envelope's active set (`next_active`): an operating point whose weight in the smooth
     #: max stays below this is not simulated (0: every point, every iteration) ...
     skip_weight: float = 1e-3
@@ -168,6 +172,12 @@ class SteadySettings:
                 f"corner_constraint = {self.corner_constraint!r}: must be one of {', '.join(CORNER_CONSTRAINTS)}"
             )
         require("skip_weight", self.skip_weight, lambda v: (v >= 0) & (v < 1), "in [0, 1)")
+        require(
+            "corner_risk_level",
+            self.corner_risk_level,
+            lambda v: (v > 0) & (v < 1),
+            "in (0, 1) per revolution",
+        )
         require(
             "recheck_every", self.recheck_every, lambda v: (v >= 1) & (v == np.round(v)), "an integer >= 1"
         )
@@ -975,6 +985,8 @@ def _estimates(m) -> dict:
         "corner_margin_bound_mm": float(m.corner_margin_bound) * 1e3,
         # how far zero corner contact in these seeds bounds the tail (upper 95 % bounds)
         "corner_contact_bound": m.summary.get("corner_contact_bound"),
+        # the probability per revolution of reaching the corner, with its bounds (`run.corner_risk`)
+        "corner_risk": m.summary.get("corner_risk"),
         "settled": m.settled,
         "seeds": m.seeds,
     }
@@ -1035,7 +1047,27 @@ def verification(problem: DesignProblem, settings: SteadySettings, design, refer
             out[f"{name}_corner_contact_per_revolution_upper95"] = max(
                 b["per_revolution_upper95"] for b in bounds
             )
+    out["tail"] = tail_verification(opts, settings.corner_risk_level)
     return out
+
+
+def tail_verification(rows: list[dict], level: float) -> dict:
+    """Whether the verification bounds the found design's corner-contact risk at `level` per
+    cage revolution at every operating point: the largest upper bound of `run.corner_risk` over
+    the points (one-sided 95 % or more), `verified` when it is at most `level`; else the design
+    is unverified in the tail, and `revolutions_needed` says how many revolutions per point
+    without corner contact would bound it by counting alone."""
+    risks = [r.get("corner_risk") for r in rows]
+    uppers = [r["upper"] if r and r.get("upper") is not None else 1.0 for r in risks]
+    upper = max(uppers) if uppers else 1.0
+    return {
+        "level_per_revolution": float(level),
+        "upper_per_revolution": float(upper),
+        "methods": [r.get("method") if r else None for r in risks],
+        "revolutions_per_point": [r.get("revolutions") if r else 0 for r in risks],
+        "verified": bool(upper <= level),
+        "revolutions_needed": revolutions_needed(level),
+    }
 
 
 @_in_shared_pool

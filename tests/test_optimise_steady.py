@@ -73,6 +73,7 @@ def test_bad_steady_settings_are_one_line(kw, text):
         (["--skip-weight", "1.5"], "skip_weight = 1.5: must be in [0, 1)"),
         (["--corner-constraint", "p99"], "corner_constraint = 'p99': must be one of prediction, mean"),
         (["--recheck-every", "0"], "recheck_every = 0: must be > 0"),
+        (["--corner-risk-level", "2"], "corner_risk_level = 2.0: must be in (0, 1) per revolution"),
     ],
 )
 def test_cli_steady_option_errors(tmp_path, capsys, args, text):
@@ -778,3 +779,22 @@ def test_clearance_signal_at_2_mrad_is_the_paired_difference_and_positive(monkey
     assert ev.gradient[2] == pytest.approx(signal * scale, rel=1e-9, abs=1e-300)
     assert ev.gradient_stderr[2] == pytest.approx(se * scale, rel=1e-9)
     assert fd > 0, (fd, se)
+
+
+def test_tail_verification_needs_the_risk_bounded_at_every_operating_point(tmp_path, capsys):
+    """The verification's tail statement: verified only when the corner-contact risk's upper bound
+    is at most the level at every operating point; a point without a risk estimate counts as
+    unbounded; the revolutions needed are those of counting alone (2995 for 1e-3 at 95 %)."""
+    from optimise._cli import tail_text
+
+    risk = lambda upper, n: {"corner_risk": {"upper": upper, "method": "count", "revolutions": n}}  # noqa: E731
+    ok = steady.tail_verification([risk(4e-4, 4000), risk(9e-4, 3200)], 1e-3)
+    assert ok["verified"] and ok["upper_per_revolution"] == 9e-4 and ok["revolutions_needed"] == 2995
+    assert "verified in the tail at 0.001" in tail_text(ok) and "NOT" not in tail_text(ok)
+    short = steady.tail_verification([risk(4e-4, 4000), risk(0.17, 16)], 1e-3)
+    assert not short["verified"] and short["upper_per_revolution"] == 0.17
+    assert "NOT verified in the tail" in tail_text(short) and "2995 revolutions per point" in tail_text(short)
+    assert not steady.tail_verification([{"corner_risk": None}], 1e-3)["verified"]
+    # the level is a setting of the search: out of (0, 1) it is one line before anything runs
+    assert main(["run", "--out", str(tmp_path), "--corner-risk-level", "0"]) == 2
+    assert capsys.readouterr().err.count("corner_risk_level = 0.0: must be in (0, 1) per revolution") == 1

@@ -359,6 +359,9 @@ CLI_CHECKS = {
     ("optimise", "run", "--verify-seeds"): [
         "test_optimise_steady.py::test_verify_seeds_option_reaches_the_verification"
     ],
+    ("optimise", "run", "--corner-risk-level"): [
+        "test_optimise_steady.py::test_tail_verification_needs_the_risk_bounded_at_every_operating_point"
+    ],
     ("optimise", "run", "--no-verify"): [_STEADY_CLI],
     ("optimise", "run", "--workers"): [_STEADY_CLI],
     ("optimise", "run", "--duration-ms"): [_OPT_FILE, "test_optimise.py::test_cli_end_to_end"],
