@@ -66,10 +66,9 @@ def _intervals(engine, members, seeds):
     for i in range(0, len(members), seeds):
         runs = engine.runs[i : i + seeds]
         m = members[i]
+        settings = jb.run.SteadySettings(window_revs=runs[0].edges.size - 1, tolerance=2e-3)
         block = jb.summarise_steady(
-            jb.SteadyResult(
-                runs, "auto", runs[0].edges.size - 1, 2e-3, 0.3, "skid", 0.0, 0.0, m.bearing, m.operating
-            )
+            jb.SteadyResult(runs, settings, "auto", "skid", 0.0, 0.0, m.bearing, m.operating)
         )
         row = {"speed_rpm": round(float(jb.rad_s_to_rpm(m.operating.inner_speed)))}
         for key, est in (

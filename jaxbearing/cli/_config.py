@@ -69,22 +69,25 @@ def register(sub) -> None:
         "its rule and uncertainty (also in the file's [uncertainty] table), the operating point "
         "is a placeholder to set.",
     )
-    new.add_argument("--bore-mm", dest="bore_mm", type=float, required=True, help="bore d [mm]")
+    new.add_argument(
+        "--bore-mm", dest="bore_mm", type=float, required=True, help="bore d [mm] (default: none, required)"
+    )
     new.add_argument(
         "--outside-diameter-mm",
         dest="outside_diameter_mm",
         type=float,
         default=None,
-        help="outside diameter D [mm] (or --series)",
+        help="outside diameter D [mm] (default: from --series)",
     )
     new.add_argument(
-        "--width-mm", dest="width_mm", type=float, default=None, help="width B [mm] (or --series)"
+        "--width-mm", dest="width_mm", type=float, default=None, help="width B [mm] (default: from --series)"
     )
     new.add_argument(
         "--series",
         default=None,
         metavar="SERIES",
-        help="ISO 15 dimension series (10, 02, 22, 03): outside diameter and width from the bore",
+        help="ISO 15 dimension series (10, 02, 22, 03): outside diameter and width from the bore "
+        "(default: none, give both dimensions)",
     )
     new.add_argument(
         "--type",
@@ -117,7 +120,7 @@ def register(sub) -> None:
     new.add_argument(
         "--out", default=None, metavar="FILE", help="write FILE (default: print to standard output)"
     )
-    new.add_argument("--force", action="store_true", help="overwrite --out if it exists")
+    new.add_argument("--force", action="store_true", help="overwrite --out if it exists (default: refuse)")
     new.set_defaults(func=run_new)
 
 

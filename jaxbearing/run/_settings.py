@@ -42,6 +42,7 @@ class SettleAuto:
     """Settle until the settling verdict passes (`settling_verdict`; docs/model.md 16)."""
 
     value = "auto"  # as the command line and the TOML files write it
+    mode = "auto"  # as the summary names it
 
     def __str__(self) -> str:
         return "auto"
@@ -52,6 +53,7 @@ class SettleFixed:
     """Settle for a fixed time `ms` [ms] (>= 0), declared settled by the user."""
 
     ms: float
+    mode = "fixed"
 
     def __post_init__(self):
         value = _as_float("settle", self.ms)
@@ -74,6 +76,7 @@ class SettleOff:
     """No settling: the window starts at the start (its statistics are a start-up transient's)."""
 
     value = "off"
+    mode = "off"
 
     def __str__(self) -> str:
         return "off"

@@ -161,7 +161,7 @@ def _settle_mode(settings: SteadySettings, continuing: bool) -> str:
     with `continuation_settle_revs` = n, "continuation, n revolutions"."""
     if continuing and settings.continuation_settle_revs is not None:
         return f"continuation, {settings.continuation_settle_revs} revolutions"
-    return {"auto": "auto", "off": "off"}.get(str(settings.settle), "fixed")
+    return settings.settle.mode
 
 
 def summarise_steady(result: SteadyResult, threshold: float = CONTACT_THRESHOLD) -> dict:

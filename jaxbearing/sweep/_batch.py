@@ -299,12 +299,11 @@ def settle_batch(spec: SweepSpec, cases: Sequence[int], devices: Sequence | None
 def _settled_row(spec: SweepSpec, runs, member) -> dict:
     from ..run import SteadyResult, revolution_statistic_keys, summarise_steady
 
+    steady = spec.steady
     result = SteadyResult(
         runs=list(runs),
-        settle=spec.settle,
-        window_revs=spec.window_revs,
-        tolerance=spec.settle_tolerance,
-        cap=spec.settle_cap_ms * 1e-3,
+        settings=steady,
+        settle_mode=steady.settle.mode,
         start=spec.start,
         wall_time_s=float("nan"),
         compile_time_s=float("nan"),
