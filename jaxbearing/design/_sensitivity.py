@@ -29,11 +29,12 @@ Methods (`METHODS`), chosen per statistic:
 - "static" (cage slip only; `--quick`): central differences of the cage slip of the static skid
   equilibrium (`dynamics.skid_equilibrium`: the cage and roller speeds at which the slow
   accelerations of the dynamic model vanish, docs/model.md 16), deterministic and cheap (one
-  equilibrium solve per evaluation). dS/dx is the difference at h = u / 2; its interval is
-  +/- |D(u) - D(u / 2)|, a truncation-error bound (about three times the error of D(u / 2) for
-  a smooth S), not a statistical interval. The static balance leaves out the flanges' friction
-  once the rollers skew (it lies 1.4 % above the settled cage speed at the reference point), so
-  it ranks the inputs of the cage slip; the settled value is the "crn" method's.
+  equilibrium solve per evaluation). dS/dx is the difference D(u) at h = u, the same secant as
+  the "crn" method's; its interval +/- |D(u) - D(u/2)| u says how far the cage slip departs
+  from a straight line over the stated range (for a smooth S it bounds the secant's distance
+  from the derivative), not a statistical interval. The static balance leaves out the flanges'
+  friction once the rollers skew (it lies 1.4 % above the settled cage speed at the reference
+  point), so it ranks the inputs of the cage slip; the settled value is the "crn" method's.
 """
 
 from __future__ import annotations
@@ -98,8 +99,8 @@ STATISTICS = {
 METHODS = {
     "crn": "common-random-number central differences of settled ensembles (same seeds), h = u; "
     "95 % Student-t interval over the seeds",
-    "static": "central differences of the static skid equilibrium's cage slip, h = u/2; "
-    "interval +/- |D(u) - D(u/2)| (truncation bound, deterministic)",
+    "static": "central differences of the static skid equilibrium's cage slip, h = u; "
+    "interval +/- |D(u) - D(u/2)| u (departure from a straight line over the range; deterministic)",
 }
 
 #: the model's representative constants and their default half-widths u (in the key's unit) with
@@ -272,15 +273,15 @@ def static_cage_slip(cfg: Config) -> float:
 
 
 def static_effect(cfg: Config, item: SensitivityInput) -> Effect:
-    """The "static" effect of `item` on the cage slip (module docstring)."""
+    """The "static" effect of `item` on the cage slip (module docstring): D(u) u, interval
+    +/- |D(u) - D(u/2)| u."""
     h, up, down = perturbed(cfg, item, item.plus_minus)
     d_full = (static_cage_slip(up) - static_cage_slip(down)) / (2 * h)
-    _, up2, down2 = perturbed(cfg, item, h / 2)
-    h2 = h / 2 if KEY_BY_PATH[item.key].kind is not int else h
+    h2, up2, down2 = perturbed(cfg, item, h / 2)
     d_half = (static_cage_slip(up2) - static_cage_slip(down2)) / (2 * h2)
     u = item.plus_minus
-    e, err = d_half * u, abs(d_full - d_half) * u
-    return Effect(e, e - err, e + err, d_half, "static", h2, 1)
+    e, err = d_full * u, abs(d_full - d_half) * u
+    return Effect(e, e - err, e + err, d_full, "static", h, 1)
 
 
 # -- CRN central differences of settled ensembles -------------------------------------------------
