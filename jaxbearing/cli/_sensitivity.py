@@ -44,7 +44,8 @@ def register(sub) -> None:
     p.add_argument(
         "--quick",
         action="store_true",
-        help="cage slip only, from the static skid equilibrium: seconds per input, no settled run",
+        help="cage slip only, from the static skid equilibrium: seconds per input, no settled run "
+        "(default: off, settled runs)",
     )
     p.add_argument(
         "--seeds",
