@@ -114,7 +114,7 @@ def draw(result, path) -> None:
 
     plt = pyplot()
     n = len(result.statistics)
-    fig, axes = plt.subplots(1, n, figsize=(4.2 * n + 2.0, 0.45 * len(result.inputs) + 1.6), squeeze=False)
+    fig, axes = plt.subplots(1, n, figsize=(6.0 * n, 0.45 * len(result.inputs) + 1.6), squeeze=False)
     for ax, s in zip(axes[0], result.statistics):
         st = SENSITIVITY_STATISTICS[s]
         order = result.ranking(s)[::-1]
@@ -125,7 +125,7 @@ def draw(result, path) -> None:
         y = np.arange(len(order))
         ax.barh(y, np.nan_to_num(eff), xerr=err, color="tab:blue", ecolor="k", capsize=3)
         ax.axvline(0.0, color="k", lw=0.8)
-        ax.set_yticks(y, [result.inputs[i].key for i in order] if ax is axes[0][0] else [""] * len(y))
+        ax.set_yticks(y, [result.inputs[i].key for i in order], fontsize=8)  # each panel in its own order
         ax.set_xlabel(f"effect on {st.label} [{st.shown_unit}]")
         ax.set_title(f"{st.label} ({result.effects[s][0].method})", fontsize=9)
     fig.suptitle("effect of each input over its stated uncertainty (95 % interval)", fontsize=10)
