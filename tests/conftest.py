@@ -58,6 +58,7 @@ FILE_SECONDS = {
     "test_config_new.py": 30,  # measured alone (34 s at load 6, warm cache), not in that run
     # 13 s of CPU time measured alone on the loaded machine (not in a make test run)
     "test_corner_risk.py": 14,
+    "test_sensitivity.py": 50,  # measured alone: 28 s with the static-slip program cached, about 35 s more to compile it
 }
 
 #: files that compile the same programs, run by one process in this order (`make test`, the

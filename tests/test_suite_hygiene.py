@@ -257,6 +257,7 @@ _STEADY_CLI = "test_optimise_steady.py::test_killed_run_resumes_with_the_same_re
 _OPT_FILE = "test_optimise.py::test_cli_settings_from_a_file_and_options_reach_the_problem"
 _TWO_PROCESSES = "test_sweep_distributed.py::test_two_processes_match_single_process"
 _VALIDATE = "test_validate.py::test_validate_writes_the_comparison"
+_SENS_QUICK = "test_sensitivity.py::test_quick_cli_ranks_writes_and_agrees_with_a_finer_step"
 _NEW = "test_config_new.py::test_config_new_writes_once_and_show_marks_estimates"
 CLI_CHECKS = {
     ("jaxbearing", "demo", "--window-revs"): [
@@ -292,6 +293,15 @@ CLI_CHECKS = {
     ("jaxbearing", "validate", "--out"): [
         _VALIDATE,
         "test_validate.py::test_an_interrupted_validation_keeps_its_finished_points",
+    ],
+    ("jaxbearing", "sensitivity", "--statistics"): [
+        _SENS_QUICK,
+    ],
+    ("jaxbearing", "sensitivity", "--quick"): [_SENS_QUICK],
+    ("jaxbearing", "sensitivity", "--out"): [_SENS_QUICK],
+    ("jaxbearing", "sensitivity", "--seeds"): ["test_sensitivity.py::test_settled_options_reach_the_study"],
+    ("jaxbearing", "sensitivity", "--window-revs"): [
+        "test_sensitivity.py::test_settled_options_reach_the_study"
     ],
     ("jaxbearing", "zone", "--config"): ["test_zone.py::test_cli_zone_reads_a_config"],
     ("jaxbearing", "zone", "--flange-load-N"): ["test_zone.py::test_cli_zone_prints_margins_and_writes_maps"],

@@ -27,6 +27,7 @@ COMMANDS = {
     "zone": "jaxbearing.cli._zone",
     "simulate": "jaxbearing.cli._simulate",
     "sweep": "jaxbearing.cli._sweep",
+    "sensitivity": "jaxbearing.cli._sensitivity",
     "plot": "jaxbearing.cli._plot",
     "validate": "jaxbearing.cli._validate",
 }

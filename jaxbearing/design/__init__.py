@@ -17,6 +17,13 @@
   accumulators they differentiate, `STEADY_FUNCTIONALS` (`STATISTICS`: the mean, and the
   peak statistic's p-mean with p = `PEAK_EXPONENT`).
 
+- which uncertain inputs matter (docs/model.md 18): `sensitivity` (the effect, derivative x
+  stated uncertainty, of every `[uncertainty]` key and `MODEL_CONSTANTS` entry on settled
+  statistics, `SENSITIVITY_STATISTICS`, by the methods `SENSITIVITY_METHODS`: CRN central
+  differences of settled runs, or the static skid equilibrium for the cage slip), `Sensitivity`,
+  `SensitivityInput`, `Effect`, `sensitivity_inputs`, `static_cage_slip`,
+  `parse_sensitivity_statistics`.
+
 The `optimise` package searches designs with these.
 
 May import: every layer below (`run` and down); `run` only through its public names.
@@ -33,6 +40,18 @@ from ._design import (
     forward_jacobian,
     seated_perturbation,
 )
+from ._sensitivity import METHODS as SENSITIVITY_METHODS
+from ._sensitivity import (
+    MODEL_CONSTANTS,
+    Effect,
+    Sensitivity,
+    SensitivityInput,
+    sensitivity,
+    sensitivity_inputs,
+    static_cage_slip,
+)
+from ._sensitivity import STATISTICS as SENSITIVITY_STATISTICS
+from ._sensitivity import parse_statistics as parse_sensitivity_statistics
 from ._steady_design import (
     CORNER_MARGIN,
     SteadyDesignMetrics,
@@ -60,10 +79,16 @@ __all__ = [
     "GRADIENT_MODE_NOTE",
     "GRADIENT_RTOL",
     "GRADIENT_WINDOW",
+    "MODEL_CONSTANTS",
     "PEAK_EXPONENT",
+    "SENSITIVITY_METHODS",
+    "SENSITIVITY_STATISTICS",
     "STATISTICS",
     "STEADY_FUNCTIONALS",
     "DesignMetrics",
+    "Effect",
+    "Sensitivity",
+    "SensitivityInput",
     "SteadyDesignMetrics",
     "SteadyGradient",
     "design_jacobian",
@@ -72,8 +97,12 @@ __all__ = [
     "frozen_load_gradient",
     "frozen_load_gradients",
     "paired_central_difference",
+    "parse_sensitivity_statistics",
     "ratio_gradient",
     "seated_perturbation",
+    "sensitivity",
+    "sensitivity_inputs",
+    "static_cage_slip",
     "steady_design_metrics",
     "steady_design_metrics_points",
     "steady_gradient",
