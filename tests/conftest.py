@@ -28,37 +28,35 @@ import pytest  # noqa: E402
 jax.config.update("jax_enable_x64", True)
 
 #: seconds of test time per file in a cold-cache `make test` from a fresh clone on the 2-core
-#: machine, nothing else running (2026-11-26, bc6ad24, junit; 938 s in all, 8 min 01 s of
-#: pytest; docs/performance.md). Files not listed take under 10 s.
+#: machine, nothing else running (`PYTEST_ADDOPTS=--junitxml=J.xml ../shared/tools/fresh-clone-test`
+#: at c4d6d45, 1144 s in all, 9 min 48 s of pytest; docs/performance.md). Files not listed
+#: take under 10 s.
 FILE_SECONDS = {
-    "test_steady_gradient.py": 101,
-    "test_engine.py": 100,
-    "test_notebooks.py": 87,
-    "test_optimise.py": 64,
-    "test_rosenbrock.py": 64,
-    "test_settle.py": 48,
-    "test_speed.py": 46,
-    "test_cmd_simulate.py": 43,
-    "test_sweep_distributed.py": 40,
-    "test_design.py": 36,
-    "test_outputs.py": 27,
-    "test_validate.py": 25,
-    "test_sweep.py": 24,
-    "test_dynamics.py": 23,
-    "test_flange_arrangement.py": 21,  # one process, the full-size simulate program compiled
-    "test_quasistatic.py": 19,
+    "test_steady_gradient.py": 119,
+    "test_engine.py": 114,
+    "test_notebooks.py": 98,
+    "test_cmd_simulate.py": 83,
+    "test_optimise.py": 70,
+    "test_rosenbrock.py": 69,
+    "test_settle.py": 58,
+    "test_speed.py": 49,
+    "test_sweep_distributed.py": 45,
+    "test_design.py": 33,
+    "test_outputs.py": 30,
+    "test_validate.py": 28,
+    "test_dynamics.py": 27,
+    "test_sweep.py": 27,
+    "test_sensitivity.py": 25,
+    "test_skid.py": 23,
+    "test_quasistatic.py": 21,
+    "test_flange_contact.py": 19,
     "test_flange_lubrication.py": 18,
-    "test_misalignment.py": 17,
-    "test_raceway.py": 16,
-    "test_skid.py": 16,
-    "test_steady_design.py": 16,
-    "test_contact_hertz.py": 15,
-    "test_flange_contact.py": 15,
-    "test_program_cache.py": 10,
-    "test_config_new.py": 30,  # measured alone (34 s at load 6, warm cache), not in that run
-    # 13 s of CPU time measured alone on the loaded machine (not in a make test run)
-    "test_corner_risk.py": 14,
-    "test_sensitivity.py": 50,  # measured alone: 28 s with the static-slip program cached, about 35 s more to compile it
+    "test_misalignment.py": 18,
+    "test_raceway.py": 18,
+    "test_contact_hertz.py": 18,
+    "test_steady_design.py": 17,
+    "test_flange_arrangement.py": 13,
+    "test_config_new.py": 13,
 }
 
 #: files that compile the same programs, run by one process in this order (`make test`, the
