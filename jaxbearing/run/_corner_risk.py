@@ -192,7 +192,7 @@ def _check(maxima, rho_lim, confidence, peak_pv=None):
 
 # -- counting --------------------------------------------------------------------------------
 def _counting(rows, rho_lim, confidence):
-    """(p^, lower, upper, counting_upper, deff) by counting (module docstring, method "count")."""
+    """(p^, lower, upper, deff) by counting (module docstring, method "count")."""
     counts = np.array([np.sum(r > rho_lim) for r in rows], float)
     sizes = np.array([r.size for r in rows], float)
     n, x = float(sizes.sum()), float(counts.sum())

@@ -16,7 +16,6 @@ controllers are:
 from __future__ import annotations
 
 import dataclasses
-import math
 
 import numpy as np
 
@@ -94,20 +93,18 @@ def _as_float(name: str, value) -> float:
         ) from None
 
 
-def settling(value, name: str = "settle") -> Settling:
+def settling(value) -> Settling:
     """The settling object of `value`: a settling object itself, or the text of the command line
     and the TOML files ("auto", "off", or a settling time in ms, as a number or its text). The
-    one place where that text becomes an object; a bad value gets one line naming `name`."""
+    one place where that text becomes an object; a bad value gets one line naming `settle`
+    (`SettleFixed` checks the time)."""
     if isinstance(value, SettleAuto | SettleFixed | SettleOff):
         return value
     if isinstance(value, str) and value in ("auto", "off"):
         return SettleAuto() if value == "auto" else SettleOff()
     if isinstance(value, bool):
-        raise UserInputError(f'{name} = {value!r}: must be "auto", "off" or a settling time >= 0 ms')
-    ms = _as_float(name, value)
-    if not (math.isfinite(ms) and ms >= 0):
-        raise UserInputError(f'{name} = {ms}: must be "auto", "off" or a settling time >= 0 ms')
-    return SettleFixed(ms)
+        raise UserInputError(f'settle = {value!r}: must be "auto", "off" or a settling time >= 0 ms')
+    return SettleFixed(value)
 
 
 @dataclasses.dataclass(frozen=True)
