@@ -217,8 +217,8 @@ def _batch_sizes(options, sizes):
 def _search_iteration() -> dict:
     """One iteration of the 3-speed design search, twice (module docstring)."""
     import jaxbearing as jb
-    from optimise import make_problem
-    from optimise._steady import SteadySettings, evaluate_starts, start_points
+    from optimise import SteadySettings, make_problem, start_points
+    from optimise._evaluate import evaluate_starts
 
     bearing = dataclasses.replace(jb.reference_bearing(), num_slices=11)
     problem = make_problem(bearing, jb.reference_operating_point(), speeds_rpm=[10000.0, 20000.0, 30000.0])

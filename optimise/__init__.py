@@ -11,6 +11,7 @@ objective's gradients come from forward-mode differentiation through the diffrax
 import jaxbearing  # noqa: F401  (enables 64-bit floats)
 from jaxbearing.flange import MARGIN_NAMES
 
+from ._grid import steady_grid
 from ._plot import plot_search
 from ._problem import (
     Bounds,
@@ -23,13 +24,18 @@ from ._problem import (
     operating_envelope,
 )
 from ._search import SearchResult, grid_search, search, start_points
-from ._steady import near_optimal_set
+from ._settings import SteadySettings
+from ._steady import NearOptimal, SteadySearchResult, near_optimal_set, steady_search
+from ._verify import verification
 
 __all__ = [
     "MARGIN_NAMES",
     "Bounds",
     "DesignProblem",
+    "NearOptimal",
     "SearchResult",
+    "SteadySearchResult",
+    "SteadySettings",
     "any_feasible",
     "bounds_from_engineering",
     "feasibility_map",
@@ -41,4 +47,7 @@ __all__ = [
     "plot_search",
     "search",
     "start_points",
+    "steady_grid",
+    "steady_search",
+    "verification",
 ]

@@ -74,7 +74,7 @@ def build_parser() -> argparse.ArgumentParser:
     from jaxbearing.flange import DEFAULT_FLANGE_LOAD
 
     from ._problem import DEFAULT_DURATION, Bounds
-    from ._steady import ESTIMATORS, SteadySettings
+    from ._settings import ESTIMATORS, SteadySettings
 
     st, b, d = SteadySettings(), Bounds(), SEARCH_DEFAULTS
     mm, deg = 1e3, 180 / math.pi
@@ -368,7 +368,7 @@ def objective_of(s: dict) -> str:
 
 def steady_settings_from(s: dict):
     """SteadySettings from merged settings (engineering units)."""
-    from ._steady import SteadySettings
+    from ._settings import SteadySettings
 
     st = SteadySettings()
     settle = s.get("settle", st.settle)
@@ -413,14 +413,14 @@ def _progress(quiet: bool, start_line):
     def progress(it, info):
         if quiet:
             return
-        best = info["best"]
+        best = info.best
         print(
             f"iter {it:3d}  best feasible {best:.4f} GPa m/s"
             if np.isfinite(best)
             else f"iter {it:3d}  best feasible   none yet"
         )
-        for j in range(info["x"].shape[0]):
-            m = info["margins"][j]
+        for j in range(info.x.shape[0]):
+            m = info.margins[j]
             print(f"   start {j}: " + start_line(j, info, m, int(np.argmin(m))))
         sys.stdout.flush()
 
@@ -468,9 +468,9 @@ def run(args) -> int:
 
     def start_line(j, info, m, w):
         return (
-            f"J {info['objective'][j]:8.4f} GPa m/s  "
-            f"min margin {MARGIN_NAMES[w]} {m[w] * 1e3:+.4f} mm  {_design_text(info['x'][j])}"
-            f"{'' if info['feasible'][j] else '  (infeasible)'}"
+            f"J {info.objective[j]:8.4f} GPa m/s  "
+            f"min margin {MARGIN_NAMES[w]} {m[w] * 1e3:+.4f} mm  {_design_text(info.x[j])}"
+            f"{'' if info.feasible[j] else '  (infeasible)'}"
         )
 
     progress = _progress(args.quiet, start_line)
@@ -581,7 +581,8 @@ def run_steady(args, problem, options, settings, out, meta=None) -> int:
     from jaxbearing.run import MemberProgress
 
     from ._plot import plot_search
-    from ._steady import CHECKPOINT, CONSTRAINT_NAMES, steady_search
+    from ._state import CHECKPOINT
+    from ._steady import CONSTRAINT_NAMES, near_optimal_set, steady_search
 
     k = problem.num_operating_points
     print(
@@ -593,11 +594,11 @@ def run_steady(args, problem, options, settings, out, meta=None) -> int:
     sys.stdout.flush()
 
     def start_line(j, info, m, w):
-        lo, hi = info["ci"][j]
-        g = info["gradient"][j]
+        lo, hi = info.ci[j]
+        g = info.gradient[j]
         return (
-            f"J {info['objective'][j]:7.4f} [{lo:.4f}, {hi:.4f}] GPa m/s  "
-            f"min margin {CONSTRAINT_NAMES[w]} {m[w] * 1e3:+.4f} mm  {_design_text(info['x'][j])}  "
+            f"J {info.objective[j]:7.4f} [{lo:.4f}, {hi:.4f}] GPa m/s  "
+            f"min margin {CONSTRAINT_NAMES[w]} {m[w] * 1e3:+.4f} mm  {_design_text(info.x[j])}  "
             f"dJ/du ({g[0]:+.3f}, {g[1]:+.3f}, {g[2]:+.3f})"
         )
 
@@ -631,11 +632,9 @@ def run_steady(args, problem, options, settings, out, meta=None) -> int:
     )
     what = {"mean": "mean PV", "peak": "peak PV (p-mean)", "tail": "tail PV"}.get(settings.statistic, "PV")
     print(f"  steady {what} {res.objective:.4f} [{lo:.4f}, {hi:.4f}] GPa m/s (search seeds)")
-    from ._steady import near_optimal_set
-
     near = near_optimal_set(res)
     if near:
-        binds = sorted({d["binding_margin"] for d in near})
+        binds = sorted({d.binding_margin for d in near})
         print(
             f"  near-optimal set: {len(near)} evaluated design(s) within the best's 95 % interval, "
             f"binding margin {', '.join(binds)} (result.json near_optimal; drawn on {plot_path.name})"
@@ -717,19 +716,13 @@ def _steady_result_json(problem, options, settings, res) -> dict:
 
     import numpy as np
 
-    from ._steady import (
-        CLEARANCE_EFFECT,
-        CLEARANCE_MISALIGNMENT,
-        CLEARANCE_STEP,
-        CONSTRAINT_NAMES,
-        clearance_step_for,
-        near_optimal_set,
-    )
+    from ._settings import CLEARANCE_MISALIGNMENT, CLEARANCE_STEP, clearance_step_for
+    from ._steady import CONSTRAINT_NAMES, near_optimal_set
 
     h = res.history
     clearance_step = clearance_step_for(problem, settings)
-    x = np.asarray(h["x"]) if len(h["x"]) else np.zeros((0, 0, 3))
-    margins = np.asarray(h["margins"]) if len(h["margins"]) else np.zeros((0, 0, 5))
+    x = np.asarray(h.x) if len(h) else np.zeros((0, 0, 3))
+    margins = np.asarray(h.margins) if len(h) else np.zeros((0, 0, 5))
     return {
         "objective_kind": "steady",
         "status": res.status,
@@ -744,21 +737,21 @@ def _steady_result_json(problem, options, settings, res) -> dict:
         "verification": res.verification,
         "near_optimal": [
             {
-                **_engineering(d["design"]),
-                "objective_GPa_m_s": {
-                    "value": d["objective"],
-                    "ci95_low": d["ci95"][0],
-                    "ci95_high": d["ci95"][1],
-                },
-                "iteration": d["iteration"],
-                "start": d["start"],
-                "binding_margin": d["binding_margin"],
-                "binding_margin_mm": d["binding_margin_m"] * 1e3,
+                **_engineering(d.design),
+                "objective_GPa_m_s": {"value": d.objective, "ci95_low": d.ci95[0], "ci95_high": d.ci95[1]},
+                "iteration": d.iteration,
+                "start": d.start,
+                "binding_margin": d.binding_margin,
+                "binding_margin_mm": d.binding_margin_m * 1e3,
             }
             for d in near_optimal_set(res)
         ],
         "axial_clearance_effect": {
-            **CLEARANCE_EFFECT,
+            "estimator_sees_it": False,
+            "why": "the frozen-load estimator moves the flange in its own plane at a fixed load: its "
+            "dJ/dDelta_bf is 0 by construction; Delta_bf moves only where a margin pushes it",
+            "measured": "docs/model.md 17: the clearance study (significant only with the inner ring "
+            "misaligned by 2 mrad)",
             **(
                 {
                     "estimator_sees_it": True,
@@ -796,22 +789,22 @@ def _steady_result_json(problem, options, settings, res) -> dict:
         },
         "search": dict(options),
         "num_settled_ensembles": res.num_evaluations,
-        "simulated_ms": float(np.sum(h["simulated_ms"])) if len(h["simulated_ms"]) else 0.0,
+        "simulated_ms": float(np.sum(h.simulated_ms)) if len(h) else 0.0,
         "resumed_from_iteration": res.resumed_from,
         "wall_time_s": res.wall_time_s,
         "history": {
-            "objective_GPa_m_s": np.asarray(h["objective"]).tolist(),
-            "ci95_GPa_m_s": np.asarray(h["ci"]).tolist(),
-            "gradient_per_unit_box": np.asarray(h["gradient"]).tolist(),
-            "gradient_stderr": np.asarray(h["gradient_stderr"]).tolist(),
+            "objective_GPa_m_s": np.asarray(h.objective).tolist(),
+            "ci95_GPa_m_s": np.asarray(h.ci).tolist(),
+            "gradient_per_unit_box": np.asarray(h.gradient).tolist(),
+            "gradient_stderr": np.asarray(h.gradient_stderr).tolist(),
             "end_radius_mm": (x[..., 0] * 1e3).tolist(),
             "layback_angle_deg": np.degrees(x[..., 1]).tolist(),
             "axial_clearance_mm": (x[..., 2] * 1e3).tolist(),
             "margins_mm": {n: (margins[..., i] * 1e3).tolist() for i, n in enumerate(CONSTRAINT_NAMES)},
-            "wall_s": np.asarray(h["wall_s"]).tolist(),
-            "simulated_ms": np.asarray(h["simulated_ms"]).tolist(),
+            "wall_s": np.asarray(h.wall_s).tolist(),
+            "simulated_ms": np.asarray(h.simulated_ms).tolist(),
             # per iteration, start and operating point: simulated (True) or its last values reused
-            "points_simulated": np.asarray(h.get("points_simulated", []), dtype=bool).tolist(),
+            "points_simulated": np.asarray(h.points_simulated, dtype=bool).tolist(),
         },
     }
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import pathlib
 
@@ -39,7 +40,7 @@ def plot_search(problem, result, path) -> pathlib.Path:
         if m.min() < 0 < m.max():
             ax.contour(rr, tt, m, levels=[0.0], colors=colour, linewidths=1.2)
             ax.plot([], [], color=colour, label=f"{label} margin = 0")
-    h = result.history
+    h = _history(result)
     margins = np.asarray(h.get("margins", [])) if h else np.zeros(0)
     if margins.ndim == 3 and margins.shape[-1] == 5 and getattr(result, "best_iteration", -1) >= 0:
         # steady search: the dynamic corner margin, with the skew excursion max - rho_c measured
@@ -57,7 +58,7 @@ def plot_search(problem, result, path) -> pathlib.Path:
             ax.plot(xs[0, s, 0] * 1e3, math.degrees(xs[0, s, 1]), "o", color=line.get_color(), mfc="none")
     near = _near_optimal(result)
     if near:
-        pts = np.asarray([d["design"] for d in near])
+        pts = np.asarray([d.design for d in near])
         ax.plot(
             pts[:, 0] * 1e3,
             np.degrees(pts[:, 1]),
@@ -97,9 +98,19 @@ def plot_search(problem, result, path) -> pathlib.Path:
 def _near_optimal(result) -> list:
     """The steady search's near-optimal set (`_steady.near_optimal_set`); none for the startup
     search."""
-    margins = np.asarray(result.history.get("margins", [])) if result.history else np.zeros(0)
+    h = _history(result)
+    margins = np.asarray(h.get("margins", [])) if h else np.zeros(0)
     if margins.ndim != 3 or margins.shape[-1] != 5:
         return []
     from ._steady import near_optimal_set
 
     return near_optimal_set(result)
+
+
+def _history(result) -> dict:
+    """The search's history as arrays by field name: the start-up search keeps a dict, the
+    steady search a `_state.History` (empty: {})."""
+    h = result.history
+    if dataclasses.is_dataclass(h):
+        return {f.name: getattr(h, f.name) for f in dataclasses.fields(h)} if len(h) else {}
+    return h

@@ -41,12 +41,12 @@ import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
-import optax
 
 from jaxbearing import UserInputError
 from jaxbearing.design import forward_jacobian
 from jaxbearing.flange import DesignVariables
 
+from ._lagrangian import Hyper, IterationReport, augmented_lagrangian_step
 from ._problem import DesignProblem, any_feasible, margins_batch
 
 
@@ -105,21 +105,7 @@ def start_points(problem: DesignProblem, num_starts: int, first: np.ndarray | No
     return u
 
 
-@dataclasses.dataclass(frozen=True)
-class _Hyper:
-    """Static hyperparameters of the search (hashable: part of the compile-cache key)."""
-
-    learning_rate: float
-    num_iterations: int
-    rho: float
-
-    def optimiser(self) -> optax.GradientTransformation:
-        """Adam with a cosine-decayed step size (to 10% at the last iteration)."""
-        schedule = optax.cosine_decay_schedule(self.learning_rate, self.num_iterations, alpha=0.1)
-        return optax.adam(schedule)
-
-
-def _one_iteration(problem: DesignProblem, hyper: _Hyper, u, opt_state, lam):
+def _one_iteration(problem: DesignProblem, hyper: Hyper, u, opt_state, lam):
     """One iteration from one start: objective value and forward-mode gradient (one solve per
     operating point carrying three tangents), constraints and their Jacobian (cheap),
     augmented-Lagrangian gradient, optax update, projection onto the box, multiplier update."""
@@ -135,15 +121,14 @@ def _one_iteration(problem: DesignProblem, hyper: _Hyper, u, opt_state, lam):
     jc = jax.jacfwd(problem.constraints)(u)  # (4, 3)
     ok = jnp.isfinite(val) & jnp.all(jnp.isfinite(g_obj))
     g_obj = jnp.where(ok, g_obj, 0.0)  # failed solve: follow the constraints only
-    act = jnp.maximum(0.0, lam - rho * c)
-    g = jnp.where(free, g_obj - act @ jc, 0.0)
-    updates, opt_state = hyper.optimiser().update(g, opt_state, u)
-    u_new = jnp.clip(optax.apply_updates(u, updates), 0.0, 1.0)
+    u_new, opt_state, act = augmented_lagrangian_step(
+        hyper.optimiser(), rho, free, g_obj, c, jc, lam, opt_state, u
+    )
     return u_new, opt_state, act, val, pv, problem.margins(u)
 
 
 @eqx.filter_jit
-def _iterate(problem: DesignProblem, hyper: _Hyper, u, opt_state, lam):
+def _iterate(problem: DesignProblem, hyper: Hyper, u, opt_state, lam):
     """`_one_iteration` vmapped over starts; compiled once per problem structure and hyper."""
     return jax.vmap(_one_iteration, in_axes=(None, None, 0, 0, 0))(problem, hyper, u, opt_state, lam)
 
@@ -199,7 +184,7 @@ def search(
             compile_time_s=0.0,
         )
 
-    hyper = _Hyper(float(learning_rate), int(num_iterations), float(rho))
+    hyper = Hyper(float(learning_rate), int(num_iterations), float(rho))
     history, best, times = _iterations(problem, hyper, jnp.asarray(u), callback)
     # the first call compiles (unless cached): its excess over the later iterations
     compile_time = max(0.0, times[0] - float(np.median(times[1:]))) if len(times) > 1 else 0.0
@@ -237,7 +222,7 @@ def search(
     )
 
 
-def _iterations(problem: DesignProblem, hyper: _Hyper, uj, callback):
+def _iterations(problem: DesignProblem, hyper: Hyper, uj, callback):
     """Run the search from the scaled starts `uj` (S, 3): (history of stacked per-iteration
     arrays, best feasible (objective, iteration, start), wall time of each iteration).
     Iteration i evaluates the objective at u_i (before its update); one extra pass evaluates
@@ -267,9 +252,7 @@ def _iterations(problem: DesignProblem, hyper: _Hyper, uj, callback):
         ):
             hist[key].append(value)
         if callback is not None:
-            callback(
-                it, dict(u=np.asarray(uj), x=x, objective=val, margins=marg, feasible=feas, best=best[0])
-            )
+            callback(it, IterationReport(x=x, objective=val, margins=marg, best=best[0], feasible=feas))
         if it < hyper.num_iterations:
             uj, opt_state, lam = u_new, opt_state_new, lam_new
     return {k_: np.stack(v) for k_, v in hist.items()}, best, times

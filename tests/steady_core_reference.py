@@ -51,6 +51,7 @@ def _estimate(block) -> list:
 
 def compute() -> dict:
     import jaxbearing as jb
+    import optimise
     from jaxbearing.design import frozen_load_gradient, steady_design_metrics
     from jaxbearing.flange import DesignVariables
     from jaxbearing.run import (
@@ -60,7 +61,6 @@ def compute() -> dict:
         simulate_steady_points,
         summarise_steady,
     )
-    from optimise import _steady as steady
     from optimise import make_problem
 
     b = dataclasses.replace(jb.reference_bearing(), num_slices=11)
@@ -94,13 +94,14 @@ def compute() -> dict:
     out["frozen_load_gradient"] = {"value": float(g.value), "gradient": np.asarray(g.gradient).tolist()}
 
     problem = make_problem(b, op)
-    settings = steady.SteadySettings(seeds=2, window_revs=2, settle=0.005, workers=1)
+    settings = optimise.SteadySettings(seeds=2, window_revs=2, settle=0.005, workers=1)
     with tempfile.TemporaryDirectory() as tmp:
-        res = steady.steady_search(
+        res = optimise.steady_search(
             problem, settings, directory=tmp, num_starts=1, num_iterations=1, verify=False
         )
     out["search_iteration"] = {
-        key: np.asarray(res.history[key]).tolist() for key in ("x", "objective", "gradient", "margins")
+        key: np.asarray(getattr(res.history, key)).tolist()
+        for key in ("x", "objective", "gradient", "margins")
     }
     return out
 

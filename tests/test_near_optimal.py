@@ -5,6 +5,7 @@ result.json's terms and on the search-path figure. Fabricated histories: no solv
 import numpy as np
 
 from optimise import near_optimal_set
+from optimise._state import History
 from optimise._steady import CONSTRAINT_NAMES, SteadySearchResult
 
 
@@ -31,7 +32,17 @@ def _result():
         objective=1.11,
         objective_ci=(1.06, 1.16),
         start_design=x[0, 0],
-        history=dict(x=x, objective=objective, ci=ci, margins=margins),
+        history=History(
+            x=x,
+            objective=objective,
+            ci=ci,
+            margins=margins,
+            gradient=np.zeros((3, 2, 3)),
+            gradient_stderr=np.zeros((3, 2, 3)),
+            wall_s=np.zeros((3, 2)),
+            simulated_ms=np.zeros((3, 2)),
+            points_simulated=np.ones((3, 2, 1), bool),
+        ),
         num_iterations=2,
         num_evaluations=6,
         wall_time_s=0.0,
@@ -45,11 +56,11 @@ def test_near_optimal_set_is_the_feasible_designs_within_the_best_interval():
     near = near_optimal_set(_result())
     # 1.11 (best), 1.12 (iteration 2, start 0), 1.16 (iteration 1, start 1, at the interval's top);
     # 1.12 at iteration 1 start 0 is infeasible, 1.3 and above outside the interval
-    assert [(d["iteration"], d["start"]) for d in near] == [(2, 1), (2, 0), (1, 1)]
-    assert [d["objective"] for d in near] == [1.11, 1.12, 1.16]
-    assert near[0]["binding_margin"] == "dynamic_corner" and near[0]["binding_margin_m"] == 3e-6
-    assert near[1]["binding_margin"] == CONSTRAINT_NAMES[0] and near[1]["binding_margin_m"] == 2e-6
-    assert near[0]["design"] == [0.106, 0.0278, 1.5e-4] and np.allclose(near[0]["ci95"], [1.06, 1.16])
+    assert [(d.iteration, d.start) for d in near] == [(2, 1), (2, 0), (1, 1)]
+    assert [d.objective for d in near] == [1.11, 1.12, 1.16]
+    assert near[0].binding_margin == "dynamic_corner" and near[0].binding_margin_m == 3e-6
+    assert near[1].binding_margin == CONSTRAINT_NAMES[0] and near[1].binding_margin_m == 2e-6
+    assert near[0].design.tolist() == [0.106, 0.0278, 1.5e-4] and np.allclose(near[0].ci95, [1.06, 1.16])
 
 
 def test_no_near_optimal_set_without_a_feasible_design():
@@ -64,19 +75,17 @@ def test_result_json_and_figure_carry_the_near_optimal_set(tmp_path, monkeypatch
     import jaxbearing as jb
     from optimise import make_problem, plot_search
     from optimise._cli import _steady_result_json
-    from optimise._steady import SteadySettings
+    from optimise._settings import SteadySettings
 
     res = _result()
     problem = make_problem(jb.reference_bearing(), jb.reference_operating_point())
-    for k in ("gradient", "gradient_stderr", "wall_s", "simulated_ms"):
-        res.history[k] = np.zeros((3, 2) + ((3,) if k.startswith("gradient") else ()))
     doc = _steady_result_json(problem, {}, SteadySettings(), res)
     assert [d["end_radius_mm"] for d in doc["near_optimal"]] == [106.0, 94.0, 105.0]
     assert doc["near_optimal"][0]["binding_margin"] == "dynamic_corner"
     # the clearance: not seen by the estimator, said with the measured bound, not silently kept
     effect = doc["axial_clearance_effect"]
     assert effect["estimator_sees_it"] is False and effect["moved"] is False
-    assert "[-0.13e12, +3.79e12]" in effect["measured"] and "not significant" in effect["measured"]
+    assert "docs/model.md 17" in effect["measured"]  # the measured bounds: on that page, with their study
     assert abs(doc["near_optimal"][1]["binding_margin_mm"] - 2e-3) < 1e-12
     labels = []
     real = matplotlib.axes.Axes.plot

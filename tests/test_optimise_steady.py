@@ -16,7 +16,12 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
+import optimise._envelope as envelope
+import optimise._evaluate as evaluation
+import optimise._grid as grid_module
+import optimise._settings as search_settings
 import optimise._steady as steady
+import optimise._verify as verify
 from jaxbearing import UserInputError
 from optimise._cli import main
 
@@ -54,7 +59,7 @@ ARGS = [
 )
 def test_bad_steady_settings_are_one_line(kw, text):
     with pytest.raises(UserInputError, match=text.replace("(", r"\(")):
-        steady.SteadySettings(**kw)
+        search_settings.SteadySettings(**kw)
 
 
 @pytest.mark.parametrize(
@@ -103,7 +108,7 @@ def _stand_in(problem, settings, u, states=None, *, gradient=True):
     target = np.array([0.7, 0.6, 0.5])
     steps = 0 if states is None else int(states[0][0])
     value = 1.0 + float(np.sum((u - target) ** 2)) + 0.01 * steps
-    point = dict(  # every operating point alike: the envelope simulates them all
+    point = evaluation.PointRecord(  # every operating point alike: the envelope simulates them all
         value=value,
         ci=(value - 0.02, value + 0.02),
         gradient=2.0 * (u - target),
@@ -115,7 +120,7 @@ def _stand_in(problem, settings, u, states=None, *, gradient=True):
         settled=True,
         simulated=True,
     )
-    return steady.Evaluation(
+    return evaluation.Evaluation(
         objective=value,
         objective_ci=(value - 0.02, value + 0.02),
         gradient=2.0 * (u - target) if gradient else np.full(3, np.nan),
@@ -252,7 +257,7 @@ def test_verify_seeds_option_reaches_the_verification(tmp_path, config, monkeypa
     `steady_design_metrics_points`; the real ones are in tests/test_steady_design.py)."""
     monkeypatch.setattr(steady, "evaluate_starts", _stand_in_starts)
     calls = []
-    monkeypatch.setattr(steady, "steady_design_metrics_points", _metrics_stand_in(calls))
+    monkeypatch.setattr(evaluation, "steady_design_metrics_points", _metrics_stand_in(calls))
     out = tmp_path / "verified"
     assert main(["run", "--config", config, *ARGS, "--verify-seeds", "3", "--quiet", "--out", str(out)]) == 0
     r = json.loads((out / "result.json").read_text())
@@ -283,14 +288,14 @@ def test_verification_uses_unseen_seeds(config, monkeypatch):
     calls = []
     metrics = _metrics_stand_in(calls)
 
-    monkeypatch.setattr(steady, "steady_design_metrics_points", metrics)
+    monkeypatch.setattr(evaluation, "steady_design_metrics_points", metrics)
     cfg = jb.load_config(config)
     problem = make_problem(cfg.bearing(), cfg.operating_point())
-    settings = steady.SteadySettings(
+    settings = search_settings.SteadySettings(
         seeds=2, window_revs=2, workers=1, verify_seeds=3, verify_first_seed=7, verify_window_revs=4
     )
     x = np.array([0.08, 1.6 * math.pi / 180, 0.15e-3])
-    v = steady.verification(problem, settings, x, x)
+    v = verify.verification(problem, settings, x, x)
     assert v["seeds"] == [7, 8, 9]
     assert calls == [(0.08, 3, 7, 4), (0.08, 3, 7, 4), "call"]
     for name in ("reference", "optimum"):
@@ -308,7 +313,7 @@ def test_verification_uses_unseen_seeds(config, monkeypatch):
     assert v["mean_pv_lower_disjoint"] is False
     assert v["optimum_corner_contacts"] is False
     # a design 12.5 % lower, beyond the intervals, with corner contact
-    v = steady.verification(problem, settings, np.array([0.07, *x[1:]]), x)
+    v = verify.verification(problem, settings, np.array([0.07, *x[1:]]), x)
     assert v["optimum"]["mean_pv_GPa_m_s"]["value"] == pytest.approx(0.875)
     assert v["mean_pv_lower_disjoint"] is True and v["optimum_corner_contacts"] is True
     assert v["reference_corner_contact_per_revolution_upper95"] == 0.17
@@ -333,9 +338,9 @@ def test_grid_picks_the_best_point_inside_every_margin_and_resumes(tmp_path, con
         ev.dynamic_margin = 1e-4 if u[0] < 0.6 else -1e-4  # large end radii reach the corner
         return ev
 
-    monkeypatch.setattr(steady, "evaluate", evaluate)
-    settings = steady.SteadySettings(seeds=2, workers=1)
-    grid = steady.steady_grid(problem, settings, 4, 3, 0.15e-3, directory=tmp_path)
+    monkeypatch.setattr(grid_module, "evaluate", evaluate)
+    settings = search_settings.SteadySettings(seeds=2, workers=1)
+    grid = grid_module.steady_grid(problem, settings, 4, 3, 0.15e-3, directory=tmp_path)
     feasible = np.all(grid["static_margins"] > 0, axis=-1)
     assert len(seen) == grid["num_evaluations"] == feasible.sum() > 0
     assert seen[0][1] is None and all(s is not None for _, s in seen[1:])  # continuation
@@ -343,7 +348,7 @@ def test_grid_picks_the_best_point_inside_every_margin_and_resumes(tmp_path, con
     assert grid["best_objective"] == pytest.approx(np.min(grid["objective"][ok]))
     assert np.all(np.isnan(grid["objective"][~feasible]))
     seen.clear()
-    again = steady.steady_grid(problem, settings, 4, 3, 0.15e-3, directory=tmp_path)
+    again = grid_module.steady_grid(problem, settings, 4, 3, 0.15e-3, directory=tmp_path)
     assert seen == [] and again["best_objective"] == grid["best_objective"]
 
 
@@ -410,12 +415,14 @@ def test_an_iteration_evaluates_every_start_in_one_engine_call(monkeypatch):
     from optimise import make_problem
 
     seen, cases = [], []
-    monkeypatch.setattr(steady, "steady_design_metrics_points", _engine_stand_in(seen, samples=True))
-    monkeypatch.setattr(steady, "frozen_load_gradients", _frozen_stand_in(cases))
+    monkeypatch.setattr(evaluation, "steady_design_metrics_points", _engine_stand_in(seen, samples=True))
+    monkeypatch.setattr(evaluation, "frozen_load_gradients", _frozen_stand_in(cases))
     problem = make_problem(jb.reference_bearing(), jb.reference_operating_point())
-    settings = steady.SteadySettings(seeds=2, window_revs=2, settle=0.005, gradient_window=0.1e-3, workers=1)
+    settings = search_settings.SteadySettings(
+        seeds=2, window_revs=2, settle=0.005, gradient_window=0.1e-3, workers=1
+    )
     us = [np.array([0.5, 0.5, 0.25]), np.array([0.8, 0.3, 0.25])]
-    evaluations = steady.evaluate_starts(problem, settings, us, [None, None])
+    evaluations = evaluation.evaluate_starts(problem, settings, us, [None, None])
     assert len(seen) == 1 and len(seen[0][0]) == 2 and len(cases) == 1 and len(cases[0]) == 2
     width = np.asarray(problem.bounds.upper - problem.bounds.lower)
     for u, ev, case in zip(us, evaluations, cases[0]):
@@ -441,14 +448,14 @@ def test_clearance_gradient_is_a_paired_crn_difference_in_the_same_engine_call(m
     from optimise import make_problem
 
     seen = []
-    monkeypatch.setattr(steady, "steady_design_metrics_points", _engine_stand_in(seen))
-    monkeypatch.setattr(steady, "frozen_load_gradients", _frozen_stand_in())
+    monkeypatch.setattr(evaluation, "steady_design_metrics_points", _engine_stand_in(seen))
+    monkeypatch.setattr(evaluation, "frozen_load_gradients", _frozen_stand_in())
     problem = make_problem(jb.reference_bearing(), jb.reference_operating_point())
     h = 0.01e-3
-    settings = steady.SteadySettings(seeds=3, workers=1, clearance_step=h)
+    settings = search_settings.SteadySettings(seeds=3, workers=1, clearance_step=h)
     u = np.array([0.5, 0.5, 0.25])
     chain = [["a", "b", "c"]]
-    (ev,) = steady.evaluate_starts(problem, settings, [u], [chain])
+    (ev,) = evaluation.evaluate_starts(problem, settings, [u], [chain])
     ((clearances, initial),) = seen
     base = float(problem.design(jnp.asarray(u)).axial_clearance)
     np.testing.assert_allclose(clearances, [base, base + h, base - h], rtol=1e-12)
@@ -459,12 +466,12 @@ def test_clearance_gradient_is_a_paired_crn_difference_in_the_same_engine_call(m
     assert ev.simulated_ms == pytest.approx(3 * 3 * (1.0 + 2.0))
     # off without a gradient (and by default): one design per start
     seen.clear()
-    steady.evaluate_starts(problem, settings, [u], [chain], gradient=False)
+    evaluation.evaluate_starts(problem, settings, [u], [chain], gradient=False)
     assert len(seen[0][0]) == 1
     with pytest.raises(UserInputError, match=r"^clearance_step = -1"):
-        steady.SteadySettings(clearance_step=-1.0)
+        search_settings.SteadySettings(clearance_step=-1.0)
     with pytest.raises(UserInputError, match=r"^clearance_step = 'soon': must be 'auto'"):
-        steady.SteadySettings(clearance_step="soon")
+        search_settings.SteadySettings(clearance_step="soon")
 
 
 def test_clearance_signal_is_the_paired_difference_where_significant():
@@ -474,18 +481,21 @@ def test_clearance_signal_is_the_paired_difference_where_significant():
     h = 1e-5
     minus = np.array([1.0, 2.0, 3.0, 4.0])
     clear = minus + 2 * h * np.array([1.0, 1.1, 0.9, 1.05])  # d about 1, SE 0.04
-    d, se = steady.clearance_signal(clear, minus, h)
+    d, se = evaluation.clearance_signal(clear, minus, h)
     assert d == pytest.approx(1.0125) and se == pytest.approx(np.std([1, 1.1, 0.9, 1.05], ddof=1) / 2)
     noisy = minus + 2 * h * np.array([1.0, -1.2, 0.8, -0.4])  # d 0.05, SE 0.5
-    d, se = steady.clearance_signal(noisy, minus, h)
+    d, se = evaluation.clearance_signal(noisy, minus, h)
     assert d == 0.0 and se > 0.4
     # at the bound: t_{0.975, 3} = 3.182; d = 3.0 SE is not significant, 3.3 SE is
     for z, expected in ((3.0, 0.0), (3.3, None)):
         per = np.array([1.0, -1.0, 1.0, -1.0])  # std 1.1547, SE 0.5774
         steps = per + z * np.std(per, ddof=1) / 2
-        d, _ = steady.clearance_signal(minus + 2 * h * steps, minus, h)
+        d, _ = evaluation.clearance_signal(minus + 2 * h * steps, minus, h)
         assert d == (pytest.approx(np.mean(steps)) if expected is None else expected), z
-    assert steady.clearance_signal(minus[:1] + h, minus[:1], h) == (0.0, pytest.approx(np.nan, nan_ok=True))
+    assert evaluation.clearance_signal(minus[:1] + h, minus[:1], h) == (
+        0.0,
+        pytest.approx(np.nan, nan_ok=True),
+    )
 
 
 def test_auto_clearance_step_is_on_where_the_envelope_is_misaligned_beyond_1_mrad():
@@ -498,15 +508,18 @@ def test_auto_clearance_step_is_on_where_the_envelope_is_misaligned_beyond_1_mra
     import jaxbearing as jb
     from optimise import make_problem
 
-    auto = steady.SteadySettings()
+    auto = search_settings.SteadySettings()
     assert auto.clearance_step == "auto"
     op = jb.reference_operating_point()
-    for tilt, step in ((0.0, 0.0), (1e-3, 0.0), (-2e-3, steady.CLEARANCE_STEP), (1.5e-3, 0.01e-3)):
+    for tilt, step in ((0.0, 0.0), (1e-3, 0.0), (-2e-3, search_settings.CLEARANCE_STEP), (1.5e-3, 0.01e-3)):
         problem = make_problem(jb.reference_bearing(), dataclasses.replace(op, misalignment=tilt))
-        assert steady.clearance_step_for(problem, auto) == pytest.approx(step, abs=1e-15), tilt
+        assert search_settings.clearance_step_for(problem, auto) == pytest.approx(step, abs=1e-15), tilt
     aligned = make_problem(jb.reference_bearing(), op, speeds_rpm=[10000.0, 30000.0])
-    assert steady.clearance_step_for(aligned, auto) == 0.0
-    assert steady.clearance_step_for(aligned, steady.SteadySettings(clearance_step=2e-5)) == 2e-5
+    assert search_settings.clearance_step_for(aligned, auto) == 0.0
+    assert (
+        search_settings.clearance_step_for(aligned, search_settings.SteadySettings(clearance_step=2e-5))
+        == 2e-5
+    )
 
 
 def _envelope_engine(seen):
@@ -551,9 +564,9 @@ def _three_speed_stand_ins(monkeypatch, engine):
     from jaxbearing.design import SteadyGradient
     from optimise import make_problem
 
-    monkeypatch.setattr(steady, "steady_design_metrics_points", engine)
+    monkeypatch.setattr(evaluation, "steady_design_metrics_points", engine)
     monkeypatch.setattr(
-        steady,
+        evaluation,
         "frozen_load_gradients",
         lambda cases, **kw: [
             SteadyGradient(1e9, np.array([3e9, -4e9, 0.0]), np.full(3, 1e7), 1e6, 1e-4, 4, None, None, None)
@@ -563,7 +576,7 @@ def _three_speed_stand_ins(monkeypatch, engine):
     problem = make_problem(
         jb.reference_bearing(), jb.reference_operating_point(), speeds_rpm=[10e3, 20e3, 30e3]
     )
-    return problem, steady.SteadySettings(seeds=2, workers=1)
+    return problem, search_settings.SteadySettings(seeds=2, workers=1)
 
 
 def test_envelope_leaves_out_points_of_negligible_weight(monkeypatch):
@@ -579,56 +592,61 @@ def test_envelope_leaves_out_points_of_negligible_weight(monkeypatch):
     seen = []
     problem, settings = _three_speed_stand_ins(monkeypatch, _envelope_engine(seen))
     u0, u1 = np.array([0.5, 0.5, 0.25]), np.array([0.55, 0.45, 0.25])
-    (ev0,) = steady.evaluate_starts(problem, settings, [u0], [None])
+    (ev0,) = evaluation.evaluate_starts(problem, settings, [u0], [None])
     assert len(seen[-1]) == 3
     # the corner constraint: by default on the prediction bound, "mean" on the expectation
     assert ev0.dynamic_margin == pytest.approx(0.5e-3 / (float(problem.operating.inner_speed[2]) / 1000.0))
-    (ev_mean,) = steady.evaluate_starts(
-        problem, steady.SteadySettings(seeds=2, workers=1, corner_constraint="mean"), [u0], [None]
+    (ev_mean,) = evaluation.evaluate_starts(
+        problem, search_settings.SteadySettings(seeds=2, workers=1, corner_constraint="mean"), [u0], [None]
     )
     assert ev_mean.dynamic_margin == pytest.approx(2 * ev0.dynamic_margin)
-    assert steady.next_active(problem, settings, ev0, [0, 0, 0]) == [False, False, True]
-    assert steady.next_active(problem, settings, ev0, [2, 0, 0]) == [True, False, True]  # recheck due
-    wide = steady.SteadySettings(seeds=2, workers=1, corner_margin=0.3e-3)  # 20k within 0.3 mm of 30k's
-    assert steady.next_active(problem, wide, ev0, [0, 0, 0]) == [False, True, True]
+    assert envelope.next_active(problem, settings, ev0, [0, 0, 0]) == [False, False, True]
+    assert envelope.next_active(problem, settings, ev0, [2, 0, 0]) == [True, False, True]  # recheck due
+    wide = search_settings.SteadySettings(
+        seeds=2, workers=1, corner_margin=0.3e-3
+    )  # 20k within 0.3 mm of 30k's
+    assert envelope.next_active(problem, wide, ev0, [0, 0, 0]) == [False, True, True]
     # 10,000 rpm's 0.48 mm is within 0.4 mm of the smallest but above CORNER_WATCH: cannot bind yet
-    wider = steady.SteadySettings(seeds=2, workers=1, corner_margin=0.4e-3)
-    assert steady.next_active(problem, wider, ev0, [0, 0, 0]) == [False, True, True]
-    assert steady.next_active(problem, steady.SteadySettings(skip_weight=0.0), ev0, [0, 0, 0]) == [True] * 3
+    wider = search_settings.SteadySettings(seeds=2, workers=1, corner_margin=0.4e-3)
+    assert envelope.next_active(problem, wider, ev0, [0, 0, 0]) == [False, True, True]
+    assert (
+        envelope.next_active(problem, search_settings.SteadySettings(skip_weight=0.0), ev0, [0, 0, 0])
+        == [True] * 3
+    )
     mean = make_problem(
         jb.reference_bearing(),
         jb.reference_operating_point(),
         speeds_rpm=[10e3, 20e3, 30e3],
         aggregate="mean",
     )
-    assert steady.next_active(mean, settings, ev0, [0, 0, 0]) == [True] * 3
+    assert envelope.next_active(mean, settings, ev0, [0, 0, 0]) == [True] * 3
 
-    (ev1,) = steady.evaluate_starts(
+    (ev1,) = evaluation.evaluate_starts(
         problem, settings, [u1], [ev0.states], active=[[False, False, True]], previous=[ev0]
     )
     assert len(seen[-1]) == 1  # only 30,000 rpm simulated
     for k in (0, 1):
         old, new = ev0.per_point[k], ev1.per_point[k]
-        assert new["value"] == old["value"] and new["simulated"] is False and ev1.states[k] is ev0.states[k]
+        assert new.value == old.value and new.simulated is False and ev1.states[k] is ev0.states[k]
         lc = MARGIN_NAMES.index("limited_circle")
         moved = float(problem.margins(jnp.asarray(u1))[lc] - problem.margins(jnp.asarray(u0))[lc])
-        assert new["corner_margin"] == pytest.approx(old["corner_margin"] + moved, rel=1e-12)
+        assert new.corner_margin == pytest.approx(old.corner_margin + moved, rel=1e-12)
     assert ev1.states[2][0][1] == 2  # the simulated point continued its chain
     assert ev1.objective == pytest.approx(ev0.objective, rel=1e-12)  # the worst point's value, unchanged here
     # the combined objective's interval: the dominant point's half-widths (+-5 %) around J, which
     # lies T ln 3 below the largest point (the others weigh nothing)
-    worst = ev0.per_point[2]["value"]
+    worst = ev0.per_point[2].value
     assert ev0.objective == pytest.approx(worst - 0.1 * math.log(3), rel=1e-9)
     np.testing.assert_allclose(
         ev0.objective_ci, (ev0.objective - 0.05 * worst, ev0.objective + 0.05 * worst), rtol=1e-9
     )
     with pytest.raises(ValueError, match="previous evaluation"):
-        steady.evaluate_starts(problem, settings, [u1], [ev0.states], active=[[False, False, True]])
+        evaluation.evaluate_starts(problem, settings, [u1], [ev0.states], active=[[False, False, True]])
     for bad, name in ((1.0, "skip_weight"), (-0.1, "skip_weight")):
         with pytest.raises(UserInputError, match=f"^{name} = "):
-            steady.SteadySettings(skip_weight=bad)
+            search_settings.SteadySettings(skip_weight=bad)
     with pytest.raises(UserInputError, match="^recheck_every = 0"):
-        steady.SteadySettings(recheck_every=0)
+        search_settings.SteadySettings(recheck_every=0)
 
 
 def test_envelope_search_rechecks_and_resumes_identically(tmp_path, monkeypatch):
@@ -643,7 +661,7 @@ def test_envelope_search_rechecks_and_resumes_identically(tmp_path, monkeypatch)
     kw = dict(num_starts=1, num_iterations=4, verify=False)
     whole = steady.steady_search(problem, settings, directory=tmp_path / "whole", **kw)
     assert [len(s) for s in seen] == [3, 1, 1, 3, 1]
-    simulated = whole.history["points_simulated"][:, 0]
+    simulated = whole.history.points_simulated[:, 0]
     np.testing.assert_array_equal(simulated.sum(axis=1), [3, 1, 1, 3, 1])
     assert whole.num_evaluations == 9
 
@@ -655,15 +673,15 @@ def test_envelope_search_rechecks_and_resumes_identically(tmp_path, monkeypatch)
             raise KeyboardInterrupt
         return engine(*a, **k)
 
-    monkeypatch.setattr(steady, "steady_design_metrics_points", dying)
+    monkeypatch.setattr(evaluation, "steady_design_metrics_points", dying)
     with pytest.raises(KeyboardInterrupt):
         steady.steady_search(problem, settings, directory=tmp_path / "killed", **kw)
-    monkeypatch.setattr(steady, "steady_design_metrics_points", engine)
+    monkeypatch.setattr(evaluation, "steady_design_metrics_points", engine)
     seen.clear()
     resumed = steady.steady_search(problem, settings, directory=tmp_path / "killed", **kw)
     assert resumed.resumed_from == 1 and [len(s) for s in seen] == [1, 3, 1]
     for key in ("x", "objective", "gradient", "margins", "points_simulated"):
-        np.testing.assert_array_equal(resumed.history[key], whole.history[key])
+        np.testing.assert_array_equal(getattr(resumed.history, key), getattr(whole.history, key))
 
 
 def test_verification_reports_every_operating_point(monkeypatch, capsys):
@@ -685,12 +703,12 @@ def test_verification_reports_every_operating_point(monkeypatch, capsys):
                 est["ci95_low"], est["ci95_high"] = est["value"] - hw, est["value"] + hw
         return out
 
-    monkeypatch.setattr(steady, "steady_design_metrics_points", engine)
+    monkeypatch.setattr(evaluation, "steady_design_metrics_points", engine)
     problem = make_problem(jb.reference_bearing(), jb.reference_operating_point(), speeds_rpm=[10e3, 30e3])
-    settings = steady.SteadySettings(seeds=2, workers=1)
+    settings = search_settings.SteadySettings(seeds=2, workers=1)
     reference = np.array([0.08, 1.6 * math.pi / 180, 0.15e-3])
     found = np.array([0.07, 1.6 * math.pi / 180, 0.15e-3])
-    v = steady.verification(problem, settings, found, reference)
+    v = verify.verification(problem, settings, found, reference)
     assert len(v["optimum"]["per_operating_point"]) == 2
     assert v["mean_pv_lower_disjoint_per_operating_point"] == [False, True]
     assert v["objective_lower_disjoint_per_operating_point"] == [False, True]
@@ -715,14 +733,14 @@ def test_initial_states_continue_a_start_s_first_evaluation(config, monkeypatch)
     monkeypatch.setattr(steady, "evaluate_starts", evaluate_starts)
     cfg = jb.load_config(config)
     problem = make_problem(cfg.bearing(), cfg.operating_point())
-    settings = steady.SteadySettings(seeds=2, window_revs=2, settle=0.5, workers=1)
+    settings = search_settings.SteadySettings(seeds=2, window_revs=2, settle=0.5, workers=1)
     kw = dict(num_starts=2, num_iterations=1, verify=False)
     given = steady.steady_search(problem, settings, initial_states=[[[4]], None], **kw)
     # the stand-in's states count the evaluations along a chain (and add 0.01 each to J): the
     # first start's chain went on from the 4 given, the second's from the skid start
     assert seen == [[[[4]], None], [[[5]], [[1]]]]
-    u0 = np.asarray(given.history["x"])[0]
-    j0 = np.asarray(given.history["objective"])[0]
+    u0 = np.asarray(given.history.x)[0]
+    j0 = np.asarray(given.history.objective)[0]
     target = 1.0 + np.sum((np.asarray(problem.bounds.to_scaled(u0)) - [0.7, 0.6, 0.5]) ** 2, axis=-1)
     np.testing.assert_allclose(j0 - target, [0.04, 0.0], atol=1e-9)
     for bad in ([[[4]]], [[[4], [4]], None]):
@@ -753,29 +771,29 @@ def test_clearance_signal_at_2_mrad_is_the_paired_difference_and_positive(monkey
     bearing = dataclasses.replace(jb.reference_bearing(), num_slices=11)
     op = dataclasses.replace(jb.reference_operating_point(), misalignment=2e-3)
     problem = make_problem(bearing, op)
-    settings = steady.SteadySettings(seeds=4, window_revs=2)
-    h = steady.clearance_step_for(problem, settings)
-    assert h == steady.CLEARANCE_STEP
+    settings = search_settings.SteadySettings(seeds=4, window_revs=2)
+    h = search_settings.clearance_step_for(problem, settings)
+    assert h == search_settings.CLEARANCE_STEP
     lower, upper = np.asarray(problem.bounds.lower), np.asarray(problem.bounds.upper)
     u = (np.array([0.100, np.radians(1.4), 0.15e-3]) - lower) / (upper - lower)
-    (settled,) = steady.evaluate_starts(problem, settings, [u], [None], gradient=False)
+    (settled,) = evaluation.evaluate_starts(problem, settings, [u], [None], gradient=False)
     seen = []
-    engine = steady.steady_design_metrics_points
+    engine = evaluation.steady_design_metrics_points
 
     def spied(bearing_, ops, designs, **kw):
         out = engine(bearing_, ops, designs, **kw)
         seen.append(([float(d.axial_clearance) for d in designs], out))
         return out
 
-    monkeypatch.setattr(steady, "steady_design_metrics_points", spied)
-    (ev,) = steady.evaluate_starts(problem, settings, [u], [settled.states])
+    monkeypatch.setattr(evaluation, "steady_design_metrics_points", spied)
+    (ev,) = evaluation.evaluate_starts(problem, settings, [u], [settled.states])
     ((clearances, members),) = seen
     np.testing.assert_allclose(clearances, [0.15e-3, 0.15e-3 + h, 0.15e-3 - h], rtol=1e-9)
     fd, se, n = paired_central_difference(members[1].objective_per_seed, members[2].objective_per_seed, h)
     assert n == 4
-    signal, _ = steady.clearance_signal(members[1].objective_per_seed, members[2].objective_per_seed, h)
+    signal, _ = evaluation.clearance_signal(members[1].objective_per_seed, members[2].objective_per_seed, h)
     assert signal in (0.0, fd)  # the difference where significant at 5 %, else 0
-    scale = (upper[2] - lower[2]) / steady.PV_SCALE
+    scale = (upper[2] - lower[2]) / evaluation.PV_SCALE
     assert ev.gradient[2] == pytest.approx(signal * scale, rel=1e-9, abs=1e-300)
     assert ev.gradient_stderr[2] == pytest.approx(se * scale, rel=1e-9)
     assert fd > 0, (fd, se)
@@ -788,13 +806,13 @@ def test_tail_verification_needs_the_risk_bounded_at_every_operating_point(tmp_p
     from optimise._cli import tail_text
 
     risk = lambda upper, n: {"corner_risk": {"upper": upper, "method": "count", "revolutions": n}}  # noqa: E731
-    ok = steady.tail_verification([risk(4e-4, 4000), risk(9e-4, 3200)], 1e-3)
+    ok = verify.tail_verification([risk(4e-4, 4000), risk(9e-4, 3200)], 1e-3)
     assert ok["verified"] and ok["upper_per_revolution"] == 9e-4 and ok["revolutions_needed"] == 2995
     assert "verified in the tail at 0.001" in tail_text(ok) and "NOT" not in tail_text(ok)
-    short = steady.tail_verification([risk(4e-4, 4000), risk(0.17, 16)], 1e-3)
+    short = verify.tail_verification([risk(4e-4, 4000), risk(0.17, 16)], 1e-3)
     assert not short["verified"] and short["upper_per_revolution"] == 0.17
     assert "NOT verified in the tail" in tail_text(short) and "2995 revolutions per point" in tail_text(short)
-    assert not steady.tail_verification([{"corner_risk": None}], 1e-3)["verified"]
+    assert not verify.tail_verification([{"corner_risk": None}], 1e-3)["verified"]
     # the level is a setting of the search: out of (0, 1) it is one line before anything runs
     assert main(["run", "--out", str(tmp_path), "--corner-risk-level", "0"]) == 2
     assert capsys.readouterr().err.count("corner_risk_level = 0.0: must be in (0, 1) per revolution") == 1

@@ -282,7 +282,7 @@ def test_optimise_run_help_shows_the_actual_defaults_and_values():
         problem_from_settings,
         steady_settings_from,
     )
-    from optimise._steady import ESTIMATORS, SteadySettings
+    from optimise._settings import ESTIMATORS, SteadySettings
 
     actions = {a.option_strings[0]: a for a in _actions(build_parser(), "run")}
     shown = {k: _shown_default(a) for k, a in actions.items()}  # every option says its default

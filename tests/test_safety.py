@@ -123,45 +123,49 @@ def test_compile_cache_never_unpickles_a_planted_program(tmp_path, plant, monkey
 
 
 def test_steady_checkpoints_refuse_a_planted_pickle(tmp_path, plant):
-    import optimise._steady as steady
+    import optimise._state as steady
 
     for name in ("checkpoint.npz", "grid_checkpoint.npz"):
         path = tmp_path / name
         marker = plant(path)
         with pytest.raises(UserInputError) as e:
-            steady._load_checkpoint(path)
+            steady.load_checkpoint(path)
         assert "not a checkpoint" in _one_line(e.value, path)
         assert not marker.exists()
     for name in ("checkpoint.pkl", "grid_checkpoint.pkl"):
         path = tmp_path / name
         marker = plant(path)
         with pytest.raises(UserInputError) as e:
-            steady._refuse_legacy(path)
+            steady.refuse_legacy(path)
         assert "older version" in _one_line(e.value, path)
         assert not marker.exists()
 
 
 def test_steady_checkpoint_of_the_wrong_shape_is_refused(tmp_path):
-    import optimise._steady as steady
+    import dataclasses
 
-    template = dict(
+    import optimise._state as steady
+    from optimise._envelope import Envelope
+
+    template = steady.SearchState(
         iteration=-1,
         u=np.zeros((2, 3)),
         opt=[],
         lam=np.zeros((2, 5)),
         chains=[None, None],
-        history={"x": []},
-        best=(np.inf, -1, -1, None, None),
+        history=steady.History(),
+        best=steady.Best(),
         evaluations=0,
+        envelope=Envelope.fresh(2, 1),
     )
     path = tmp_path / "checkpoint.npz"
-    wrong = dict(template, u=np.zeros((3, 3)))
+    wrong = dataclasses.replace(template, u=np.zeros((3, 3)))
     with pytest.raises(TreeFileError, match="shape"):
-        steady._checked_state(path, wrong, template, 4)
+        steady.checked_state(path, wrong, template, 4)
     with pytest.raises(UserInputError, match="its fields differ"):
-        steady._checked_state(path, {"u": 1}, template, 4)
+        steady.checked_state(path, {"u": 1}, template, 4)
     with pytest.raises(UserInputError, match="iteration"):
-        steady._checked_state(path, dict(template, iteration=9), template, 4)
+        steady.checked_state(path, dataclasses.replace(template, iteration=9), template, 4)
 
 
 def test_optimise_run_refuses_a_planted_checkpoint_in_one_line(tmp_path, plant, capsys):

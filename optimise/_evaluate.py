@@ -1,0 +1,359 @@
+"""One evaluation of the design search on steady running: the settled objective, its gradient
+and the constraints of every start's design at every operating point of the envelope
+(docs/model.md 17).
+
+Objective. At every operating point k the smooth mean flange PV over contact time of settled
+running (`jaxbearing.design.steady_design_metrics_points`: skid start or continuation, settling,
+a window of `window_revs` cage revolutions, `seeds` seeded scatters; Student-t CI over the
+seeds), combined over the envelope as in `DesignProblem.combine` (smooth max or weighted mean),
+in GPa m/s, with the delta-method interval of `combined_interval`.
+
+Gradient. "frozen": the frozen-load estimate (`jaxbearing.design.frozen_load_gradients`) from
+the settled states the objective's runs passed through; "window": short-window forward-mode
+sensitivities (`jaxbearing.design.steady_gradient`). Neither sees the axial clearance: where
+`clearance_step_for` gives h > 0, dJ/dDelta_bf is the paired common-random-number central
+difference of the settled objective (`clearance_signal`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import time
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+from scipy import stats
+
+from jaxbearing.design import (
+    SteadyGradient,
+    frozen_load_gradients,
+    paired_central_difference,
+    steady_design_metrics_points,
+    steady_gradient,
+)
+from jaxbearing.flange import MARGIN_NAMES, DesignVariables
+from jaxbearing.run import shared_workers
+
+from ._problem import PV_SCALE, DesignProblem
+from ._settings import SteadySettings, clearance_step_for
+
+
+@dataclasses.dataclass
+class PointRecord:
+    """What one evaluation measured at one operating point (objective values in GPa m/s,
+    gradients per unit of the scaled box, margins in m)."""
+
+    value: float
+    ci: tuple  # (low, high): the point's 95 % interval
+    gradient: np.ndarray  # (3,)
+    gradient_stderr: np.ndarray  # (3,)
+    #: the dynamic corner margin the search constrains (`SteadySettings.corner_constraint`), moved
+    #: by the static limited-circle margin's change where the point was not simulated
+    corner_margin: float
+    measured_corner_margin: float  # ... as measured, at `measured_at`
+    measured_at: np.ndarray  # the scaled design (3,) where it was measured
+    corner_contact_share: float
+    settled: bool
+    simulated: bool  # False: the values of an earlier evaluation (`next_active`)
+    estimator_value: float = float("nan")  # the gradient estimator's own objective [GPa m/s]
+
+
+@dataclasses.dataclass
+class Evaluation:
+    """The steady objective, its gradient and the constraints of one design (scaled u)."""
+
+    objective: float  # combined over the envelope [GPa m/s]
+    objective_ci: tuple  # (low, high): its 95 % interval (`combined_interval`) [GPa m/s]
+    gradient: np.ndarray  # dJ/du (3,)
+    gradient_stderr: np.ndarray  # (3,)
+    per_point: list[PointRecord]
+    static_margins: np.ndarray  # (4,) [m]
+    dynamic_margin: float  # [m], worst operating point
+    states: list  # per operating point: the settled states to continue from
+    wall_time_s: float
+    simulated_ms: float  # simulated time of every seed's settling, window and gradient samples
+
+
+@dataclasses.dataclass(frozen=True)
+class Previous:
+    """What `evaluate_starts` reuses of a start's operating points left out."""
+
+    per_point: list[PointRecord]
+    states: list
+
+
+def in_shared_pool(function):
+    """Run `function(problem, settings, ...)` with one pool of `settings.num_workers` processes
+    for all its ensembles and gradients (`jaxbearing.run.shared_workers`): the workers import
+    JAX and load their programs once per search instead of twice per evaluation."""
+
+    @functools.wraps(function)
+    def wrapper(problem, settings=None, *args, **kwargs):
+        settings = SteadySettings() if settings is None else settings
+        with shared_workers(settings.num_workers):
+            return function(problem, settings, *args, **kwargs)
+
+    return wrapper
+
+
+def operating_points(problem: DesignProblem) -> list:
+    """The envelope's operating points, one `OperatingPoint` each."""
+    return [
+        jax.tree_util.tree_map(lambda a: a[k], problem.operating) for k in range(problem.num_operating_points)
+    ]
+
+
+def settled_metrics(problem: DesignProblem, settings: SteadySettings, ops, designs, **kwargs):
+    """`steady_design_metrics_points` of (design, operating point) pairs, one engine call, with
+    the problem's and the settings' measurement options (`kwargs`: seeds, window, ...)."""
+    return steady_design_metrics_points(
+        problem.bearing,
+        ops,
+        designs,
+        settle=settings.settle,
+        corner_margin=settings.corner_margin,
+        flange_load=problem.flange_load,
+        workers=settings.num_workers,
+        rtol=settings.rtol,
+        statistic=settings.statistic,
+        **kwargs,
+    )
+
+
+def evaluate(
+    problem: DesignProblem, settings: SteadySettings, u, states=None, *, gradient: bool = True
+) -> Evaluation:
+    """Settled objective and constraints of the scaled design u (one settled ensemble per
+    operating point, continuing from `states` when given) and, with `gradient`, the estimated
+    gradient (NaN without): `evaluate_starts` of one start."""
+    (ev,) = evaluate_starts(problem, settings, [u], [states], gradient=gradient)
+    return ev
+
+
+def _checked_active(active, n: int, num_designs: int, previous) -> list[list[bool]]:
+    active = (
+        [[True] * n for _ in range(num_designs)] if active is None else [[bool(a) for a in r] for r in active]
+    )
+    for s, row in enumerate(active):
+        if not all(row) and (previous is None or previous[s] is None):
+            raise ValueError(f"start {s}: an operating point left out needs the start's previous evaluation")
+    return active
+
+
+def _gradients(settings: SteadySettings, cases, gradient: bool) -> list[SteadyGradient]:
+    """The gradient estimates of `cases` (bearing, op, design, states) by `settings.estimator`."""
+    if not gradient:
+        return [SteadyGradient.missing() for _ in cases]
+    if settings.estimator == "frozen":
+        return frozen_load_gradients(
+            cases,
+            window=settings.gradient_window,
+            rtol=settings.rtol,
+            workers=settings.num_workers,
+            statistic=settings.statistic,
+        )
+    return [
+        steady_gradient(
+            *case, window=settings.gradient_window, rtol=settings.rtol, workers=settings.num_workers
+        )
+        for case in cases
+    ]
+
+
+def evaluate_starts(
+    problem: DesignProblem,
+    settings: SteadySettings,
+    us,
+    chains,
+    *,
+    gradient: bool = True,
+    active=None,
+    previous=None,
+) -> list[Evaluation]:
+    """`evaluate` of every scaled design of `us` (the starts of one iteration; `chains`: the
+    continuation states of each, or None): every start's operating points' seeds are members
+    of one call of the steady-running engine, and every trajectory of the frozen-load
+    gradients of one call of `frozen_load_gradients` (on an accelerator, one vmapped program
+    each). The wall time of each evaluation is the whole call's.
+
+    The clearance (h = `clearance_step_for(...)` > 0, Delta_bf free): dJ/dDelta_bf is the paired
+    common-random-number central difference of the settled objective per seed, (J_k(Delta_bf +
+    h) - J_k(Delta_bf - h)) / 2h with the same seeds from the same states (`clearance_signal`);
+    the two shifted designs of every start and operating point are further members of the same
+    engine call.
+
+    The envelope (`active`: per start, one flag per operating point, or None: all): a point
+    not active is not simulated; its record is `previous`'s (the start's last measurements),
+    the corner margin moved by the static limited-circle margin's change since it was measured,
+    and it continues later from its old states (`next_active`)."""
+    t0 = time.perf_counter()
+    width = np.asarray(problem.bounds.upper - problem.bounds.lower)
+    ops = operating_points(problem)
+    n = len(ops)
+    h = clearance_step_for(problem, settings)
+    shifts = (0.0, h, -h) if gradient and h > 0 and width[2] > 0 else (0.0,)
+    designs = [problem.design(jnp.asarray(u)) for u in us]
+    chains = [None] * len(designs) if chains is None else list(chains)
+    active = _checked_active(active, n, len(designs), previous)
+    # every active (start, shift, operating point) is one member group of the engine call
+    jobs = [
+        (s, j, k) for s in range(len(designs)) for j in range(len(shifts)) for k in range(n) if active[s][k]
+    ]
+    listed = settled_metrics(
+        problem,
+        settings,
+        [ops[k] for _, _, k in jobs],
+        [_shift_clearance(designs[s], shifts[j]) for s, j, _ in jobs],
+        seeds=settings.seeds,
+        window_revs=settings.window_revs,
+        initial_states=None
+        if all(c is None for c in chains)
+        else [None if chains[s] is None else chains[s][k] for s, _, k in jobs],
+    )
+    metrics = dict(zip(jobs, listed))
+    keys = [(s, k) for (s, j, k) in jobs if j == 0]
+    cases = [
+        (designs[s].apply(problem.bearing), ops[k], designs[s], metrics[(s, 0, k)].sample_states)
+        for s, k in keys
+    ]
+    gradients = dict(zip(keys, _gradients(settings, cases, gradient)))
+    if len(shifts) == 3:
+        for s, k in keys:
+            gradients[(s, k)] = _with_clearance_difference(
+                gradients[(s, k)], metrics[(s, 1, k)], metrics[(s, 2, k)], h
+            )
+    wall = time.perf_counter() - t0
+    evaluations = []
+    for s, u in enumerate(us):
+        measured = {k: (metrics[(s, 0, k)], gradients[(s, k)]) for k in range(n) if active[s][k]}
+        ev = _evaluation(
+            problem, settings, u, measured, None if previous is None else previous[s], wall, gradient
+        )
+        ev.simulated_ms += sum(
+            simulated_ms(metrics[(s, j, k)]) for j in range(1, len(shifts)) for k in measured
+        )
+        evaluations.append(ev)
+    return evaluations
+
+
+def simulated_ms(m) -> float:
+    """Simulated ms of one operating point's settled ensemble: every seed's settling and window."""
+    return sum(r["settle_time_ms"] for r in m.summary["per_seed"]) + len(m.seeds) * m.summary.get(
+        "window_ms", 0.0
+    )
+
+
+def _shift_clearance(design: DesignVariables, dh: float) -> DesignVariables:
+    if dh == 0.0:
+        return design
+    x = np.asarray(design.as_array(), dtype=float)
+    return DesignVariables.from_array(jnp.asarray([x[0], x[1], x[2] + dh]))
+
+
+def clearance_signal(plus, minus, h: float) -> tuple[float, float]:
+    """The search's dJ/dDelta_bf and its standard error from the per-seed objectives at
+    Delta_bf +- h (`paired_central_difference`): the difference where it is significant at
+    5 % (|d| > t_{0.975, n-1} SE, two-sided), else 0. Adam scales every component's step to
+    about the learning rate whatever its size, so an insignificant difference would move
+    Delta_bf a full step in the direction of its noise; gated, Delta_bf moves where the
+    difference shows a direction. (Ungated, the first evaluation of the default search at
+    2 mrad, from the skid start at 90 mm / 1.33 deg, gave -1.3e12 Pa m/s per m, and Delta_bf
+    took a full step up, 0.016 mm; the next evaluation's difference was positive.)"""
+    d, se, n = paired_central_difference(plus, minus, h)
+    if n < 2 or not np.isfinite(se) or abs(d) <= stats.t.ppf(0.975, n - 1) * se:
+        return 0.0, se
+    return d, se
+
+
+def _with_clearance_difference(g: SteadyGradient, plus, minus, h: float) -> SteadyGradient:
+    """`g` with its Delta_bf component the paired common-random-number central difference of
+    the objective per seed where significant (`clearance_signal`) and its standard error."""
+    grad, se = np.array(g.gradient, dtype=float), np.array(g.gradient_stderr, dtype=float)
+    grad[2], se[2] = clearance_signal(plus.objective_per_seed, minus.objective_per_seed, h)
+    return dataclasses.replace(g, gradient=grad, gradient_stderr=se)
+
+
+def _num(v) -> float:
+    return float("nan") if v is None else float(v)
+
+
+def _measured_record(settings: SteadySettings, u, m, g, width) -> PointRecord:
+    """The record of one simulated operating point from its metrics `m` and gradient `g`."""
+    j = m.objective
+    margin = (
+        _num(m.corner_margin_bound)
+        if settings.corner_constraint == "prediction"
+        else _num(m.corner_margin["value"])
+    )
+    return PointRecord(
+        value=_num(j["value"]) / PV_SCALE,
+        ci=(_num(j["ci95_low"]) / PV_SCALE, _num(j["ci95_high"]) / PV_SCALE),
+        gradient=g.gradient * width / PV_SCALE,
+        gradient_stderr=g.gradient_stderr * width / PV_SCALE,
+        estimator_value=g.value / PV_SCALE,
+        corner_margin=margin,
+        measured_corner_margin=margin,
+        measured_at=np.asarray(u, dtype=float),
+        corner_contact_share=_num(m.corner_contact_share["value"]),
+        settled=m.settled,
+        simulated=True,
+    )
+
+
+def _reused_record(problem: DesignProblem, old: PointRecord, here) -> PointRecord:
+    """A point left out: its previous record, the corner margin moved by the static
+    limited-circle margin's change since it was measured."""
+    lc = MARGIN_NAMES.index("limited_circle")
+    then = np.asarray(problem.margins(jnp.asarray(old.measured_at)))
+    moved = old.measured_corner_margin + float(here[lc] - then[lc])
+    return dataclasses.replace(old, corner_margin=moved, simulated=False)
+
+
+def _evaluation(problem, settings, u, measured, previous, wall, gradient: bool) -> Evaluation:
+    """One start's `Evaluation` from the metrics and gradient estimates of its simulated
+    operating points (`measured`: {point: (metrics, gradient)}) and, for the others, `previous`
+    (`evaluate_starts`)."""
+    width = np.asarray(problem.bounds.upper - problem.bounds.lower)
+    per, new_states, simulated = [], [], 0.0
+    here = np.asarray(problem.margins(jnp.asarray(u)))
+    for k in range(problem.num_operating_points):
+        if k not in measured:
+            per.append(_reused_record(problem, previous.per_point[k], here))
+            new_states.append(previous.states[k])
+            continue
+        m, g = measured[k]
+        per.append(_measured_record(settings, u, m, g, width))
+        new_states.append(m.final_states)
+        simulated += simulated_ms(m)
+        simulated += (len(m.sample_states) * settings.gradient_window * 1e3) if gradient else 0.0
+    values = jnp.asarray([p.value for p in per])
+    val, vjp = jax.vjp(problem.combine, values)
+    (weights,) = vjp(jnp.ones(()))
+    weights = np.asarray(weights)
+    grad = sum(w * p.gradient for w, p in zip(weights, per))
+    grad_se = np.sqrt(sum((w * p.gradient_stderr) ** 2 for w, p in zip(weights, per)))
+    return Evaluation(
+        objective=float(val),
+        objective_ci=combined_interval(float(val), weights, per),
+        gradient=np.where(width > 0, grad, 0.0),
+        gradient_stderr=grad_se,
+        per_point=per,
+        static_margins=here,
+        dynamic_margin=float(min(p.corner_margin for p in per)),
+        states=new_states,
+        wall_time_s=wall,
+        simulated_ms=simulated,
+    )
+
+
+def combined_interval(value: float, weights, per: list[PointRecord]) -> tuple[float, float]:
+    """The 95 % interval of the combined objective J = combine(J_1 .. J_K) by the delta method:
+    J -+ sqrt(sum_k (w_k h_k)^2), w_k = dJ/dJ_k and h_k the lower or upper half-width of point
+    k's interval (the points' ensembles independent). With one dominant point of the smooth max
+    it is that point's interval moved to J (the smooth max lies T ln K below the largest J_k
+    when the others weigh nothing)."""
+    lo = np.sqrt(sum((w * (p.value - p.ci[0])) ** 2 for w, p in zip(weights, per)))
+    hi = np.sqrt(sum((w * (p.ci[1] - p.value)) ** 2 for w, p in zip(weights, per)))
+    return (float(value - lo), float(value + hi))

@@ -1,0 +1,156 @@
+"""How the design search on steady running measures its objective and constraints: one
+settings object, `SteadySettings`, checked once when built (one line naming the setting).
+
+Times in seconds, lengths in metres. The measurement of one evaluation (seeds, window, settling,
+tolerance, workers) is a `jaxbearing.run.SteadySettings` built from these fields
+(`SteadySettings.measurement`); the verification's another (`SteadySettings.verification`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import jax
+import numpy as np
+
+from jaxbearing import UserInputError
+from jaxbearing.design import CORNER_MARGIN, STATISTICS
+from jaxbearing.io import require
+from jaxbearing.run import available_cpus
+
+from ._problem import DesignProblem
+
+#: gradient estimators: "frozen" (the frozen-load estimate, `jaxbearing.design.frozen_load_gradients`)
+#: or "window" (short-window forward-mode sensitivities, `jaxbearing.design.steady_gradient`)
+ESTIMATORS = ("frozen", "window")
+#: a point left out of the envelope's active set still runs while its corner margin is below
+#: this [m] (`next_active`): one step of the default search moved the limited-circle margin by
+#: up to 0.25 mm and the dynamic corner margin by up to 0.28 mm (results/optimise_steady_default_run.json),
+#: so a margin above it does not bind within a step. Without it, margins alike at every speed
+#: kept every point running (benchmarks/results/bench_envelope_active_set.json)
+CORNER_WATCH = 0.3e-3
+#: the dynamic corner constraint's statistic (`SteadySettings.corner_constraint`)
+CORNER_CONSTRAINTS = ("prediction", "mean")
+
+
+#: `clearance_step="auto"` gives the search a signal for Delta_bf where an operating point is
+#: misaligned by more than this [rad]: the clearance study (docs/model.md 17) found dJ/dDelta_bf
+#: clearly significant at 2 mrad (+2.5 % of J per 10 um at 100 mm / 1.4 deg) and bounded near 0
+#: at 1 mrad at both designs (within -0.4 .. +0.4 % of J per 10 um)
+CLEARANCE_MISALIGNMENT = 1.0e-3
+#: ... with this half-step [m] (the study's h)
+CLEARANCE_STEP = 0.01e-3
+
+
+def clearance_step_for(problem: DesignProblem, settings: SteadySettings) -> float:
+    """The half-step h [m] of the search's Delta_bf difference: `settings.clearance_step`, or
+    with "auto", `CLEARANCE_STEP` where any operating point of `problem` is misaligned by more
+    than `CLEARANCE_MISALIGNMENT` and 0 (off: three times the members for a slope the study
+    bounds near 0) elsewhere."""
+    if not isinstance(settings.clearance_step, str):
+        return float(settings.clearance_step)
+    tilt = np.max(np.abs(np.asarray(problem.operating.misalignment, dtype=float)))
+    return CLEARANCE_STEP if tilt > CLEARANCE_MISALIGNMENT * (1 + 1e-9) else 0.0
+
+
+@dataclasses.dataclass(frozen=True)
+class SteadySettings:
+    """How the steady objective of the design search is measured (module docstring)."""
+
+    seeds: int = 4
+    window_revs: int = 2
+    settle: object = "auto"
+    gradient_window: float = 1.0e-3
+    estimator: str = "frozen"
+    corner_margin: float = CORNER_MARGIN
+    rtol: float = 1e-3
+    workers: int = 0  # 0: one per CPU
+    verify_seeds: int = 4
+    verify_first_seed: int = 1000
+    verify_window_revs: int = 4
+    #: the statistic of flange PV minimised: "mean" (over contact time), "peak" (its p-mean) or
+    #: "tail" (the mean of its worst 5 %, `jaxbearing.design.STATISTICS`)
+    statistic: str = "mean"
+    #: half-step of the common-random-number central difference in Delta_bf [m] (0: off), or
+    #: "auto": `CLEARANCE_STEP` where the envelope is misaligned by more than
+    #: `CLEARANCE_MISALIGNMENT`, else off (`clearance_step_for`); the frozen-load estimator
+    #: cannot see the clearance (`evaluate_starts`)
+    clearance_step: float | str = "auto"
+    #: the dynamic corner constraint: "prediction" (the margin on the upper 95 % prediction bound
+    #: of one revolution's largest contact radius: it holds for a further revolution with 95 %
+    #: probability) or "mean" (on its expectation per revolution: holds on average)
+    corner_constraint: str = "prediction"
+    #: the corner-contact risk per cage revolution the verification must bound at every
+    #: operating point (its upper 95 % bound, `run.corner_risk`), else the design is reported
+    #: unverified in the tail (`tail_verification`)
+    corner_risk_level: float = 1e-3
+    #: the envelope's active set (`next_active`): an operating point whose weight in the smooth
+    #: max stays below this is not simulated (0: every point, every iteration) ...
+    skip_weight: float = 1e-3
+    #: ... for at most this many iterations in a row
+    recheck_every: int = 3
+
+    def __post_init__(self):
+        """One-line errors naming the setting, before anything runs."""
+        for name in ("seeds", "verify_seeds"):
+            require(name, getattr(self, name), lambda v: (v >= 1) & (v == np.round(v)), "an integer >= 1")
+        if self.corner_constraint not in CORNER_CONSTRAINTS:
+            raise UserInputError(
+                f"corner_constraint = {self.corner_constraint!r}: must be one of {', '.join(CORNER_CONSTRAINTS)}"
+            )
+        require("skip_weight", self.skip_weight, lambda v: (v >= 0) & (v < 1), "in [0, 1)")
+        require(
+            "corner_risk_level",
+            self.corner_risk_level,
+            lambda v: (v > 0) & (v < 1),
+            "in (0, 1) per revolution",
+        )
+        require(
+            "recheck_every", self.recheck_every, lambda v: (v >= 1) & (v == np.round(v)), "an integer >= 1"
+        )
+        for name in ("window_revs", "verify_window_revs"):  # batch means need two batches
+            require(name, getattr(self, name), lambda v: (v >= 2) & (v == np.round(v)), "an integer >= 2")
+        require(
+            "verify_first_seed",
+            self.verify_first_seed,
+            lambda v: (v >= 0) & (v == np.round(v)),
+            "an integer >= 0",
+        )
+        if self.verify_first_seed < self.seeds:
+            raise UserInputError(
+                f"verify_first_seed = {self.verify_first_seed}: must be >= seeds = {self.seeds} "
+                "(verification uses seeds the search never saw)"
+            )
+        if self.statistic not in STATISTICS:
+            raise UserInputError(
+                f"statistic = {self.statistic!r}: must be one of {', '.join(map(repr, STATISTICS))}"
+            )
+        if self.statistic != "mean" and self.estimator != "frozen":
+            raise UserInputError(
+                f"statistic = {self.statistic!r} needs estimator = 'frozen' (not {self.estimator!r})"
+            )
+        if self.estimator not in ESTIMATORS:
+            raise UserInputError(f"estimator = {self.estimator!r}: must be one of {', '.join(ESTIMATORS)}")
+        require("gradient_window", self.gradient_window, lambda v: np.isfinite(v) & (v > 0), "> 0 s")
+        require("corner_margin", self.corner_margin, lambda v: np.isfinite(v) & (v >= 0), ">= 0 m")
+        require("rtol", self.rtol, lambda v: np.isfinite(v) & (v > 0) & (v < 1), "in (0, 1)")
+        require("workers", self.workers, lambda v: (v >= 0) & (v == np.round(v)), "an integer >= 0")
+        if self.clearance_step != "auto":
+            if isinstance(self.clearance_step, str):
+                raise UserInputError(
+                    f"clearance_step = {self.clearance_step!r}: must be 'auto' or a number in [0, 1e-3) m"
+                )
+            require(
+                "clearance_step",
+                self.clearance_step,
+                lambda v: np.isfinite(v) & (v >= 0) & (v < 1e-3),
+                "'auto' or in [0, 1e-3) m",
+            )
+
+    @property
+    def num_workers(self) -> int:
+        """`workers`, or 0: one per CPU; on an accelerator one (the members are vmapped there,
+        and worker processes would each claim the device)."""
+        if int(self.workers):
+            return int(self.workers)
+        return available_cpus() if jax.default_backend() == "cpu" else 1

@@ -1,0 +1,126 @@
+"""Verification of a found design: the design and the reference re-simulated from the skid
+start with seeds the search never used, at every operating point (docs/model.md 17).
+
+The search uses seeds 0 .. seeds - 1; the verification `verify_seeds` seeds numbered from
+`verify_first_seed` with windows of `verify_window_revs` revolutions. Each design's row holds
+mean, p95, peak and tail PV over contact time and the corner-contact share with their 95 %
+intervals, the corner margin, and the corner-contact risk per cage revolution with its bounds
+(`jaxbearing.run.corner_risk`); `tail_verification` says whether that risk is bounded at the
+user's level at every operating point.
+"""
+
+from __future__ import annotations
+
+import jax.numpy as jnp
+
+from jaxbearing.flange import DesignVariables
+from jaxbearing.run import revolutions_needed
+
+from ._evaluate import in_shared_pool, operating_points, settled_metrics
+from ._problem import PV_SCALE, DesignProblem
+from ._settings import SteadySettings
+
+
+def _estimates(m) -> dict:
+    """One design's verification row: the issue's `mean_pv`, `p95_pv` [Pa m/s, SI] and
+    `corner_contact_share`, each as value / ci95_low / ci95_high / n, and the same in the
+    engineering units the documentation and the CLI print (GPa m/s, mm)."""
+    return {
+        "mean_pv": _scaled(m.mean_pv, 1.0) | {"unit": "Pa m/s"},
+        "p95_pv": _scaled(m.p95_pv, 1.0) | {"unit": "Pa m/s"},
+        "mean_pv_GPa_m_s": _scaled(m.mean_pv),
+        "p95_pv_GPa_m_s": _scaled(m.p95_pv),
+        "objective_GPa_m_s": _scaled(m.objective),
+        # the expected largest PV of a cage revolution (what the "peak" statistic aims at)
+        "peak_pv_GPa_m_s": _scaled(m.summary.get("flange_pv_Pa_m_s", {}).get("max", {})),
+        # the mean of the worst 5 % of PV over contact time (the "tail" statistic)
+        "tail_pv_GPa_m_s": _scaled(m.summary.get("flange_pv_contact_time_Pa_m_s", {}).get("tail95", {})),
+        "corner_contact_share": dict(m.corner_contact_share),
+        "corner_margin_mm": _scaled(m.corner_margin, 1e-3),
+        # the margin on the upper 95 % prediction bound of one revolution's largest contact radius
+        "corner_margin_bound_mm": float(m.corner_margin_bound) * 1e3,
+        # how far zero corner contact in these seeds bounds the tail (upper 95 % bounds)
+        "corner_contact_bound": m.summary.get("corner_contact_bound"),
+        # the probability per revolution of reaching the corner, with its bounds (`run.corner_risk`)
+        "corner_risk": m.summary.get("corner_risk"),
+        "settled": m.settled,
+        "seeds": m.seeds,
+    }
+
+
+def _scaled(est: dict, unit: float = PV_SCALE) -> dict:
+    return {
+        k: (None if est.get(k) is None else float(est[k]) / unit) if k != "n" else est.get("n", 0)
+        for k in ("value", "ci95_low", "ci95_high", "n")
+    }
+
+
+@in_shared_pool
+def verification(problem: DesignProblem, settings: SteadySettings, design, reference) -> dict:
+    """The found design and the reference design re-simulated from the skid start with seeds
+    the search never used (module docstring), at every operating point: both designs' points'
+    seeds members of one call of the steady-running engine."""
+    out = {
+        "seeds": list(range(settings.verify_first_seed, settings.verify_first_seed + settings.verify_seeds))
+    }
+    ops = operating_points(problem)
+    designs = [DesignVariables.from_array(jnp.asarray(x)) for x in (reference, design)]
+    metrics = settled_metrics(
+        problem,
+        settings,
+        ops * 2,
+        [d for d in designs for _ in ops],
+        seeds=settings.verify_seeds,
+        window_revs=settings.verify_window_revs,
+        first_seed=settings.verify_first_seed,
+    )
+    for i, name in enumerate(("reference", "optimum")):
+        rows = [_estimates(m) for m in metrics[i * len(ops) : (i + 1) * len(ops)]]
+        out[name] = rows[0] if len(rows) == 1 else {"per_operating_point": rows}
+    refs = out["reference"].get("per_operating_point", [out["reference"]])
+    opts = out["optimum"].get("per_operating_point", [out["optimum"]])
+
+    def lower(key: str) -> list[bool]:  # per point: the optimum's interval below the reference's
+        return [
+            bool(
+                None not in (r[key]["ci95_low"], o[key]["ci95_high"])
+                and o[key]["ci95_high"] < r[key]["ci95_low"]
+            )
+            for r, o in zip(refs, opts)
+        ]
+
+    # at every operating point (the whole envelope)
+    out["mean_pv_lower_disjoint"] = all(lower("mean_pv_GPa_m_s"))
+    out["objective_lower_disjoint"] = all(lower("objective_GPa_m_s"))
+    if len(ops) > 1:
+        out["mean_pv_lower_disjoint_per_operating_point"] = lower("mean_pv_GPa_m_s")
+        out["objective_lower_disjoint_per_operating_point"] = lower("objective_GPa_m_s")
+    out["optimum_corner_contacts"] = any((o["corner_contact_share"].get("value") or 0.0) > 0 for o in opts)
+    for name in ("reference", "optimum"):  # the weakest bound over the operating points
+        rows = out[name].get("per_operating_point", [out[name]])
+        bounds = [r["corner_contact_bound"] for r in rows if r.get("corner_contact_bound")]
+        if bounds:
+            out[f"{name}_corner_contact_per_revolution_upper95"] = max(
+                b["per_revolution_upper95"] for b in bounds
+            )
+    out["tail"] = tail_verification(opts, settings.corner_risk_level)
+    return out
+
+
+def tail_verification(rows: list[dict], level: float) -> dict:
+    """Whether the verification bounds the found design's corner-contact risk at `level` per
+    cage revolution at every operating point: the largest upper bound of `run.corner_risk` over
+    the points (one-sided 95 % or more), `verified` when it is at most `level`; else the design
+    is unverified in the tail, and `revolutions_needed` says how many revolutions per point
+    without corner contact would bound it by counting alone."""
+    risks = [r.get("corner_risk") for r in rows]
+    uppers = [r["upper"] if r and r.get("upper") is not None else 1.0 for r in risks]
+    upper = max(uppers) if uppers else 1.0
+    return {
+        "level_per_revolution": float(level),
+        "upper_per_revolution": float(upper),
+        "methods": [r.get("method") if r else None for r in risks],
+        "revolutions_per_point": [r.get("revolutions") if r else 0 for r in risks],
+        "verified": bool(upper <= level),
+        "revolutions_needed": revolutions_needed(level),
+    }
