@@ -215,10 +215,19 @@ def build_parser() -> argparse.ArgumentParser:
     )
     r.add_argument(
         "--corner-constraint",
-        metavar="{prediction,mean}",  # checked by `SteadySettings`: one-line errors
-        help="steady: the dynamic corner margin on the upper 95 %% prediction bound of one revolution's "
-        "largest contact radius (prediction: holds for a further revolution with 95 %% probability) or on "
-        f"its expectation per revolution (mean) (default: {st.corner_constraint})",
+        metavar="{risk,prediction,mean}",  # checked by `SteadySettings`: one-line errors
+        help="steady: the dynamic corner margin on the contact radius one revolution exceeds with "
+        "probability --corner-risk-level at most, at 95 %% confidence (risk: the corner-contact risk "
+        "bounded), on the upper 95 %% prediction bound of one revolution's largest contact radius "
+        "(prediction) or on its expectation per revolution (mean) "
+        f"(default: {st.corner_constraint})",
+    )
+    r.add_argument(
+        "--choose",
+        metavar="{safest,best}",  # checked by `SteadySettings`: one-line errors
+        help="steady: the design returned: of the feasible designs statistically tied with the one of the "
+        "lowest upper 95 %% bound of the objective, the one of the lowest corner-risk bound (safest), or "
+        f"that one itself (best) (default: {st.choose})",
     )
     r.add_argument(
         "--skip-weight",
@@ -240,9 +249,9 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument(
         "--corner-risk-level",
         type=float,
-        help="steady: the corner-contact risk per cage revolution the verification must bound (upper 95 %% "
-        f"bound) at every operating point, else the design is reported unverified in the tail (default: "
-        f"{st.corner_risk_level:g})",
+        help="steady: the corner-contact risk per cage revolution the search keeps below (--corner-constraint "
+        "risk) and the verification must bound (upper 95 %% bound) at every operating point, else the design "
+        f"is reported unverified in the tail (default: {st.corner_risk_level:g})",
     )
     r.add_argument("--no-verify", action="store_true", help="steady: skip the verification (default: verify)")
     r.add_argument(
@@ -295,6 +304,7 @@ def _settings(args) -> dict:
         ("clearance_step_mm", args.clearance_step_mm),
         ("statistic", args.statistic),
         ("corner_constraint", args.corner_constraint),
+        ("choose", args.choose),
         ("skip_weight", args.skip_weight),
         ("recheck_every", args.recheck_every),
         ("verify_seeds", args.verify_seeds),
@@ -387,6 +397,7 @@ def steady_settings_from(s: dict):
         clearance_step=_clearance_step(s),
         statistic=s.get("statistic", st.statistic),
         corner_constraint=s.get("corner_constraint", st.corner_constraint),
+        choose=s.get("choose", st.choose),
         skip_weight=_positive(s, "skip_weight", st.skip_weight, strict=False),
         recheck_every=int(_positive(s, "recheck_every", st.recheck_every, int)),
         corner_risk_level=float(s.get("corner_risk_level", st.corner_risk_level)),
@@ -636,9 +647,15 @@ def run_steady(args, problem, options, settings, out, meta=None) -> int:
     if near:
         binds = sorted({d.binding_margin for d in near})
         print(
-            f"  near-optimal set: {len(near)} evaluated design(s) within the best's 95 % interval, "
-            f"binding margin {', '.join(binds)} (result.json near_optimal; drawn on {plot_path.name})"
+            f"  near-optimal set: {len(near)} evaluated design(s) statistically tied with the best, "
+            f"binding margin {', '.join(binds)} (result.json near_optimal; drawn on {plot_path.name}); "
+            f"returned: the {settings.choose} of them"
         )
+        for d in near[:5]:
+            print(
+                f"    {_design_text(d.design)}  J {d.objective:.4f} [{d.ci95[0]:.4f}, {d.ci95[1]:.4f}]  "
+                f"corner risk <= {d.corner_risk:.2g}/rev  corner margin {d.corner_margin_m * 1e3:+.3f} mm"
+            )
     v = res.verification
     if v:
         import numpy as np
@@ -743,6 +760,10 @@ def _steady_result_json(problem, options, settings, res) -> dict:
                 "start": d.start,
                 "binding_margin": d.binding_margin,
                 "binding_margin_mm": d.binding_margin_m * 1e3,
+                "corner_risk_per_revolution_upper95": None
+                if not np.isfinite(d.corner_risk)
+                else d.corner_risk,
+                "corner_margin_mm": d.corner_margin_m * 1e3,
             }
             for d in near_optimal_set(res)
         ],
@@ -772,8 +793,14 @@ def _steady_result_json(problem, options, settings, res) -> dict:
             ),
         },
         "near_optimal_rule": (
-            "every feasible design the search evaluated whose objective lies within the best design's "
-            "95 % interval (search seeds), best first; binding_margin: its smallest margin"
+            "every feasible design the search evaluated that is statistically tied with the best (its "
+            "objective's 95 % interval reaches below the upper bound of the design of the lowest upper bound; "
+            "search seeds), best first; binding_margin: its smallest margin; corner_risk_per_revolution_upper95: "
+            "the upper 95 % bound of its corner-contact risk per cage revolution at its worst operating point"
+        ),
+        "choice_rule": (
+            f"choose = {settings.choose!r}: 'safest' returns the tied design of the lowest corner-risk bound "
+            "(then the largest dynamic corner margin), 'best' the one of the lowest upper bound of the objective"
         ),
         "bounds": problem.bounds.engineering(),
         "operating_points": [

@@ -59,6 +59,7 @@ class Envelope:
     measured_at: np.ndarray
     share: np.ndarray
     settled: np.ndarray
+    risk: np.ndarray
 
     @classmethod
     def fresh(cls, num_starts: int, num_points: int) -> Envelope:
@@ -76,6 +77,7 @@ class Envelope:
             measured_at=np.zeros(shape + (3,)),
             share=nan.copy(),
             settled=np.zeros(shape, bool),
+            risk=nan.copy(),
         )
 
     def record(self, problem: DesignProblem, settings: SteadySettings, s: int, ev: Evaluation) -> None:
@@ -89,6 +91,7 @@ class Envelope:
             self.gradient[s, k], self.gradient_stderr[s, k] = p.gradient, p.gradient_stderr
             self.corner_margin[s, k], self.measured_at[s, k] = p.measured_corner_margin, p.measured_at
             self.share[s, k], self.settled[s, k] = p.corner_contact_share, p.settled
+            self.risk[s, k] = p.corner_risk
         self.active[s] = next_active(problem, settings, ev, self.since[s])
 
     def previous(self, s: int, states) -> Previous | None:
@@ -108,6 +111,7 @@ class Envelope:
                 corner_contact_share=float(self.share[s, k]),
                 settled=bool(self.settled[s, k]),
                 simulated=False,
+                corner_risk=float(self.risk[s, k]),
             )
             for k in range(self.value.shape[1])
         ]

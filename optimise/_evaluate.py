@@ -34,7 +34,7 @@ from jaxbearing.design import (
     steady_gradient,
 )
 from jaxbearing.flange import MARGIN_NAMES, DesignVariables
-from jaxbearing.run import shared_workers
+from jaxbearing.run import CORNER_RISK_CONFIDENCE, shared_workers, tolerance_bound
 
 from ._problem import PV_SCALE, DesignProblem
 from ._settings import SteadySettings, clearance_step_for
@@ -58,6 +58,8 @@ class PointRecord:
     settled: bool
     simulated: bool  # False: the values of an earlier evaluation (`next_active`)
     estimator_value: float = float("nan")  # the gradient estimator's own objective [GPa m/s]
+    #: the upper 95 % bound of the corner-contact risk per cage revolution (`run.corner_risk`)
+    corner_risk: float = float("nan")
 
 
 @dataclasses.dataclass
@@ -74,6 +76,8 @@ class Evaluation:
     states: list  # per operating point: the settled states to continue from
     wall_time_s: float
     simulated_ms: float  # simulated time of every seed's settling, window and gradient samples
+    #: the largest upper bound of the corner-contact risk per revolution over the points
+    corner_risk: float = float("nan")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -279,14 +283,30 @@ def _num(v) -> float:
     return float("nan") if v is None else float(v)
 
 
+def corner_margin_of(settings: SteadySettings, m) -> float:
+    """The dynamic corner margin [m] of one operating point's metrics `m` that the search
+    constrains (`SteadySettings.corner_constraint`): rho_lim - `corner_margin` minus the normal
+    tolerance bound of the per-revolution largest contact radius at `corner_risk_level`
+    ("risk"; the prediction bound where fewer than three revolutions touched a flange), the
+    prediction bound ("prediction") or its mean ("mean")."""
+    if settings.corner_constraint == "mean":
+        return _num(m.corner_margin["value"])
+    if settings.corner_constraint == "risk":
+        bound = tolerance_bound(m.contact_radius_maxima, settings.corner_risk_level, CORNER_RISK_CONFIDENCE)
+        if np.isfinite(bound):
+            return float(m.limited_circle_radius_m - settings.corner_margin - bound)
+    return _num(m.corner_margin_bound)
+
+
+def _risk_upper(m) -> float:
+    risk = m.summary.get("corner_risk") or {}
+    return _num(risk.get("upper"))
+
+
 def _measured_record(settings: SteadySettings, u, m, g, width) -> PointRecord:
     """The record of one simulated operating point from its metrics `m` and gradient `g`."""
     j = m.objective
-    margin = (
-        _num(m.corner_margin_bound)
-        if settings.corner_constraint == "prediction"
-        else _num(m.corner_margin["value"])
-    )
+    margin = corner_margin_of(settings, m)
     return PointRecord(
         value=_num(j["value"]) / PV_SCALE,
         ci=(_num(j["ci95_low"]) / PV_SCALE, _num(j["ci95_high"]) / PV_SCALE),
@@ -299,6 +319,7 @@ def _measured_record(settings: SteadySettings, u, m, g, width) -> PointRecord:
         corner_contact_share=_num(m.corner_contact_share["value"]),
         settled=m.settled,
         simulated=True,
+        corner_risk=_risk_upper(m),
     )
 
 
@@ -345,6 +366,7 @@ def _evaluation(problem, settings, u, measured, previous, wall, gradient: bool) 
         states=new_states,
         wall_time_s=wall,
         simulated_ms=simulated,
+        corner_risk=worst_risk([p.corner_risk for p in per]),
     )
 
 
@@ -357,3 +379,10 @@ def combined_interval(value: float, weights, per: list[PointRecord]) -> tuple[fl
     lo = np.sqrt(sum((w * (p.value - p.ci[0])) ** 2 for w, p in zip(weights, per)))
     hi = np.sqrt(sum((w * (p.ci[1] - p.value)) ** 2 for w, p in zip(weights, per)))
     return (float(value - lo), float(value + hi))
+
+
+def worst_risk(uppers) -> float:
+    """The largest of the corner-risk bounds `uppers`, the unknown (NaN) left out; NaN if none
+    is known."""
+    known = [float(v) for v in uppers if np.isfinite(v)]
+    return max(known) if known else float("nan")

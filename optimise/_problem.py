@@ -194,6 +194,7 @@ OPTIMISE_TOML_KEYS = {
         "estimator",
         "corner_margin_mm",
         "corner_constraint",
+        "choose",
         "clearance_step_mm",
         "statistic",
         "verify_seeds",
@@ -214,7 +215,7 @@ def load_optimise_toml(path: str) -> dict:
                        skip_weight = 1e-3, recheck_every = 3 (steady: the active set)
         [search]       objective = "steady" | "startup", starts, iterations, learning_rate,
                        rtol; steady: seeds, window_revs, settle, gradient_window_ms, estimator,
-                       corner_margin_mm, corner_constraint, clearance_step_mm, statistic,
+                       corner_margin_mm, corner_constraint, choose, clearance_step_mm, statistic,
                        verify_seeds, corner_risk_level, workers;
                        startup: duration_ms, atol
 
@@ -244,7 +245,7 @@ def load_optimise_toml(path: str) -> dict:
 
 _PAIRS = ("end_radius_mm", "layback_angle_deg", "axial_clearance_mm")
 _LISTS = ("speeds_rpm", "loads_N", "weights")
-_TEXTS = ("aggregate", "objective", "estimator", "statistic", "corner_constraint")
+_TEXTS = ("aggregate", "objective", "estimator", "statistic", "corner_constraint", "choose")
 _INTS = ("starts", "iterations", "seeds", "window_revs", "verify_seeds", "workers", "recheck_every")
 #: most values of an envelope list
 _MAX_LIST = 1000

@@ -30,7 +30,9 @@ ESTIMATORS = ("frozen", "window")
 #: kept every point running (benchmarks/results/bench_envelope_active_set.json)
 CORNER_WATCH = 0.3e-3
 #: the dynamic corner constraint's statistic (`SteadySettings.corner_constraint`)
-CORNER_CONSTRAINTS = ("prediction", "mean")
+CORNER_CONSTRAINTS = ("risk", "prediction", "mean")
+#: which of the statistically tied feasible designs the search returns (`SteadySettings.choose`)
+CHOICES = ("safest", "best")
 
 
 #: `clearance_step="auto"` gives the search a signal for Delta_bf where an operating point is
@@ -76,14 +78,22 @@ class SteadySettings:
     #: `CLEARANCE_MISALIGNMENT`, else off (`clearance_step_for`); the frozen-load estimator
     #: cannot see the clearance (`evaluate_starts`)
     clearance_step: float | str = "auto"
-    #: the dynamic corner constraint: "prediction" (the margin on the upper 95 % prediction bound
-    #: of one revolution's largest contact radius: it holds for a further revolution with 95 %
-    #: probability) or "mean" (on its expectation per revolution: holds on average)
-    corner_constraint: str = "prediction"
-    #: the corner-contact risk per cage revolution the verification must bound at every
-    #: operating point (its upper 95 % bound, `run.corner_risk`), else the design is reported
-    #: unverified in the tail (`tail_verification`)
+    #: the dynamic corner constraint: "risk" (the margin on the contact radius that one revolution
+    #: exceeds with probability `corner_risk_level` at most, at 95 % confidence: the normal
+    #: tolerance bound of the per-revolution largest contact radius, `run.tolerance_bound`; the
+    #: corner-contact risk's upper bound below the level), "prediction" (on the upper 95 %
+    #: prediction bound of one revolution's largest contact radius: it holds for a further
+    #: revolution with 95 % probability) or "mean" (on its expectation per revolution)
+    corner_constraint: str = "risk"
+    #: the corner-contact risk per cage revolution the search keeps below at every operating
+    #: point ("risk" constraint) and the verification must bound (its upper 95 % bound,
+    #: `run.corner_risk`), else the design is reported unverified in the tail
+    #: (`tail_verification`)
     corner_risk_level: float = 1e-3
+    #: the design returned: "safest" (of the feasible designs statistically tied with the one of
+    #: the lowest upper 95 % bound of the objective, the one of the lowest corner-risk bound) or
+    #: "best" (the lowest upper bound of the objective itself)
+    choose: str = "safest"
     #: the envelope's active set (`next_active`): an operating point whose weight in the smooth
     #: max stays below this is not simulated (0: every point, every iteration) ...
     skip_weight: float = 1e-3
@@ -98,6 +108,8 @@ class SteadySettings:
             raise UserInputError(
                 f"corner_constraint = {self.corner_constraint!r}: must be one of {', '.join(CORNER_CONSTRAINTS)}"
             )
+        if self.choose not in CHOICES:
+            raise UserInputError(f"choose = {self.choose!r}: must be one of {', '.join(CHOICES)}")
         require("skip_weight", self.skip_weight, lambda v: (v >= 0) & (v < 1), "in [0, 1)")
         require(
             "corner_risk_level",

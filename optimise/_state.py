@@ -30,13 +30,14 @@ CHECKPOINT = "checkpoint.npz"
 LEGACY_CHECKPOINT = "checkpoint.pkl"
 #: version of the measured objective, margins and state layout, part of a checkpoint's
 #: fingerprint: a checkpoint of another version is refused, not resumed
-MEASUREMENT_VERSION = 5
+MEASUREMENT_VERSION = 6
 
 
 @jax.tree_util.register_dataclass
 @dataclasses.dataclass
 class Best:
-    """The best feasible design so far (`objective` inf: none yet)."""
+    """The feasible design of the lowest upper 95 % bound of the objective so far (`objective`:
+    its value; inf: none yet)."""
 
     objective: float = float("inf")
     iteration: int = -1
@@ -59,6 +60,8 @@ class History:
     wall_s: list = dataclasses.field(default_factory=list)  # (S,)
     simulated_ms: list = dataclasses.field(default_factory=list)  # (S,)
     points_simulated: list = dataclasses.field(default_factory=list)  # (S, K) bool
+    #: (S,) the largest upper 95 % bound of the corner-contact risk per revolution over the points
+    corner_risk: list = dataclasses.field(default_factory=list)
 
     def append(self, rows: dict) -> None:
         """One iteration's rows (a list per field, one entry per start)."""

@@ -157,14 +157,17 @@ def _row(ev: Evaluation, x, margins) -> dict:
         margins=margins,
         wall_s=ev.wall_time_s,
         simulated_ms=ev.simulated_ms,
+        corner_risk=ev.corner_risk,
     )
 
 
 def _consider(state: SearchState, ev: Evaluation, margins, x, it: int, s: int) -> None:
-    """Make start `s`'s evaluation at iteration `it` the best design when it is feasible and
-    better."""
+    """Make start `s`'s evaluation at iteration `it` the best design so far when it is feasible
+    and the upper 95 % bound of its objective is lower (the progress line's; the returned design
+    is chosen from the whole history, `choose`)."""
     feasible = bool(np.all(margins > 0) and np.isfinite(ev.objective))
-    if feasible and ev.objective < state.best.objective:
+    best_high = np.inf if state.best.ci is None else float(state.best.ci[1])
+    if feasible and ev.objective_ci[1] < best_high:
         state.best = Best(ev.objective, it, s, x, ev.objective_ci)
 
 
@@ -243,16 +246,50 @@ def steady_search(
             save_checkpoint(path, key, state)
         if callback is not None:
             callback(it, _report(rows, state.best))
-    result = _result(state, x_start, num_iterations, resumed)
+    result = _result(state, x_start, num_iterations, resumed, settings.choose)
     if verify and result.feasible:
         result.verification = verification(problem, settings, result.design, x_start)
     result.wall_time_s = time.perf_counter() - t_start
     return result
 
 
-def _result(state: SearchState, x_start, num_iterations: int, resumed: int) -> SteadySearchResult:
+def _feasible(h: History) -> np.ndarray:
+    objective, margins = np.asarray(h.objective, float), np.asarray(h.margins, float)
+    return np.all(margins > 0, axis=-1) & np.isfinite(objective)
+
+
+def tied_with_best(h: History) -> tuple[np.ndarray, tuple | None]:
+    """The feasible evaluations statistically tied with the best (iteration, start mask), and
+    the best's index: the best is the feasible evaluation of the lowest upper 95 % bound of the
+    objective (not the lowest point estimate: one with a wide interval may lie anywhere in it);
+    tied are those whose lower bound lies below that upper bound (the intervals overlap)."""
+    feasible = _feasible(h) if len(h) else np.zeros((0, 0), bool)
+    if not feasible.any():
+        return feasible, None
+    ci = np.asarray(h.ci, float)
+    high = np.where(feasible, ci[..., 1], np.inf)
+    best = np.unravel_index(int(np.argmin(high)), high.shape)
+    return feasible & (ci[..., 0] <= high[best]), best
+
+
+def choose(h: History, how: str) -> tuple | None:
+    """The (iteration, start) the search returns (`SteadySettings.choose`): "best", the feasible
+    evaluation of the lowest upper bound of the objective; "safest", of those tied with it
+    (`tied_with_best`), the lowest upper bound of the corner-contact risk per revolution, then
+    the largest dynamic corner margin. None without a feasible evaluation."""
+    tied, best = tied_with_best(h)
+    if best is None or how == "best":
+        return best
+    risk = np.asarray(h.corner_risk, float)
+    risk = np.where(np.isfinite(risk), risk, 1.0)  # an unknown risk is not the safest
+    dynamic = np.asarray(h.margins, float)[..., -1]
+    candidates = np.argwhere(tied)
+    order = sorted(candidates.tolist(), key=lambda i: (risk[tuple(i)], -dynamic[tuple(i)]))
+    return tuple(order[0])
+
+
+def _result(state: SearchState, x_start, num_iterations: int, resumed: int, how: str) -> SteadySearchResult:
     history = History(**state.history.as_arrays())
-    best = state.best
     common = dict(
         start_design=x_start,
         history=history,
@@ -261,24 +298,26 @@ def _result(state: SearchState, x_start, num_iterations: int, resumed: int) -> S
         resumed_from=resumed,
         wall_time_s=0.0,
     )
-    if int(best.iteration) < 0:
+    chosen = choose(history, how)
+    if chosen is None:
         return SteadySearchResult("no_feasible_iterate", False, None, float("nan"), None, **common)
+    it, s = (int(v) for v in chosen)
     return SteadySearchResult(
         "ok",
         True,
-        np.asarray(best.x),
-        float(best.objective),
-        tuple(float(v) for v in best.ci),
-        best_start=int(best.start),
-        best_iteration=int(best.iteration),
+        np.asarray(history.x[it, s]),
+        float(history.objective[it, s]),
+        tuple(float(v) for v in history.ci[it, s]),
+        best_start=s,
+        best_iteration=it,
         **common,
     )
 
 
 @dataclasses.dataclass(frozen=True)
 class NearOptimal:
-    """A feasible design the search evaluated whose objective lies within the best design's
-    95 % interval."""
+    """A feasible design the search evaluated that is statistically tied with the best
+    (`tied_with_best`), with its corner-contact risk and margins."""
 
     design: np.ndarray  # (R_end, theta_f, Delta_bf) [SI]
     objective: float  # [GPa m/s]
@@ -287,21 +326,25 @@ class NearOptimal:
     start: int
     binding_margin: str  # the smallest of its margins (`CONSTRAINT_NAMES`)
     binding_margin_m: float
+    corner_risk: float  # the upper 95 % bound of the corner-contact risk per revolution (worst point)
+    corner_margin_m: float  # the dynamic corner margin (`SteadySettings.corner_constraint`)
 
 
 def near_optimal_set(result: SteadySearchResult) -> list[NearOptimal]:
-    """The feasible designs the search evaluated whose objective lies within the best design's
-    95 % interval (the optimum is a ridge along a binding margin, not a point; a designer
-    chooses among these by other criteria), best first. Empty without a feasible design."""
+    """The feasible designs the search evaluated that are statistically tied with the best
+    (their objective's interval reaches below the best's upper 95 % bound, `tied_with_best`):
+    the optimum is a ridge along a binding margin, not a point, and a designer chooses among
+    these by other criteria; each with its corner-contact risk and margins. Best objective
+    first; empty without a feasible design."""
     h = result.history
-    if result.design is None or result.objective_ci is None or not len(h):
+    if result.design is None or not len(h):
         return []
+    tied, _ = tied_with_best(h)
     x, objective = np.asarray(h.x), np.asarray(h.objective, float)  # (I, S, 3), (I, S)
     ci, margins = np.asarray(h.ci, float), np.asarray(h.margins, float)  # (I, S, 2), (I, S, 5)
-    feasible = np.all(margins > 0, axis=-1) & np.isfinite(objective)
-    near = feasible & (objective <= float(result.objective_ci[1]))
+    risk = np.asarray(h.corner_risk, float)
     out = []
-    for it, s in zip(*np.nonzero(near)):
+    for it, s in zip(*np.nonzero(tied)):
         k = int(np.argmin(margins[it, s]))
         out.append(
             NearOptimal(
@@ -312,6 +355,8 @@ def near_optimal_set(result: SteadySearchResult) -> list[NearOptimal]:
                 start=int(s),
                 binding_margin=CONSTRAINT_NAMES[k],
                 binding_margin_m=float(margins[it, s, k]),
+                corner_risk=float(risk[it, s]),
+                corner_margin_m=float(margins[it, s, -1]),
             )
         )
     return sorted(out, key=lambda d: d.objective)

@@ -94,7 +94,10 @@ def compute() -> dict:
     out["frozen_load_gradient"] = {"value": float(g.value), "gradient": np.asarray(g.gradient).tolist()}
 
     problem = make_problem(b, op)
-    settings = optimise.SteadySettings(seeds=2, window_revs=2, settle=0.005, workers=1)
+    # the corner constraint of the recording (the default then)
+    settings = optimise.SteadySettings(
+        seeds=2, window_revs=2, settle=0.005, workers=1, corner_constraint="prediction"
+    )
     with tempfile.TemporaryDirectory() as tmp:
         res = optimise.steady_search(
             problem, settings, directory=tmp, num_starts=1, num_iterations=1, verify=False

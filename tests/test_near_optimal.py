@@ -2,11 +2,13 @@
 objective lies within the best design's 95 % interval, each with its binding margin, in
 result.json's terms and on the search-path figure. Fabricated histories: no solve."""
 
+import dataclasses
+
 import numpy as np
 
 from optimise import near_optimal_set
 from optimise._state import History
-from optimise._steady import CONSTRAINT_NAMES, SteadySearchResult
+from optimise._steady import CONSTRAINT_NAMES, SteadySearchResult, choose, tied_with_best
 
 
 def _result():
@@ -42,6 +44,7 @@ def _result():
             wall_s=np.zeros((3, 2)),
             simulated_ms=np.zeros((3, 2)),
             points_simulated=np.ones((3, 2, 1), bool),
+            corner_risk=np.array([[0.5, 0.2], [0.4, 3e-4], [1e-4, 2e-3]]),
         ),
         num_iterations=2,
         num_evaluations=6,
@@ -61,6 +64,24 @@ def test_near_optimal_set_is_the_feasible_designs_within_the_best_interval():
     assert near[0].binding_margin == "dynamic_corner" and near[0].binding_margin_m == 3e-6
     assert near[1].binding_margin == CONSTRAINT_NAMES[0] and near[1].binding_margin_m == 2e-6
     assert near[0].design.tolist() == [0.106, 0.0278, 1.5e-4] and np.allclose(near[0].ci95, [1.06, 1.16])
+
+
+def test_the_safest_of_the_tied_designs_is_returned_unless_asked_otherwise():
+    """The best is the feasible evaluation of the lowest upper bound (1.11 + 0.05 = 1.16 at
+    iteration 2, start 1); tied with it are the feasible ones whose lower bound reaches below
+    1.16 (1.11, 1.12 and 1.16: 1.16 - 0.05 <= 1.16); "safest" returns the tied one of the lowest
+    corner-risk bound (1e-4 at iteration 2, start 0), "best" the best itself; a wide interval
+    with a low point estimate does not win on its point estimate."""
+    h = _result().history
+    tied, best = tied_with_best(h)
+    assert best == (2, 1) and sorted(map(tuple, np.argwhere(tied))) == [(1, 1), (2, 0), (2, 1)]
+    assert choose(h, "best") == (2, 1) and choose(h, "safest") == (2, 0)
+    wide = dataclasses.replace(h, ci=np.array(h.ci, float))
+    wide.objective[2, 0], wide.ci[2, 0] = 1.0, (0.2, 1.8)  # lowest point, widest interval
+    assert choose(wide, "best") == (2, 1)
+    near = near_optimal_set(_result())
+    assert [d.corner_risk for d in near] == [2e-3, 1e-4, 3e-4]
+    assert near[0].corner_margin_m == 3e-6
 
 
 def test_no_near_optimal_set_without_a_feasible_design():

@@ -9,6 +9,7 @@ iteration's evaluation of two starts runs on real settled running (one engine ca
 gradient call), and the real ensemble is measured in tests/test_steady_design.py and by the
 search in notebook 05."""
 
+import dataclasses
 import json
 import math
 
@@ -76,7 +77,8 @@ def test_bad_steady_settings_are_one_line(kw, text):
         (["--clearance-step-mm", "-0.01"], "clearance_step_mm = -0.01: must be >= 0"),
         (["--clearance-step-mm", "soon"], "clearance_step_mm = 'soon': expected a float"),
         (["--skip-weight", "1.5"], "skip_weight = 1.5: must be in [0, 1)"),
-        (["--corner-constraint", "p99"], "corner_constraint = 'p99': must be one of prediction, mean"),
+        (["--corner-constraint", "p99"], "corner_constraint = 'p99': must be one of risk, prediction, mean"),
+        (["--choose", "cheapest"], "choose = 'cheapest': must be one of safest, best"),
         (["--recheck-every", "0"], "recheck_every = 0: must be > 0"),
         (["--corner-risk-level", "2"], "corner_risk_level = 2.0: must be in (0, 1) per revolution"),
     ],
@@ -160,6 +162,8 @@ def test_killed_run_resumes_with_the_same_result(tmp_path, config, monkeypatch, 
         "2",
         "--corner-constraint",
         "mean",
+        "--choose",
+        "best",
         *ARGS,
     ]
     args[args.index("--iterations") + 1] = "2"
@@ -175,7 +179,7 @@ def test_killed_run_resumes_with_the_same_result(tmp_path, config, monkeypatch, 
     assert r1["optimiser_settings"]["seeds"] == 2 and "units" in r1
     assert r1["settings"]["statistic"] == "peak"
     assert (r1["settings"]["skip_weight"], r1["settings"]["recheck_every"]) == (0.0, 2)
-    assert r1["settings"]["corner_constraint"] == "mean"
+    assert r1["settings"]["corner_constraint"] == "mean" and r1["settings"]["choose"] == "best"
     assert r1["settings"]["estimator"] == "frozen" and r1["settings"]["corner_margin"] == pytest.approx(
         0.04e-3
     )
@@ -382,6 +386,8 @@ def _engine_stand_in(seen, samples=False):
                     summary={"per_seed": [{"settle_time_ms": 1.0}] * seeds, "window_ms": 2.0},
                     final_states=[("state", float(d.axial_clearance))] * seeds,
                     sample_states=[("sample", float(d.end_radius))] if samples else [],
+                    contact_radius_maxima=[],  # no revolutions: the risk margin falls back
+                    limited_circle_radius_m=3.36e-3,
                 )
             )
         return out
@@ -550,6 +556,8 @@ def _envelope_engine(seen):
                     summary={"per_seed": [{"settle_time_ms": 1.0}] * seeds, "window_ms": 2.0},
                     final_states=[(w, steps + 1)] * seeds,
                     sample_states=[],
+                    contact_radius_maxima=[],  # no revolutions: the risk margin falls back
+                    limited_circle_radius_m=3.36e-3,
                 )
             )
         return out
@@ -816,3 +824,35 @@ def test_tail_verification_needs_the_risk_bounded_at_every_operating_point(tmp_p
     # the level is a setting of the search: out of (0, 1) it is one line before anything runs
     assert main(["run", "--out", str(tmp_path), "--corner-risk-level", "0"]) == 2
     assert capsys.readouterr().err.count("corner_risk_level = 0.0: must be in (0, 1) per revolution") == 1
+
+
+def test_risk_corner_margin_is_the_tolerance_bound_inside_the_limited_circle():
+    """`corner_constraint = "risk"` (the default): the margin is rho_lim - corner_margin - (m +
+    k_tol s) of the per-revolution maxima, k_tol the one-sided normal tolerance factor at the
+    risk level and 95 % (`run.tolerance_factor`, checked against Natrella's table in
+    tests/test_corner_risk.py); it shrinks as the level falls; "prediction" keeps the prediction
+    bound, and so does "risk" where fewer than three revolutions touched a flange."""
+    import types
+
+    from jaxbearing.run import tolerance_factor
+
+    rows = [np.array([2.9e-3, 3.0e-3, 2.95e-3, 3.05e-3]), np.array([2.92e-3, 3.02e-3, 2.97e-3, 2.99e-3])]
+    m = types.SimpleNamespace(
+        contact_radius_maxima=rows,
+        limited_circle_radius_m=3.36e-3,
+        corner_margin_bound=1e-4,
+        corner_margin={},
+    )
+    values = np.concatenate(rows)
+    settings = search_settings.SteadySettings(corner_margin=0.05e-3, corner_risk_level=1e-3)
+    margin = evaluation.corner_margin_of(settings, m)
+    # the two members' means differ little against their spread: no design effect (deff = 1)
+    k = tolerance_factor(values.size, 1e-3, 0.95)
+    assert margin == pytest.approx(3.36e-3 - 0.05e-3 - (values.mean() + k * values.std(ddof=1)), rel=1e-9)
+    stricter = dataclasses.replace(settings, corner_risk_level=1e-5)
+    assert evaluation.corner_margin_of(stricter, m) < margin
+    assert (
+        evaluation.corner_margin_of(dataclasses.replace(settings, corner_constraint="prediction"), m) == 1e-4
+    )
+    m.contact_radius_maxima = [np.array([3.0e-3, 0.0]), np.array([3.1e-3])]  # two in contact
+    assert evaluation.corner_margin_of(settings, m) == 1e-4

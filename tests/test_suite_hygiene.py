@@ -363,6 +363,7 @@ CLI_CHECKS = {
     ("optimise", "run", "--corner-margin-mm"): [_STEADY_CLI],
     ("optimise", "run", "--clearance-step-mm"): [_STEADY_CLI],
     ("optimise", "run", "--corner-constraint"): [_STEADY_CLI],
+    ("optimise", "run", "--choose"): [_STEADY_CLI],
     ("optimise", "run", "--skip-weight"): [_STEADY_CLI],
     ("optimise", "run", "--recheck-every"): [_STEADY_CLI],
     ("optimise", "run", "--statistic"): [_STEADY_CLI],

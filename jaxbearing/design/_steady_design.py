@@ -67,6 +67,7 @@ from ..run import (
     Perturbation,
     SteadySettings,
     simulate_steady_points,
+    steady_revolution_maxima,
     student_t_interval,
     summarise_steady,
     window_statistics,
@@ -105,13 +106,18 @@ class SteadyDesignMetrics:
     #: give (those with the run's functionals: the mean and the tail come from one ensemble,
     #: the peak from its own); `objective_per_seed` is the chosen statistic's
     objectives_per_seed: dict = dataclasses.field(default_factory=dict)
+    #: per seed, the largest contact radius in contact of every measured cage revolution [m]
+    #: (0: no flange contact; `run.revolution_maxima`): the data of the corner-contact risk
+    contact_radius_maxima: list = dataclasses.field(default_factory=list, repr=False)
+    #: rho_lim [m] (`geometry.limited_circle_radius`)
+    limited_circle_radius_m: float = float("nan")
 
     def as_dict(self) -> dict:
-        """Everything but the final states, as plain (JSON-able) values."""
+        """Everything but the states and the per-revolution maxima, as plain (JSON-able) values."""
         return {
             f.name: getattr(self, f.name)
             for f in dataclasses.fields(self)
-            if f.name not in ("final_states", "sample_states")
+            if f.name not in ("final_states", "sample_states", "contact_radius_maxima")
         }
 
 
@@ -248,6 +254,8 @@ def _metrics(
         ],
         corner_margin_bound=float("nan") if rho_lim is None else rho_lim - corner_margin - bound,
         objectives_per_seed=objectives,
+        contact_radius_maxima=steady_revolution_maxima(result).contact_radius_m,
+        limited_circle_radius_m=float("nan") if rho_lim is None else float(rho_lim),
     )
 
 

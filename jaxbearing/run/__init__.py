@@ -14,10 +14,13 @@
   `TAIL_LEVEL` quantile); how often the contact reached the corner,
   with upper bounds: `corner_contact_bound`, `upper_probability_bound`; the prediction bound
   of one revolution's largest contact radius: `max_contact_radius_bound`; the corner-contact
-  risk per revolution with its confidence bounds (counting, or a generalised Pareto tail with a
-  profile-likelihood interval): `corner_risk` (`CornerRisk`, `TailFit`, `ConditionalPeak`),
-  from a settled run `steady_corner_risk` (or its members' statistics,
-  `corner_risk_of_revolutions`; in the summary as `corner_risk`), its data `revolution_maxima` (`RevolutionMaxima`),
+  risk per revolution with its confidence bounds (counting, a generalised Pareto tail with a
+  profile-likelihood interval, or a normal model from few revolutions): `corner_risk`
+  (`CornerRisk`, `TailFit`, `NormalTail`, `ConditionalPeak`), from a settled run
+  `steady_corner_risk` (or its members' statistics, `corner_risk_of_revolutions`; in the summary
+  as `corner_risk`), its data `revolution_maxima` / `steady_revolution_maxima`
+  (`RevolutionMaxima`); the contact radius kept below at a risk level with a confidence,
+  `tolerance_bound` (`tolerance_factor`);
   `revolutions_needed`, `clopper_pearson`, `cluster_design_effect`;
 - settled running: `simulate_steady` (settling detection over cage revolutions, a window,
   seeds), `simulate_steady_points` (the same at several operating points, one engine call),
@@ -74,6 +77,7 @@ from ._initial import STARTS, Perturbation, SkidStart, initial_state, skid_start
 from ._measured import model_cage_speeds
 from ._member import Answer, Member, Phase, Request, SeedRun
 from ._member_progress import MemberProgress
+from ._normal_tail import NormalTail, tolerance_bound, tolerance_factor
 from ._plots import plot_measured, plot_run
 from ._progress import HostProgress, SolveProgress
 from ._proportions import CORNER_RISK_CONFIDENCE, clopper_pearson, cluster_design_effect, revolutions_needed
@@ -118,6 +122,7 @@ from ._statistics import (
     revolution_statistic_keys,
     revolution_statistics,
     steady_corner_risk,
+    steady_revolution_maxima,
     steady_statistics,
     student_t_interval,
     tail_mean,
@@ -216,6 +221,10 @@ __all__ = [
     "revolution_maxima",
     "revolutions_needed",
     "steady_corner_risk",
+    "steady_revolution_maxima",
+    "tolerance_bound",
+    "tolerance_factor",
+    "NormalTail",
     "summarise",
     "summarise_steady",
     "EngineRun",

@@ -52,7 +52,14 @@ two-sided interval at 2 confidence - 1). Three methods, chosen by the data (`cor
   Chandler & Bate 2007, Biometrika 94:167), deff the larger of the threshold-exceedance
   indicator's design effect over members (as above) and (1 + r1)/(1 - r1), r1 its lag-1
   autocorrelation within members.
-* **not enough data** (none reached it, too few revolutions for a tail fit): p^ = 0 and the
+* **normal** (none reached it, too few revolutions for a tail fit, at least
+  `MIN_NORMAL_REVOLUTIONS` with contact): the maxima of the revolutions in contact taken as
+  normal, p = Phi(-(rho_lim - mu)/sigma), bounds from the approximate noncentral t of the
+  standardised distance on the effective sample (`_normal_tail`). A model of the tail, like the
+  GPD: it covers the counted rate where the maxima spread below the corner (docs/model.md 16)
+  and underestimates it where they pile up at rho_lim, which only designs that already reach
+  the corner in a few revolutions show (those are counted).
+* **not enough data** (none reached it, fewer revolutions in contact or no spread): p^ = 0 and the
   Clopper-Pearson upper bound with no event, 1 - (1 - c)^(1/n) (about 3/n at 95 %: the "rule of
   three"), revolutions taken as independent.
 
@@ -71,10 +78,11 @@ from scipy import stats as _sp_stats
 
 from .._errors import UserInputError
 from ..io import require
+from ._normal_tail import NormalTail, normal_tail, normal_tail_bounds
 from ._proportions import CORNER_RISK_CONFIDENCE, clopper_pearson, cluster_design_effect
 from ._tail_fit import MIN_TAIL_EXCEEDANCES, MIN_TAIL_REVOLUTIONS, TailFit, tail_fit_bounds
 
-METHODS = ("count", "tail", "not enough data")
+METHODS = ("count", "tail", "normal", "not enough data")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -97,7 +105,7 @@ class CornerRisk:
     `METHODS`; `revolutions` n, `members` N, `exceedances` x (revolutions beyond `rho_lim_m`);
     `counting_upper`: the Clopper-Pearson upper bound of the counts alone; `design_effect`: the
     between-revolution dependence factor applied (1: none); `tail`: the `TailFit` (method
-    "tail"); `peak_pv_given_contact`: a `ConditionalPeak` when a revolution reached the corner
+    "tail"); `normal`: the `NormalTail` (method "normal"); `peak_pv_given_contact`: a `ConditionalPeak` when a revolution reached the corner
     and peak PVs were given; `largest_m`: the largest maximum seen."""
 
     probability: float
@@ -114,6 +122,7 @@ class CornerRisk:
     design_effect: float = 1.0
     tail: TailFit | None = None
     peak_pv_given_contact: ConditionalPeak | None = None
+    normal: NormalTail | None = None
 
     def bounded_below(self, level: float) -> bool:
         """Whether the upper bound shows p <= `level` (per revolution) at `confidence`."""
@@ -128,10 +137,11 @@ class CornerRisk:
         out = {
             f.name: getattr(self, f.name)
             for f in dataclasses.fields(self)
-            if f.name not in ("tail", "peak_pv_given_contact")
+            if f.name not in ("tail", "peak_pv_given_contact", "normal")
         }
         out = {k: (num(v) if isinstance(v, float) else v) for k, v in out.items()}
         out["tail"] = self.tail.as_dict() if self.tail is not None else None
+        out["normal"] = self.normal.as_dict() if self.normal is not None else None
         peak = self.peak_pv_given_contact
         out["peak_pv_given_contact"] = (
             {k: (num(v) if isinstance(v, float) else v) for k, v in dataclasses.asdict(peak).items()}
@@ -266,7 +276,7 @@ def corner_risk(
             f"{MIN_TAIL_EXCEEDANCES} distinct values above a threshold below rho_lim"
         )
     if tail is None:
-        return CornerRisk(0.0, 0.0, counting_upper, method="not enough data", **common)
+        return _normal_or_nothing(rows, rho_lim, confidence, common)
     p, lower, upper, fit = tail
     if fit.at_shape_bound:  # a tail the GPD family does not fit: the counting bound, model-free
         upper = max(upper, counting_upper)
@@ -280,6 +290,15 @@ def corner_risk(
         peak_pv_given_contact=peak,
         **common,
     )
+
+
+def _normal_or_nothing(rows, rho_lim: float, confidence: float, common: dict) -> CornerRisk:
+    """Method "normal" where the model can be fitted, else "not enough data" (module docstring)."""
+    fit = normal_tail(rows, rho_lim)
+    if fit is None:
+        return CornerRisk(0.0, 0.0, common["counting_upper"], method="not enough data", **common)
+    p, lower, upper = normal_tail_bounds(fit, confidence)
+    return CornerRisk(p, lower, upper, method="normal", design_effect=fit.design_effect, normal=fit, **common)
 
 
 # -- the data of a settled run -----------------------------------------------------------------

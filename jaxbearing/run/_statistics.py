@@ -39,7 +39,13 @@ from scipy import stats as _sp_stats
 
 from .._errors import UserInputError
 from ..geometry import kinematic_cage_speed, limited_circle_radius, rad_s_to_rpm
-from ._corner_risk import CORNER_RISK_CONFIDENCE, CornerRisk, corner_risk_of_revolutions
+from ._corner_risk import (
+    CORNER_RISK_CONFIDENCE,
+    CornerRisk,
+    RevolutionMaxima,
+    corner_risk_of_revolutions,
+    revolution_maxima,
+)
 from ._summary import _EVENT_QUANTITIES, CONTACT_THRESHOLD, FILM_KEYS, contact_events, film_statistics
 
 CONFIDENCE = 0.95
@@ -322,18 +328,28 @@ def steady_statistics(
     return block
 
 
-def steady_corner_risk(result, confidence: float = CORNER_RISK_CONFIDENCE) -> CornerRisk:
-    """`corner_risk` of a settled run (`SteadyResult`): every measured member's revolutions, the
-    bearing's limited circle, the peak PV given corner contact."""
-    per_rev = [
+def _measured_revolutions(result) -> list:
+    """Every measured member's `window_statistics` of a settled run (`SteadyResult`)."""
+    return [
         r.per_revolution
         if r.per_revolution is not None
         else window_statistics(r.window, r.edges, result.bearing, result.operating)
         for r in result.runs
         if r.measured
     ]
+
+
+def steady_revolution_maxima(result) -> RevolutionMaxima:
+    """The per-revolution largest contact radius and peak flange PV of every measured member of
+    a settled run (`revolution_maxima`; no member: empty lists)."""
+    return revolution_maxima(_measured_revolutions(result))
+
+
+def steady_corner_risk(result, confidence: float = CORNER_RISK_CONFIDENCE) -> CornerRisk:
+    """`corner_risk` of a settled run (`SteadyResult`): every measured member's revolutions, the
+    bearing's limited circle, the peak PV given corner contact."""
     risk = corner_risk_of_revolutions(
-        per_rev, float(limited_circle_radius(result.bearing.roller)), confidence
+        _measured_revolutions(result), float(limited_circle_radius(result.bearing.roller)), confidence
     )
     if risk is None:
         raise UserInputError(
