@@ -109,18 +109,20 @@ def operating_points(problem: DesignProblem) -> list:
     ]
 
 
-def settled_metrics(problem: DesignProblem, settings: SteadySettings, ops, designs, **kwargs):
+def settled_metrics(
+    problem: DesignProblem, settings: SteadySettings, ops, designs, *, verification: bool = False, **kwargs
+):
     """`steady_design_metrics_points` of (design, operating point) pairs, one engine call, with
-    the problem's and the settings' measurement options (`kwargs`: seeds, window, ...)."""
+    the problem's constraints and the search's (or, with `verification`, the verification's)
+    settled-run settings (`SteadySettings.measurement`); `kwargs`: `first_seed`,
+    `initial_states`."""
     return steady_design_metrics_points(
         problem.bearing,
         ops,
         designs,
-        settle=settings.settle,
+        settings.measurement(verification=verification),
         corner_margin=settings.corner_margin,
         flange_load=problem.flange_load,
-        workers=settings.num_workers,
-        rtol=settings.rtol,
         statistic=settings.statistic,
         **kwargs,
     )
@@ -210,8 +212,6 @@ def evaluate_starts(
         settings,
         [ops[k] for _, _, k in jobs],
         [_shift_clearance(designs[s], shifts[j]) for s, j, _ in jobs],
-        seeds=settings.seeds,
-        window_revs=settings.window_revs,
         initial_states=None
         if all(c is None for c in chains)
         else [None if chains[s] is None else chains[s][k] for s, _, k in jobs],

@@ -1,9 +1,12 @@
 """How the design search on steady running measures its objective and constraints: one
 settings object, `SteadySettings`, checked once when built (one line naming the setting).
 
-Times in seconds, lengths in metres. The measurement of one evaluation (seeds, window, settling,
-tolerance, workers) is a `jaxbearing.run.SteadySettings` built from these fields
-(`SteadySettings.measurement`); the verification's another (`SteadySettings.verification`).
+Lengths in metres, the gradient window in seconds, the settling time in ms. The search measures
+each evaluation with fewer seeds and revolutions than a settled run of `jaxbearing simulate`
+(4 seeds x 2 revolutions: an evaluation per start, operating point and iteration) and verifies
+with more on seeds it never used; `SteadySettings.measurement()` turns these fields into the one
+settings object of settled running (`jaxbearing.run.SteadySettings`), which the design metrics
+take.
 """
 
 from __future__ import annotations
@@ -13,7 +16,7 @@ import dataclasses
 import jax
 import numpy as np
 
-from jaxbearing import UserInputError
+from jaxbearing import UserInputError, run
 from jaxbearing.design import CORNER_MARGIN, STATISTICS
 from jaxbearing.io import require
 from jaxbearing.run import available_cpus
@@ -158,6 +161,19 @@ class SteadySettings:
                 lambda v: np.isfinite(v) & (v >= 0) & (v < 1e-3),
                 "'auto' or in [0, 1e-3) m",
             )
+
+    def measurement(self, *, verification: bool = False) -> run.SteadySettings:
+        """The settled-run settings of one evaluation (or, with `verification`, of the
+        verification): this object's seeds, window, settling, tolerance and workers as the one
+        settings object of settled running (`jaxbearing.run.SteadySettings`), every other setting
+        at its default there."""
+        return run.SteadySettings(
+            seeds=self.verify_seeds if verification else self.seeds,
+            window_revs=self.verify_window_revs if verification else self.window_revs,
+            settle=run.settling(self.settle),
+            rtol=self.rtol,
+            workers=self.num_workers,
+        )
 
     @property
     def num_workers(self) -> int:

@@ -70,8 +70,7 @@ def verification(problem: DesignProblem, settings: SteadySettings, design, refer
         settings,
         ops * 2,
         [d for d in designs for _ in ops],
-        seeds=settings.verify_seeds,
-        window_revs=settings.verify_window_revs,
+        verification=True,
         first_seed=settings.verify_first_seed,
     )
     for i, name in enumerate(("reference", "optimum")):

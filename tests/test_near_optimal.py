@@ -95,7 +95,7 @@ def test_result_json_and_figure_carry_the_near_optimal_set(tmp_path, monkeypatch
 
     import jaxbearing as jb
     from optimise import make_problem, plot_search
-    from optimise._cli import _steady_result_json
+    from optimise._cli_steady import _steady_result_json
     from optimise._settings import SteadySettings
 
     res = _result()

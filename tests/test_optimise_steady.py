@@ -247,8 +247,8 @@ def _metrics_stand_in(calls):
             seeds=list(range(first_seed, first_seed + seeds)),
         )
 
-    def points(bearing, ops, designs, *, seeds, first_seed, window_revs, **kw):
-        out = [one(d, seeds, first_seed, window_revs) for d in designs]
+    def points(bearing, ops, designs, settings, *, first_seed=0, **kw):
+        out = [one(d, settings.seeds, first_seed, settings.window_revs) for d in designs]
         calls.append("call")
         return out
 
@@ -366,7 +366,8 @@ def _engine_stand_in(seen, samples=False):
     `samples`, each design has one stand-in sample state for the gradient estimator."""
     import types
 
-    def engine(bearing, ops, designs, *, seeds, initial_states, **kw):
+    def engine(bearing, ops, designs, settings, *, initial_states, **kw):
+        seeds = settings.seeds
         seen.append(([float(d.axial_clearance) for d in designs], initial_states))
         out = []
         for d in designs:
@@ -534,7 +535,8 @@ def _envelope_engine(seen):
     counts the evaluations along its chain."""
     import types
 
-    def engine(bearing, ops, designs, *, seeds, initial_states, **kw):
+    def engine(bearing, ops, designs, settings, *, initial_states, **kw):
+        seeds = settings.seeds
         seen.append([float(op.inner_speed) for op in ops])
         out = []
         for k, op in enumerate(ops):
@@ -702,8 +704,8 @@ def test_verification_reports_every_operating_point(monkeypatch, capsys):
 
     inner = _metrics_stand_in([])
 
-    def engine(bearing, ops, designs, **kw):
-        out = inner(bearing, ops, designs, **kw)
+    def engine(bearing, ops, designs, *args, **kw):
+        out = inner(bearing, ops, designs, *args, **kw)
         for m, op in zip(out, ops):
             fast = float(op.inner_speed) > 3000.0
             for est in (m.mean_pv, m.objective):
@@ -788,8 +790,8 @@ def test_clearance_signal_at_2_mrad_is_the_paired_difference_and_positive(monkey
     seen = []
     engine = evaluation.steady_design_metrics_points
 
-    def spied(bearing_, ops, designs, **kw):
-        out = engine(bearing_, ops, designs, **kw)
+    def spied(bearing_, ops, designs, *args, **kw):
+        out = engine(bearing_, ops, designs, *args, **kw)
         seen.append(([float(d.axial_clearance) for d in designs], out))
         return out
 
@@ -811,7 +813,7 @@ def test_tail_verification_needs_the_risk_bounded_at_every_operating_point(tmp_p
     """The verification's tail statement: verified only when the corner-contact risk's upper bound
     is at most the level at every operating point; a point without a risk estimate counts as
     unbounded; the revolutions needed are those of counting alone (2995 for 1e-3 at 95 %)."""
-    from optimise._cli import tail_text
+    from optimise._cli_steady import tail_text
 
     risk = lambda upper, n: {"corner_risk": {"upper": upper, "method": "count", "revolutions": n}}  # noqa: E731
     ok = verify.tail_verification([risk(4e-4, 4000), risk(9e-4, 3200)], 1e-3)

@@ -137,7 +137,7 @@ def test_zone_maps_kept_in_the_fallback_directory(tmp_path, monkeypatch, capsys)
 
 
 def test_optimise_results_kept_in_the_fallback_directory(tmp_path, monkeypatch, capsys):
-    from optimise._cli import _write_results
+    from optimise._cli_output import _write_results
 
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
     f = tmp_path / "f"
