@@ -6,8 +6,7 @@ import math
 import pathlib
 import sys
 
-#: the exit code of a search that found no feasible design (`jaxbearing.cli.EXIT_CODES`)
-EXIT_INFEASIBLE = 3
+from jaxbearing.cli import EXIT_INFEASIBLE  # noqa: F401  (3: no feasible design; `jaxbearing.cli.EXIT_CODES`)
 
 
 def _design_text(x) -> str:

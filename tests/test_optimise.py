@@ -17,7 +17,8 @@ from _figures import assert_png_drawn
 
 import jaxbearing as jb
 import optimise as opt
-from optimise._cli import EXIT_INFEASIBLE, main
+from optimise._cli import main
+from optimise._cli_output import EXIT_INFEASIBLE
 
 #: the reference bearing at 11 raceway slices (the reduced size of every dynamic test; the command
 #: line reads it from SMALL_CONFIG, so that its search is the same compiled program)
