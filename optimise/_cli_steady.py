@@ -126,17 +126,25 @@ def _print_verification(problem, v: dict) -> None:
 
 def tail_text(tail: dict) -> str:
     """The verification's statement on the found design's corner-contact risk, in one line."""
+    methods = sorted({m for m in tail["methods"] if m})
+    model = {
+        "normal": "a normal model of the per-revolution largest contact radius",
+        "tail": "a generalised Pareto tail",
+        "count": "counted corner contacts",
+        "not enough data": "the counts alone",
+    }
+    how = " and ".join(model.get(m, m) for m in methods) or "no measured revolution"
     bound = (
         f"corner-contact risk of the found design at most {tail['upper_per_revolution']:.2g} per cage "
-        f"revolution at every operating point (upper 95 % bound, {min(tail['revolutions_per_point'])} or more "
-        "revolutions per point)"
+        f"revolution at every operating point (upper 95 % bound from {how}, "
+        f"{min(tail['revolutions_per_point'])} or more revolutions per point)"
     )
     if tail["verified"]:
         return f"{bound}: verified in the tail at {tail['level_per_revolution']:.2g} per revolution"
     return (
         f"{bound}: NOT verified in the tail at {tail['level_per_revolution']:.2g} per revolution "
-        f"(that takes {tail['revolutions_needed']} revolutions per point without corner contact: "
-        "more --verify-seeds, or an accelerator)"
+        "(more revolutions per point narrow the bound: more --verify-seeds, or an accelerator; by counting "
+        f"alone it takes {tail['revolutions_needed']} revolutions per point without corner contact)"
     )
 
 

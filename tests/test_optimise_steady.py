@@ -822,6 +822,13 @@ def test_tail_verification_needs_the_risk_bounded_at_every_operating_point(tmp_p
     short = verify.tail_verification([risk(4e-4, 4000), risk(0.17, 16)], 1e-3)
     assert not short["verified"] and short["upper_per_revolution"] == 0.17
     assert "NOT verified in the tail" in tail_text(short) and "2995 revolutions per point" in tail_text(short)
+    assert "from counted corner contacts" in tail_text(short)
+    modelled = verify.tail_verification(
+        [{"corner_risk": {"upper": 2e-4, "method": "normal", "revolutions": 16}}], 1e-3
+    )
+    assert modelled[
+        "verified"
+    ] and "a normal model of the per-revolution largest contact radius" in tail_text(modelled)
     assert not verify.tail_verification([{"corner_risk": None}], 1e-3)["verified"]
     # the level is a setting of the search: out of (0, 1) it is one line before anything runs
     assert main(["run", "--out", str(tmp_path), "--corner-risk-level", "0"]) == 2
