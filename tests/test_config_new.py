@@ -252,23 +252,23 @@ def test_catalogue_nu_bearing_checks_and_is_in_the_design_zone(series, bore, tmp
 
 #: the settled runs' bearings: (series, bore) -> the roller diameter given [mm] (None: estimated),
 #: each with 26 rollers given
-SETTLED_BEARINGS = {("10", 100): None, ("02", 70): 11.0, ("03", 40): 7.0}
+SETTLED_BEARINGS = {("10", 100): None, ("02", 100): 16.0, ("03", 100): 18.0}
 
 
 @pytest.mark.parametrize("series, bore", list(SETTLED_BEARINGS))
 def test_catalogue_nu_bearing_settled_simulate(series, bore, tmp_path, capsys):
-    """An NU 1020 (10 series, 100 x 150 x 24 mm), an NU 214 (02 series, 70 x 125 x 24 mm) and an
-    NU 308 (03 series, 40 x 90 x 23 mm), each with 26 rollers given, go through `config new`,
+    """An NU 1020 (10 series, 100 x 150 x 24 mm), an NU 220 (02 series, 100 x 180 x 34 mm) and an
+    NU 320 (03 series, 100 x 215 x 47 mm), each with 26 rollers given, go through `config new`,
     `config check`, `zone` and a settled `simulate` at reduced size: 11 slices, 8000 rpm, the skid
     start, 0.5 ms of settling (the skid start lands on the plateau, tests/test_skid.py), a
     2-revolution window, one seed. Settled, every statistic with its interval, the cage slower
     than pure rolling. 26 rollers and 11 slices are the shapes of tests/test_settle.py, whose
     compiled programs these runs load (another roller count compiles its own, 20-45 s each): the
-    NU 1020's roller count is given and its diameter estimated; the NU 214 and NU 308 fit 26
-    rollers only with a roller diameter given smaller than the estimate (11 and 7 mm against
-    13.75 and 12.5 mm), so their roller sets are not the catalogue's (the estimated sets, 16 and
-    11 rollers, go through `config check` and `zone` above). About 10 s of the 2-core machine
-    each, most of it the skid start."""
+    NU 1020's roller count is given and its diameter estimated; the NU 220 and NU 320 fit 26
+    rollers only with a roller diameter given smaller than the estimate (16 and 18 mm against
+    0.25 (D - d) = 20 and 28.75 mm), so their roller sets are not the catalogue's. About 10-14 s
+    of CPU each, most of it the skid start (smaller rollers take smaller steps: 7 mm ones in an
+    NU 308 took 40 % longer)."""
     out = tmp_path / "b.toml"
     new = [
         "config",
