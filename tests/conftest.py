@@ -65,7 +65,7 @@ FILE_SECONDS = {
 #: 11-slice skid start and settled members, which notebook 05 (checked: after test_settle it
 #: stores no skid start or settled-member program of its own), test_steady_design and
 #: test_steady_gradient load (test_engine's settled sweep too, later, from the other process;
-#: test_config_new's settled run of a catalogue bearing with 26 rollers and 11 slices, last).
+#: test_config_new's settled runs of three catalogue bearings with 26 rollers and 11 slices, last).
 #: test_steady_gradient before the notebooks: notebook 05 then reads the skid starts of seeds
 #: 0-2 of the 11-slice reference that its settled ensemble stored (the start cache,
 #: `jaxbearing.run._start_cache`) and loads its frozen-load programs.

@@ -41,7 +41,7 @@ def _ids(path: pathlib.Path) -> str:
 
 def test_notebooks_exist():
     names = {p.stem for p in NOTEBOOKS}
-    assert {"01_quickstart", "02_arc_vs_corner", "04_design_zone"} <= names, names
+    assert {"01_quickstart", "02_arc_vs_corner", "04_design_zone", "06_your_own_bearing"} <= names, names
 
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=_ids)

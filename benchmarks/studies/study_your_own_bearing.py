@@ -1,6 +1,7 @@
-"""The tutorial "Your own bearing" (docs/tutorials/your_own_bearing.md), timed: a catalogue NU 214
-(ISO 15 dimension series 02, bore 70 mm: 70 x 125 x 24 mm) from its boundary dimensions to a
-settled run, each step the command a user types, run as its own process:
+"""The steps of the tutorial "Your own bearing" (notebooks/06_your_own_bearing.ipynb, which times
+them in one process at the size of its setting), timed at full size as separate processes: a
+catalogue NU 214 (ISO 15 dimension series 02, bore 70 mm: 70 x 125 x 24 mm) from its boundary
+dimensions to a settled run, each step the command a user types, run as its own process:
 
 1. `jaxbearing config new --series 02 --bore-mm 70 --type NU --out nu214.toml`
 2. `jaxbearing config check nu214.toml`
