@@ -107,6 +107,20 @@ def group_seconds() -> dict:
     return out
 
 
+@pytest.fixture(scope="session")
+def small_sweep(tmp_path_factory):
+    """The sweep of tests/sweeps/small.toml run uninterrupted, single device, in this process:
+    (its DIR, its dataset). tests/test_sweep.py and tests/test_sweep_distributed.py compare
+    against it; one process runs both (`PROGRAM_GROUPS`), so the sweep runs once."""
+    import pathlib
+
+    from jaxbearing.sweep import load_sweep_spec, run_sweep
+
+    out = tmp_path_factory.mktemp("sweep-ref")
+    spec = load_sweep_spec(pathlib.Path(__file__).parent / "sweeps" / "small.toml")
+    return out, run_sweep(spec, out, progress=False)
+
+
 def _file_name(nodeid: str) -> str:
     return nodeid.split("::", 1)[0].rsplit("/", 1)[-1]
 
