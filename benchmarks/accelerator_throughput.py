@@ -372,35 +372,24 @@ def _table(result: dict) -> str:
     lines = []
     if "sweep" in result:
         sw = result["sweep"]
-        rows = [
-            (
-                r["platform"],
-                r["batch_size"],
-                r["compile_s"],
-                r["wall_s"],
-                r["cases_per_s"],
-                r["simulated_ms_per_s"],
-                r["throughput_vs_one_cpu_case"],
-                r["max_steps_taken"],
-                r["cases_ok"],
-            )
-            for r in sw["rows"]
-        ]
+        keys = ("platform", "batch_size", "compile_s", "wall_s", "cases_per_s", "simulated_ms_per_s")
+        keys += ("throughput_vs_one_cpu_case", "max_steps_taken", "cases_ok")
+        header = (
+            "device",
+            "batch",
+            "compile s",
+            "wall s",
+            "cases/s",
+            "sim ms/s",
+            "x one CPU case",
+            "steps",
+            "ok",
+        )
         lines.append(
             _common.format_table(
                 f"sweep batch, {sw['duration_ms']:g} ms per case from the quasi-static start ({result['device']})",
-                (
-                    "device",
-                    "batch",
-                    "compile s",
-                    "wall s",
-                    "cases/s",
-                    "sim ms/s",
-                    "x one CPU case",
-                    "steps",
-                    "ok",
-                ),
-                rows,
+                header,
+                [tuple(r[k] for k in keys) for r in sw["rows"]],
             )
         )
         lines.append(
@@ -420,30 +409,23 @@ def _table(result: dict) -> str:
             c = en["comparison"][q]
             e, r, d = c["ensemble"], c["reference"], c["difference"]
             rows.append(
-                (
-                    q,
-                    e["value"],
-                    e["ci95_high"] - e["value"],
-                    r["value"],
-                    r["half_width"],
-                    d["value"],
-                    d["half_width"],
-                    c["agrees"],
-                )
+                (q, e["value"], e["ci95_high"] - e["value"], r["value"], r["half_width"])
+                + (d["value"], d["half_width"], c["agrees"])
             )
+        header = (
+            "statistic",
+            "ensemble",
+            "+-95%",
+            "CPU reference",
+            "+-95%",
+            "paired diff",
+            "+-95%",
+            "agrees",
+        )
         lines.append(
             _common.format_table(
                 "settled statistics: accelerator ensemble (mean over seeds of the members' mean) vs the CPU tight reference",
-                (
-                    "statistic",
-                    "ensemble",
-                    "+-95%",
-                    "CPU reference",
-                    "+-95%",
-                    "paired diff",
-                    "+-95%",
-                    "agrees",
-                ),
+                header,
                 rows,
             )
         )

@@ -4,14 +4,11 @@ tight reference solution, versus field evaluations and wall time.
 Case: the reference bearing at 20,000 rpm and 1000 N, seeded initial scatter
 (`jaxbearing.Perturbation(seed=s)`, the same seeds for every integrator).
 
-Window. Settling detection is not used here (it is being built elsewhere): every run is
+Window: the start-up transient (settled running: `bench_work_precision_settled`). Every run is
 integrated over [0, T0 + W] from the quasi-static start and the statistics are taken over the
 fixed window [T0, T0 + W] (full: T0 = 2 ms, W = 6 ms, seeds 0 and 1; quick: T0 = W = 1 ms,
-seed 0), from samples every `SAMPLE_DT` = 2 us (the same instants for every integrator). The
-window is short because the reference costs about 40x the default solve; the statistics are
-therefore those of the early running, not of settled running, and their confidence intervals
-(below) describe the scatter inside that window. What is compared is how far each integrator's
-statistics are from the reference's over the same window and seed.
+seed 0), from samples every `SAMPLE_DT` = 2 us (the same instants for every integrator), and
+compared with the reference's over the same window and seed.
 
 Statistics (flange samples with normal force > 1 N, every roller and flange): mean and 95th
 percentile of PV, mean sliding speed; cage slip 1 - mean(omega_c) / omega_c,kin over the window.
@@ -20,18 +17,13 @@ Confidence interval of each (95 %): batch means over 8 contiguous blocks of the 
 
 Reference: `jaxbearing.solve` with Tsit5, max norm, rtol 1e-7, atol 1e-14 (1e-16 m).
 
-Integrators (all on the same compiled field and initial state):
-* `jaxbearing.solve` with the max norm (`raceway_loosen = 1`): the old default, at several rtol;
-* `jaxbearing.solve` with the raceway-normal tolerances loosened (`raceway_loosen` = 10, 100,
-  1000; `jaxbearing.run._step_control`);
-* `jaxbearing.solve` with `optimistix.rms_norm` (SciPy's norm inside diffrax);
-* every row above at atol `PREVIOUS_ATOL` (1 pm, 1 nm/s, 1 urad/s: what atol 1e-6 meant before
-  the state's scales were chosen for the tolerances); the last row is today's default, atol 1e-6
-  (10 nm, 10 um/s, 0.01 rad/s; `jaxbearing.dynamics.SCALED_UNITS`);
-* SciPy `solve_ivp(RK45)` at rtol 1e-3, atol 1e-10 (RMS norm; 1 pm) driving the compiled flat field
-  (`_common.FlatField`), from Python;
-* `jaxbearing.solve(..., solver="ros34pw2")`: the linearly implicit Rosenbrock-W method with every
-  roller's 12 x 12 Jacobian block implicit (`jaxbearing.run._rosenbrock`), same error norm.
+Integrators (`VARIANTS`, on the same compiled field and initial state; rows 0-12 at atol
+`PREVIOUS_ATOL`, 1 pm: what atol 1e-6 meant before the state's scales were chosen for the
+tolerances, `jaxbearing.dynamics.SCALED_UNITS`; rows 13-15 at today's 1e-6, 10 nm): `jaxbearing.solve`
+with the max norm (the old default) and the raceway-normal tolerances loosened (`raceway_loosen`,
+`jaxbearing.run._step_control`), with `optimistix.rms_norm` and with `solver="ros34pw2"` (the
+Rosenbrock-W method, every roller's 12 x 12 Jacobian block implicit, `jaxbearing.run._rosenbrock`);
+SciPy `solve_ivp(RK45)` (RMS norm) driving the compiled flat field (`_common.FlatField`).
 
 `--imex` runs only the reference, the default Tsit5 rows and the Rosenbrock-W rows
 (`IMEX_VARIANTS`) and writes `bench_work_precision_imex.json`. `--rows 0,3,13` runs the
@@ -73,12 +65,11 @@ PREVIOUS_ATOL = 1e-10
 REF_RTOL, REF_ATOL = 1e-7, 1e-14
 STATS = ("mean_pv", "p95_pv", "mean_sliding_speed", "cage_slip")
 
-#: (label, kind, rtol, atol, raceway_loosen); kind: "solve" (max norm weighted by
-#: raceway_loosen), "rms" (solve with optimistix.rms_norm), "scipy" (solve_ivp RK45), "ros"
-#: (ROS34PW2, max norm weighted by raceway_loosen), "default" (the largest RMS of one body's
-#: coordinates, weighted by raceway_loosen: solve's default norm on 2026-11-25 until its third
-#: session, since then the settled windows' only; solve's is "solve" x100, row 13); an optional sixth element, the
-#: rotations' loosening (`solve(rotation_loosen=...)`), is 1 where absent
+#: (label, kind, rtol, atol, raceway_loosen[, rotation_loosen]); kind: "solve" (max norm weighted
+#: by raceway_loosen; row 13, x100, is solve's default), "rms" (solve with optimistix.rms_norm),
+#: "scipy" (solve_ivp RK45), "ros" (ROS34PW2, max norm weighted by raceway_loosen), "default" (the
+#: largest RMS of one body's coordinates weighted by raceway_loosen: the settled windows' norm);
+#: the rotations' loosening (`solve(rotation_loosen=...)`) is 1 where absent
 VARIANTS = (
     ("old default: Tsit5, max norm, rtol 1e-3", "solve", 1e-3, PREVIOUS_ATOL, 1.0),
     ("Tsit5, max norm, rtol 1e-2", "solve", 1e-2, PREVIOUS_ATOL, 1.0),
@@ -250,9 +241,7 @@ def jacobian_cost(bearing, op, repeats: int = 20) -> dict:
 def run_solve(
     compiled, bearing, op, duration, rtol, atol, loosen, seed, kind="solve", jac_cost=0.0, rotation=1.0
 ) -> dict:
-    import jax
     import jax.numpy as jnp
-    import numpy as np
 
     f = jnp.asarray
     wall, sol = _common.time_once(
@@ -260,25 +249,33 @@ def run_solve(
             bearing, op, f(duration), f(rtol), f(atol), f(loosen), f(rotation), jnp.asarray(seed, jnp.int32)
         )
     )
-    hist = jax.tree_util.tree_map(np.asarray, sol.histories)
-    steps = int(sol.num_steps)
-    rejected = int(sol.num_rejected_steps)
-    out = {
-        "ok": int(sol.result) == 0,
-        "wall_s": wall,
-        "step_attempts": steps,
-        "rejected_steps": rejected,
-        "mean_accepted_step_us": 1e6 * float(duration) / max(steps - rejected, 1),
-        "evaluations": _common.fsal_rk_evaluations(steps),
-        "hist": hist,
-    }
+    out = solve_record(wall, sol.result, sol.num_steps, sol.num_rejected_steps, sol.histories)
+    out["mean_accepted_step_us"] = (
+        1e6 * float(duration) / max(out["step_attempts"] - out["rejected_steps"], 1)
+    )
     if kind == "ros":
         # ROS34PW2, FSAL: 3 new stages + f(t1, y1) per attempt, f(t0, y0) once; one block
         # Jacobian per attempt (refresh every step) and one at the start
-        out["field_evaluations"] = 4 * steps + 1
-        out["jacobians"] = steps + 1
+        out["field_evaluations"] = 4 * out["step_attempts"] + 1
+        out["jacobians"] = out["step_attempts"] + 1
         out["evaluations"] = out["field_evaluations"] + jac_cost * out["jacobians"]
     return out
+
+
+def solve_record(wall, code, steps, rejected, hist) -> dict:
+    """A Tsit5 run's record (`bench_work_precision_settled` too): success, wall time, step
+    attempts, rejected steps, field evaluations (`_common.fsal_rk_evaluations`), the samples."""
+    import jax
+    import numpy as np
+
+    return {
+        "ok": int(code) == 0,
+        "wall_s": wall,
+        "step_attempts": int(steps),
+        "rejected_steps": int(rejected),
+        "evaluations": _common.fsal_rk_evaluations(steps),
+        "hist": jax.tree_util.tree_map(np.asarray, hist),
+    }
 
 
 class ScipyRunner:
@@ -325,34 +322,36 @@ class ScipyRunner:
             self._warm.add(num_saves)
 
     def run(self, duration, num_saves, rtol, atol, seed) -> dict:
-        import jax
-        import numpy as np
-
+        """From seed `seed`'s quasi-static start (`run_from`)."""
         import jaxbearing as jb
 
         field = _common.FlatField(self.bearing, self.op, perturbation=jb.Perturbation(seed=seed))
-        args_flat = field.args_flat
-        ts = np.linspace(0.0, duration, num_saves)
+        return self.run_from(field.y0, field.args_flat, duration, num_saves, rtol, atol)
 
-        def fun(t, y):
-            return np.asarray(self.compiled_field(t, y, args_flat))
-
+    def run_from(self, y0, args_flat, duration, num_saves, rtol, atol) -> dict:
+        """RK45 from the flat scaled state `y0` with the flat arguments `args_flat`, sampled at
+        `num_saves` equally spaced instants of [0, duration]."""
+        import jax
+        import numpy as np
         from scipy.integrate import solve_ivp
 
-        counted = _common.count_calls(fun)
         self.warm_samples(num_saves, args_flat)
         start = time.perf_counter()
         sol = solve_ivp(
-            counted, (0.0, duration), np.asarray(field.y0), method="RK45", rtol=rtol, atol=atol, t_eval=ts
+            lambda t, y: np.asarray(self.compiled_field(t, y, args_flat)),
+            (0.0, duration),
+            np.asarray(y0),
+            method="RK45",
+            rtol=rtol,
+            atol=atol,
+            t_eval=np.linspace(0.0, duration, num_saves),
         )
         # the samples are part of the run, as in `jaxbearing.solve` (histories after the loop)
         hist = jax.tree_util.tree_map(np.asarray, self.samples(sol.t, sol.y.T, args_flat))
-        wall = time.perf_counter() - start
-        attempts = _common.rk45_attempts(sol.nfev)
         return {
             "ok": sol.status == 0,
-            "wall_s": wall,
-            "step_attempts": attempts,
+            "wall_s": time.perf_counter() - start,
+            "step_attempts": _common.rk45_attempts(sol.nfev),
             "rejected_steps": None,  # t_eval given: sol.t does not list the accepted steps
             "evaluations": int(sol.nfev),
             "hist": hist,

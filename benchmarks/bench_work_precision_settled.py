@@ -12,8 +12,8 @@ Protocol.
 1. Settled start states: per seed, the library's own settled run
    (`jaxbearing.run.simulate_steady`: skid start with its pre-start, settling detection over
    cage revolutions, then the smallest allowed window of 2 revolutions; default integrator, one
-   seed at a time in this process), and its `SeedRun.final_state`. They are kept (data-only `.npz`, `jaxbearing.io.save_tree`) under
-   `CACHE_DIR` (one file per seed), so that a rerun does not repeat the settling.
+   seed at a time in this process), and its `SeedRun.final_state`, kept under `CACHE_DIR`
+   (data-only `.npz`, `jaxbearing.io.save_tree`) so that a rerun does not repeat the settling.
 2. From each seed's settled state, a window of W = `WINDOW_REVS` cage revolutions (W =
    revolutions x 2 pi / the settled cage speed, the mean over seeds of the last settled
    revolution's mean, rounded to whole samples; the same W for every seed) is integrated with
@@ -25,17 +25,14 @@ Protocol.
    orbit, accumulators at zero), with the step controller built here as `prepare_from` builds it
    (`step_controller(rtol, atol, raceway_normal_norm(y0_scaled, loosen))`), so that rtol, atol
    and the raceway-normal loosening are chosen per integrator; the library is not changed.
-   Integrators (`VARIANTS`): the reference, Tsit5 with rtol 1e-7, atol 1e-14 (1e-16 m) and
-   the plain max norm (loosen 1); then, at atol `PREVIOUS_ATOL` (1 pm, 1 nm/s, 1 urad/s: what
-   the default atol 1e-6 meant before the state's scales were chosen for the tolerances,
-   `jaxbearing.dynamics.SCALED_UNITS`): (b) the old default, Tsit5 rtol 1e-3, loosen 1; (c) the
-   previous default, rtol 1e-3, loosen 100; (d) rtol 1e-2, (e) 3e-3, (e') 3e-2, loosen 100;
-   (f) SciPy `solve_ivp(RK45)` at rtol 1e-3 (RMS norm) on the same compiled field
-   (`_common.FlatField`, `bench_work_precision.ScipyRunner`'s samples); and at today's default
-   atol 1e-6 (10 nm, 10 um/s, 0.01 rad/s): (g) the default, rtol 1e-3, loosen 100; (h) rtol
-   1e-2, loosen 100; (i) SciPy RK45 at rtol 1e-3. Later rows (see the comments in `VARIANTS`):
-   the error norms (9-15), the step controller (16-24) and the rotations' loosening (25-27;
-   row 26 is the library's default since 2026-11-25, row 14 the per-roller RMS default before).
+   Integrators (`VARIANTS`, each row's label says what it runs): the reference, Tsit5 at rtol
+   1e-7, atol 1e-14 (1e-16 m), plain max norm; rows 0-5 at atol `PREVIOUS_ATOL` (1 pm, 1 nm/s,
+   1 urad/s: what atol 1e-6 meant before the state's scales were chosen for the tolerances,
+   `jaxbearing.dynamics.SCALED_UNITS`) and rows 6-8 at today's 1e-6 (10 nm, 10 um/s,
+   0.01 rad/s): rtol and the raceway-normal loosening, and SciPy `solve_ivp(RK45)` on the same
+   compiled field (`_common.FlatField`, `bench_work_precision.ScipyRunner`); the error norms
+   (9-15), the step controller (16-24) and the rotations' loosening (25-27; row 26 is the
+   library's default, row 14 the per-roller RMS default before it).
 3. Statistics per run over the window (`bench_work_precision.window_statistics`): mean and p95
    PV over flange samples with normal force > 1 N, mean sliding speed, cage slip
    1 - mean(cage speed) / kinematic cage speed; per-seed 95 % half-widths from 8 batch means of
@@ -52,24 +49,17 @@ Protocol.
 5. Cost: field evaluations per simulated ms (Tsit5: `_common.fsal_rk_evaluations`, 6 per step
    attempt + 1; SciPy: nfev), their ratio against the old and today's default, and wall time
    per simulated ms (compile excluded, the samples included for every integrator; single runs
-   on a shared 2-core machine: the evaluation counts are the primary figure). Until
-   2026-11-25 the Tsit5 rows evaluated the flange quantities inside diffrax's saving (7128
-   contact evaluations per window, in the timed loop) and SciPy's samples were not timed,
-   which put 0.02-0.035 s per simulated ms on the Tsit5 rows' wall times alone (the
-   `--tag wall` rerun against `--tag scipy`).
+   on a shared 2-core machine: the evaluation counts are the primary figure).
 
-`--reuse-reference` takes the reference runs from the stored results when they were made for the
-same case (the reference is 12 of the 18 minutes). `--quick`: seed 0, a 0.5 ms window, reference
-at rtol 1e-5 (a smoke test of the code path; the
-settling of seed 0 is shared with the full run through the cache). `--revs N` sets the window in
-cage revolutions (default 2). `--rows 0,6,9` runs only those rows of `VARIANTS` (ratios against
-the defaults among them) and writes `bench_work_precision_settled_rows.json` (`--tag rotation`:
-`bench_work_precision_settled_rows_rotation.json`). `--seeds 4,5,6,7` starts from other
-seeds' settled states (settled and cached on first use; a fresh reference unless one stored
-for those seeds fits) and adds `_seeds4-5-6-7` to the results name: a choice made on the
-default seeds is checked on seeds it was not made on. `--design R_end,theta_f,Delta_bf` (mm, deg,
-mm) runs the study on the reference bearing with that roller-end and flange design instead (its
-own settled states, cache files and reference; `_design...` added to the results name): for
+`--reuse-reference` takes the reference runs from the stored results made for the same case (the
+reference is 12 of the 18 minutes). `--quick`: seed 0, a 0.5 ms window, reference at rtol 1e-5 (a
+smoke test; seed 0's settling is shared with the full run through the cache). `--revs N`: the window
+in cage revolutions (default 2). `--rows 0,6,9`: only those rows of `VARIANTS` (ratios against the
+defaults among them), written to `bench_work_precision_settled_rows.json` (`--tag rotation`:
+`..._rows_rotation.json`). `--seeds 4,5,6,7`: other seeds' settled states (cached on first use;
+`_seeds4-5-6-7` added to the results name), to check a choice on seeds it was not made on.
+`--design R_end,theta_f,Delta_bf` (mm, deg, mm): the reference bearing with that roller-end and
+flange design (its own settled states and reference; `_design...` added to the results name), for
 designs near their corner limit, which the design search visits. Results:
 `results/bench_work_precision_settled.json`.
 """
@@ -95,6 +85,7 @@ from bench_work_precision import (  # noqa: E402
     confidence_halfwidths,
     errors,
     rows_argument,
+    solve_record,
     variant_row,
     window_statistics,
 )
@@ -115,18 +106,27 @@ OLD_DEFAULT, PREVIOUS_DEFAULT, CURRENT_DEFAULT = "old default", "previous defaul
 MAX_NORM_DEFAULT = "max-norm default"
 #: the default on 2026-11-25 before the rotations' tolerances were loosened (row 14)
 PER_ROLLER_DEFAULT = "per-roller RMS default"
+#: the rows that the evaluation ratios are taken against: (key in the results, label's start)
+BASES = (
+    ("old_default", OLD_DEFAULT),
+    ("max_norm_default", MAX_NORM_DEFAULT),
+    ("current_default", CURRENT_DEFAULT),
+)
+
+
+#: the step controller's coefficients, in the order of a row's "controller"
+CONTROLLER_KEYS = ("pcoeff", "icoeff", "safety", "factormax")
 
 
 def _controller_label(c: tuple) -> str:
     return "P {:g} I {:g} safety {:g} growth <= {:g}".format(*c)
 
 
-#: (label, kind, rtol, atol, raceway_loosen[, options]); options: "controller", (pcoeff, icoeff,
-#: safety, factormax) of the PID step controller, default the library's; "rotation_loosen"
-#: (`window_solve`), default 1; "flat" (`window_solve`), default None (the library's choice); kind "tsit5" (diffrax, max norm with the
-#: raceway-normal tolerances `raceway_loosen` times looser), "tsit5_rms" (the same weights in the
-#: RMS norm), "tsit5_body_rms" (the largest of the rollers', cage's and inner ring's RMS) or
-#: "scipy" (solve_ivp RK45, RMS norm)
+#: (label, kind, rtol, atol, raceway_loosen[, options]); kind "tsit5" (diffrax, max norm with the
+#: raceway-normal tolerances `raceway_loosen` times looser), "tsit5_rms" (the same weights, RMS
+#: norm), "tsit5_body_rms" (the largest of the rollers', cage's and inner ring's RMS) or "scipy"
+#: (solve_ivp RK45, RMS norm); options (`variant_options`, `window_solve`): "controller" (the PID
+#: controller's `CONTROLLER_KEYS`), "rotation_loosen", "flat"
 VARIANTS = (
     (f"{OLD_DEFAULT}: Tsit5, max norm, rtol 1e-3, atol 1 pm", "tsit5", 1e-3, PREVIOUS_ATOL, 1.0),
     (
@@ -285,15 +285,9 @@ def window_solve(
     from jaxbearing.run._step_control import raceway_normal_norm, step_controller
 
     _, args, y0_scaled, _ = prepare_from(params, start, rtol, atol)
-    pcoeff, icoeff, safety, factormax = library_controller() if controller is None else controller
+    coefficients = dict(zip(CONTROLLER_KEYS, library_controller() if controller is None else controller))
     controller = step_controller(
-        rtol,
-        atol,
-        raceway_normal_norm(y0_scaled, loosen, norm, rotation_loosen),
-        pcoeff=pcoeff,
-        icoeff=icoeff,
-        safety=safety,
-        factormax=factormax,
+        rtol, atol, raceway_normal_norm(y0_scaled, loosen, norm, rotation_loosen), **coefficients
     )
     # as the library saves (`solve_from`): the states in the loop, the samples after it
     saveat = diffrax.SaveAt(ts=jnp.linspace(0.0, duration, num_saves), fn=_saved_state)
@@ -337,41 +331,25 @@ def compile_window_solve(params, start, num_saves: int, norm: str = "max", flat:
 def run_tsit5(
     compiled, params, start, duration, rtol, atol, loosen, controller=None, rotation_loosen=1.0
 ) -> dict:
-    import jax
     import jax.numpy as jnp
-    import numpy as np
 
     f = jnp.asarray
-    wall, (hist, code, steps, rejected) = _common.time_once(
+    controller = f(controller or library_controller())
+    wall, out = _common.time_once(
         lambda: compiled(
-            params,
-            start,
-            f(duration),
-            f(rtol),
-            f(atol),
-            f(loosen),
-            f(controller or library_controller()),
-            f(rotation_loosen),
+            params, start, f(duration), f(rtol), f(atol), f(loosen), controller, f(rotation_loosen)
         )
     )
-    steps = int(steps)
-    return {
-        "ok": int(code) == 0,
-        "wall_s": wall,
-        "step_attempts": steps,
-        "rejected_steps": int(rejected),
-        "evaluations": _common.fsal_rk_evaluations(steps),
-        "hist": jax.tree_util.tree_map(np.asarray, hist),
-    }
+    hist, code, steps, rejected = out
+    return solve_record(wall, code, steps, rejected, hist)
 
 
 def run_scipy(runner: ScipyRunner, params, start, duration, num_saves, rtol, atol) -> dict:
     """SciPy RK45 from the physical state `start` on the compiled flat field of `runner`, with
-    the continuation's scaling and arguments (`prepare_from`), ravelled as `runner`'s field."""
-    import jax
+    the continuation's scaling and arguments (`prepare_from`), ravelled as `runner`'s field; the
+    samples are part of the run, as in the Tsit5 rows (`window_solve`) and the library."""
     import numpy as np
     from jax.flatten_util import ravel_pytree
-    from scipy.integrate import solve_ivp
 
     from jaxbearing.run import prepare_from
 
@@ -379,30 +357,7 @@ def run_scipy(runner: ScipyRunner, params, start, duration, num_saves, rtol, ato
     y0, args_flat = (np.asarray(ravel_pytree(x)[0]) for x in (y0_scaled, args))
     if y0.size != runner.field0.size or args_flat.size != runner.field0.args_flat.size:
         raise RuntimeError("the continuation's state or arguments do not ravel like the flat field's")
-    field = runner.compiled_field
-    ts = np.linspace(0.0, duration, num_saves)
-    runner.warm_samples(num_saves, args_flat)
-    start_t = time.perf_counter()
-    sol = solve_ivp(
-        lambda t, y: np.asarray(field(t, y, args_flat)),
-        (0.0, duration),
-        y0,
-        method="RK45",
-        rtol=rtol,
-        atol=atol,
-        t_eval=ts,
-    )
-    # the samples are part of the run, as in the Tsit5 rows (`window_solve`) and the library
-    hist = jax.tree_util.tree_map(np.asarray, runner.samples(sol.t, sol.y.T, args_flat))
-    wall = time.perf_counter() - start_t
-    return {
-        "ok": sol.status == 0,
-        "wall_s": wall,
-        "step_attempts": _common.rk45_attempts(sol.nfev),
-        "rejected_steps": None,  # t_eval given: sol.t does not list the accepted steps
-        "evaluations": int(sol.nfev),
-        "hist": hist,
-    }
+    return runner.run_from(y0, args_flat, duration, num_saves, rtol, atol)
 
 
 # -- statistics over seeds ---------------------------------------------------------------------
@@ -438,29 +393,13 @@ def stored_reference(case: dict, names: tuple = (NAME,)) -> dict | None:
     runs only the integrators (the reference is 12 of the study's 18 minutes)."""
     import json
 
+    keys = ("seeds", "window_s", "num_saves", "inner_speed_rpm", "radial_load_N", "design", "reference")
     for name in names:
         path = _common.RESULTS_DIR / f"{name}.json"
-        found = _stored_reference(json.loads(path.read_text()), case) if path.exists() else None
-        if found is not None:
-            return found
+        old = json.loads(path.read_text()) if path.exists() else {"quick": True}
+        if not old.get("quick") and all(old["case"].get(k) == case[k] for k in keys):
+            return old["reference"]
     return None
-
-
-def _stored_reference(old: dict, case: dict) -> dict | None:
-    keys = ("seeds", "window_s", "num_saves", "inner_speed_rpm", "radial_load_N", "design")
-    if old.get("quick") or any(old["case"].get(k) != case[k] for k in keys):
-        return None
-    if reference_tolerances(old["case"]["reference"]) != reference_tolerances(case["reference"]):
-        return None
-    return old["reference"]
-
-
-def reference_tolerances(reference: dict) -> tuple:
-    """(rtol, atol in metres of length, method) of a stored case's reference. Results stored
-    before the state's scales were chosen for the tolerances have no "atol_length_m": their
-    atol was of 1-um units."""
-    length = reference.get("atol_length_m", reference["atol"] * 1e-6)
-    return reference["rtol"], float(f"{length:.6g}"), reference["method"]
 
 
 def output_name(only: tuple | None, seeds: tuple, tag: str | None = None, design: tuple | None = None) -> str:
@@ -582,20 +521,21 @@ def main(
         compile_s["scipy_field"] = scipy_runner.compile_s
 
     def run(kind, seed, rtol, atol, loosen, options=None):
-        options = variant_options(options)
+        o = variant_options(options)
         if kind == "scipy":
             r = run_scipy(scipy_runner, params, starts[seed], window, num_saves, rtol, atol)
         else:
+            program = compiled[NORM_OF_KIND[kind], o["flat"]]
             r = run_tsit5(
-                compiled[NORM_OF_KIND[kind], options["flat"]],
+                program,
                 params,
                 starts[seed],
                 window,
                 rtol,
                 atol,
                 loosen,
-                options["controller"],
-                options["rotation_loosen"],
+                o["controller"],
+                o["rotation_loosen"],
             )
         hist = r.pop("hist")
         r["statistics"] = window_statistics(hist, 0.0, omega_kin)
@@ -660,7 +600,7 @@ def main(
         rows.append(
             {
                 **variant_row(label, kind, rtol, atol, loosen, per_seed),
-                "controller": dict(zip(("pcoeff", "icoeff", "safety", "factormax"), options["controller"])),
+                "controller": dict(zip(CONTROLLER_KEYS, options["controller"])),
                 "rotation_loosen": options["rotation_loosen"],
                 "flat": options["flat"],
                 "over_seeds": {
@@ -669,11 +609,7 @@ def main(
             }
         )
         rows[-1]["agrees_all"] = all(rows[-1]["over_seeds"][s]["agrees"] for s in STATS)
-    for key, label in (
-        ("old_default", OLD_DEFAULT),
-        ("max_norm_default", MAX_NORM_DEFAULT),
-        ("current_default", CURRENT_DEFAULT),
-    ):
+    for key, label in BASES:
         base = next((r for r in rows if r["label"].startswith(label + ":")), None)
         for row in rows:  # with --rows, only against the defaults that were run
             if base is not None:
@@ -708,79 +644,45 @@ _DISPLAY = {
 
 
 def _pm(est: dict, factor: float) -> str:
-    hw = est["half_width"]
-    v = est["value"]
-    if v is None:
-        return "-"
-    return f"{v * factor:.4g}" + ("" if hw is None else f" +- {hw * factor:.3g}")
+    v, hw = est["value"], est["half_width"]
+    return "-" if v is None else f"{v * factor:.4g}" + ("" if hw is None else f" +- {hw * factor:.3g}")
 
 
 def _table(r: dict) -> str:
     import numpy as np
 
-    c = r["case"]
-    ms = c["window_s"] * 1e3
+    c, design = r["case"], r["case"].get("design")
     refs = r["reference"].values()
-    cost_rows = [
-        [
-            f"reference rtol {c['reference']['rtol']:g}",
-            float(np.mean([x["evaluations_per_ms"] for x in refs])),
-            None,
-            None,
-            None,
-            float(np.mean([x["wall_s_per_ms"] for x in refs])),
-            None,
-            None,
-        ]
-    ]
+    mean_ref = [float(np.mean([x[k] for x in refs])) for k in ("evaluations_per_ms", "wall_s_per_ms")]
+    cost_rows = [[f"reference rtol {c['reference']['rtol']:g}", mean_ref[0], None, None, None, mean_ref[1]]]
     for v in r["variants"]:
+        ratios = (v.get(f"evaluation_ratio_vs_{key}", math.nan) for key, _ in BASES)
+        agree = v["agrees_all"] if len(c["seeds"]) > 1 else None
         cost_rows.append(
-            [
-                v["label"],
-                v["evaluations_per_ms"],
-                v.get("evaluation_ratio_vs_old_default", math.nan),
-                v.get("evaluation_ratio_vs_max_norm_default", math.nan),
-                v.get("evaluation_ratio_vs_current_default", math.nan),
-                v["wall_s_per_ms"],
-                v["max_error_in_ci"],
-                v["agrees_all"] if len(c["seeds"]) > 1 else None,
-            ]
+            [v["label"], v["evaluations_per_ms"], *ratios, v["wall_s_per_ms"], v["max_error_in_ci"], agree]
         )
-    design = c.get("design")
     bearing = "reference bearing" + (
         ""
         if not design
         else f" with R_end {design['end_radius_mm']:g} mm, theta_f {design['layback_angle_deg']:g} deg, "
         f"Delta_bf {design['axial_clearance_mm']:g} mm,"
     )
-    title = (
-        f"Work-precision in settled running: {bearing} {c['inner_speed_rpm']:.0f} rpm, "
-        f"{c['radial_load_N']:.0f} N; window {ms:.3g} ms from each seed's settled state, seeds {c['seeds']}"
-    )
     cost = _common.format_table(
-        title,
-        [
-            "integrator",
-            "evals/ms",
-            "x fewer vs old",
-            "x fewer vs max-norm",
-            "x fewer vs default",
-            "wall s/ms",
-            "max err/CI",
-            "agree",
-        ],
-        cost_rows,
+        f"Work-precision in settled running: {bearing} {c['inner_speed_rpm']:.0f} rpm, {c['radial_load_N']:.0f} "
+        f"N; window {c['window_s'] * 1e3:.3g} ms from each seed's settled state, seeds {c['seeds']}",
+        ["integrator", "evals/ms", *(f"x fewer vs {w}" for w in ("old", "max-norm", "default"))]
+        + ["wall s/ms", "max err/CI", "agree"],
+        [row + [None] * (8 - len(row)) for row in cost_rows],
     )
+    flag = {True: " yes", False: " NO", None: ""}
     agree_rows = [
         ["reference (ensemble)", *(_pm(r["reference_over_seeds"][s], _DISPLAY[s][1]) for s in STATS)]
     ]
     for v in r["variants"]:
-        cells = []
-        for s in STATS:
-            o = v["over_seeds"][s]
-            flag = {True: " yes", False: " NO", None: ""}[o["agrees"]]
-            cells.append(_pm(o["difference"], _DISPLAY[s][1]) + flag)
-        agree_rows.append([v["label"], *cells])
+        o = v["over_seeds"]
+        agree_rows.append(
+            [v["label"], *(_pm(o[s]["difference"], _DISPLAY[s][1]) + flag[o[s]["agrees"]] for s in STATS)]
+        )
     agree = _common.format_table(
         "Reference ensemble mean +- 95 % half-width over seeds; per integrator: mean paired difference "
         "(integrator - reference) +- 95 % half-width over seeds, and whether it agrees",
@@ -788,14 +690,6 @@ def _table(r: dict) -> str:
         agree_rows,
     )
     return cost + "\n\n" + agree
-
-
-def self_check() -> None:
-    """The agreement rule on synthetic numbers (no model compile; the Student-t interval itself:
-    tests/test_bench_work_precision_settled.py)."""
-    ref = [1.0, 2.0, 3.0, 4.0]
-    assert paired_over_seeds([2.0, 3.0, 4.0, 5.0], ref)["agrees"] is False  # interval excludes 0
-    assert paired_over_seeds([1.0], [1.0])["agrees"] is None  # one seed: no interval
 
 
 def seeds_argument(argv: list) -> tuple:

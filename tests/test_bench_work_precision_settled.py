@@ -32,6 +32,7 @@ def test_agreement_needs_the_difference_below_the_reference_half_width():
     out = paired_over_seeds([1.5, 0.701, 1.399, 0.8], ref)  # differences 0.5, -0.3, 0.4, -0.2
     assert out["difference"]["ci95_low"] < 0.0 < out["difference"]["ci95_high"]
     assert out["agrees"] is False
+    assert paired_over_seeds([1.0], [1.0])["agrees"] is None  # one seed: no interval
 
 
 def test_rows_and_seeds_options_are_checked_in_one_line():

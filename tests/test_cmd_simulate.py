@@ -219,36 +219,6 @@ def test_forced_failure_reports_status():
     assert np.isnan(res.smooth_peak_pv)
 
 
-def test_failed_settled_run_is_one_honest_line(tmp_path, capsys):
-    """A settled run whose solve fails (here at its step limit): the command prints one line with
-    the solver's reason and where it failed (not "NOT SETTLED ... at the cap"), writes
-    summary.json, draws what it can (nothing) and exits 1 without a traceback; the Python API
-    returns the same record and `summarise` does not raise. Three slices and the quasi-static
-    start keep the run's own program (a step limit is static) small."""
-    import jaxbearing as jb
-    from jaxbearing.run import simulate, summarise
-
-    cfg = _config(tmp_path, "[bearing]\nnum_slices = 3\n[simulation]\nmax_steps = 30\n")
-    out = tmp_path / "out"
-    code = main(["simulate", "--config", cfg, "--end", "arc", "--start", "quasi-static", "--out", str(out)])
-    printed = capsys.readouterr()
-    assert code == 1 and "Traceback" not in printed.out + printed.err
-    failed = [line for line in printed.out.splitlines() if "FAILED" in line]
-    assert failed == [
-        "[arc] FAILED: the step limit max_steps was reached, in the cage revolution from 0.00 to "
-        f"{failed[0].split(' to ')[1].split(' ms')[0]} ms; no statistics (summary.json has the run's record)"
-    ]
-    assert "NOT SETTLED" not in printed.out and "flange force, max" not in printed.out
-    doc = json.loads((out / "summary.json").read_text())
-    assert doc["running"] == "failed (see status)" and "max_steps" in doc["status"]
-    assert not list(out.glob("*.png"))
-
-    b = jb.load_config(cfg).bearing()
-    res = simulate(b, jb.reference_operating_point(), settle="auto", start="quasi-static", max_steps=30)
-    s = summarise(res)
-    assert not res.ok and s["status"] == doc["status"] and s["running"] == "failed (see status)"
-
-
 def test_command_line_overrides_win_over_the_file(both_run):
     """`--speed-rpm`, `--load-N`, `--duration-ms`, `--end` and `--no-progress` over the file's
     values: the kinematic cage speed is n_i (1 - D/d_m) / 2 at 20000 rpm, the quasi-static start

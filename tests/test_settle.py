@@ -155,6 +155,44 @@ def test_auto_settle_hitting_the_cap_is_not_silent(small_config, capsys):
     assert seed["start_cage_speed_rpm"] == pytest.approx(s["kinematic_cage_speed_rpm"], rel=1e-9)
 
 
+def test_failed_settled_run_is_one_honest_line(small_config, capsys):
+    """A settled run whose solve fails (here at its step limit): the command prints one line with
+    the solver's reason and where it failed (not "NOT SETTLED ... at the cap"), writes
+    summary.json, draws what it can (nothing) and exits 1 without a traceback; the Python API
+    returns the same record and `summarise` does not raise. The reduced bearing and the
+    quasi-static start of the run above: its start and its static skid equilibrium (the verdict's
+    time constant) are built and stored already, and only the member program with its own step
+    limit (static) is compiled. (Here, not in tests/test_cmd_simulate.py, whose process compiles
+    the full-size `simulate` while this one builds the reduced runs: with 3 slices there, the
+    start and the equilibrium were two more programs, 15 s.)"""
+    import jaxbearing as jb
+    from jaxbearing.run import simulate, summarise
+
+    d, _ = small_config
+    cfg = d / "failing.toml"
+    cfg.write_text("[bearing]\nnum_slices = 11\n[simulation]\nprogress = false\nmax_steps = 30\n")
+    out = d / "failed"
+    code = main(
+        ["simulate", "--config", str(cfg), "--end", "arc", "--start", "quasi-static", "--out", str(out)]
+    )
+    printed = capsys.readouterr()
+    assert code == 1 and "Traceback" not in printed.out + printed.err
+    failed = [line for line in printed.out.splitlines() if "FAILED" in line]
+    assert failed == [
+        "[arc] FAILED: the step limit max_steps was reached, in the cage revolution from 0.00 to "
+        f"{failed[0].split(' to ')[1].split(' ms')[0]} ms; no statistics (summary.json has the run's record)"
+    ]
+    assert "NOT SETTLED" not in printed.out and "flange force, max" not in printed.out
+    doc = json.loads((out / "summary.json").read_text())
+    assert doc["running"] == "failed (see status)" and "max_steps" in doc["status"]
+    assert not list(out.glob("*.png"))
+
+    b = jb.load_config(cfg).bearing()
+    res = simulate(b, jb.reference_operating_point(), settle="auto", start="quasi-static", max_steps=30)
+    s = summarise(res)
+    assert not res.ok and s["status"] == doc["status"] and s["running"] == "failed (see status)"
+
+
 @pytest.mark.slow
 def test_halving_the_tolerances_moves_settled_pv_and_slip_less_than_their_intervals():
     """Issue 11 acceptance at a reduced size (11 slices per raceway, a 4-revolution window,

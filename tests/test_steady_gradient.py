@@ -245,8 +245,24 @@ def test_tail_mean_is_the_minimum_of_the_rockafellar_uryasev_function():
     assert tail_mean(big) == pytest.approx(0.975, abs=2e-3)
 
 
+@pytest.fixture(scope="module")
+def frozen_window(settled):
+    """The frozen-load estimator's own 1 ms window from the first settled state
+    (`_frozen_window_states`), its flange loads at the saved states and their PV over the
+    reference PV: the same for every statistic, so integrated once."""
+    from jaxbearing.dynamics import Params
+
+    b, op, _, base = settled
+    saved, code = _frozen_window_states(b, op, base.sample_states[0])
+    assert int(code) == 0
+    params = Params(bearing=b, operating=op, functionals=STEADY_FUNCTIONALS)
+    q0 = jax.jit(jax.vmap(lambda s: contact_loads(s, params).flange.normal_force))(saved)
+    fl = jax.vmap(lambda s: contact_loads(s, params).flange)(saved)
+    return saved, q0, fl.pv / STEADY_FUNCTIONALS.pv_reference
+
+
 @pytest.mark.parametrize("statistic", ["mean", "peak", "tail"])
-def test_frozen_load_derivative_matches_central_differences(settled, statistic):
+def test_frozen_load_derivative_matches_central_differences(settled, frozen_window, statistic):
     """The frozen-load estimator's derivative (jax.jacfwd through the flange geometry and the
     exact-Hertz radii at the loads the dynamics gave) against central differences of the same
     frozen functional on the same saved states (relative steps 1e-6): the states of the
@@ -254,17 +270,11 @@ def test_frozen_load_derivative_matches_central_differences(settled, statistic):
     statistic's p-mean (p = 8) and the tail statistic (every touching sample's frozen PV,
     `frozen_tail_samples`, whose Jacobian `tail_integrals` sums over the worst 5 %)."""
     from jaxbearing.design._steady_gradient import frozen_load_integrands, frozen_pv, frozen_tail_samples
-    from jaxbearing.dynamics import Params
 
-    b, op, _, base = settled
+    b, op, _, _ = settled
     x = jnp.asarray(DesignVariables.of(b).as_array())
-    saved, code = _frozen_window_states(b, op, base.sample_states[0])
-    assert int(code) == 0
-    params = Params(bearing=b, operating=op, functionals=STEADY_FUNCTIONALS)
-    q0 = jax.jit(jax.vmap(lambda s: contact_loads(s, params).flange.normal_force))(saved)
+    saved, q0, ratio = frozen_window
     assert float(jnp.sum(q0 > 1.0)) > 0  # some flange contact among the saved states
-    fl = jax.vmap(lambda s: contact_loads(s, params).flange)(saved)
-    ratio = fl.pv / STEADY_FUNCTIONALS.pv_reference
 
     if statistic == "tail":
         w, pv, dpv = eqx.filter_jit(frozen_tail_samples)(b, op, x, saved)

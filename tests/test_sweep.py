@@ -86,12 +86,12 @@ def assert_same_results(a, b) -> None:
     assert a.identical(b)
 
 
-@pytest.fixture(scope="module")
-def reference(tmp_path_factory):
-    """The small sweep run uninterrupted, single device, in this process."""
-    out = tmp_path_factory.mktemp("sweep-ref")
-    ds = run_sweep(load_sweep_spec(SMALL), out, progress=False)
-    return out, ds
+@pytest.fixture
+def reference(small_sweep):
+    """The small sweep run uninterrupted, single device, in this process: (its DIR, its dataset),
+    which no test changes (they copy the DIR); run once for this file and
+    tests/test_sweep_distributed.py (`small_sweep`, tests/conftest.py)."""
+    return small_sweep
 
 
 # -- spec validation (no computing) --------------------------------------------------------------

@@ -19,13 +19,14 @@ import numpy as np
 import pytest
 from test_sweep import SMALL, assert_same_results, subprocess_env, sweep_command
 
-from jaxbearing.sweep import computed_batches, load_sweep_spec, open_results, run_sweep, variable_names
+from jaxbearing.sweep import computed_batches, open_results, variable_names
 
 
-@pytest.fixture(scope="module")
-def reference(tmp_path_factory):
-    out = tmp_path_factory.mktemp("sweep-ref-dist")
-    return run_sweep(load_sweep_spec(SMALL), out, progress=False)
+@pytest.fixture
+def reference(small_sweep):
+    """The small sweep's dataset, single device, in this process (test_sweep's run: `small_sweep`,
+    tests/conftest.py)."""
+    return small_sweep[1]
 
 
 @contextlib.contextmanager
