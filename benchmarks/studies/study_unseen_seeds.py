@@ -1,0 +1,116 @@
+"""A found design against the reference on seeds no search or verification used.
+
+    python benchmarks/studies/study_unseen_seeds.py --design 84.8,1.680,0.150 \
+        --speeds-rpm 20000,30000 --seeds 8 --first-seed 5000 --window-revs 4 --name NAME
+
+Both designs at every speed, every seed one member of one call of the steady-running engine
+(skid start, settling by the verdict, a window of `--window-revs` cage revolutions), the
+reference bearing at 1000 N. Per design and speed: mean and peak flange PV with 95 % intervals,
+the corner-contact share of contact time, how many revolutions reached the limited circle, and
+the corner-contact risk per revolution with its bounds (`jaxbearing.run.corner_risk`). Writes
+benchmarks/results/NAME.json with the command, the commit and the machine.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import pathlib
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+HERE = pathlib.Path(__file__).resolve()
+sys.path.insert(0, str(HERE.parents[1]))
+
+import _common  # noqa: E402
+
+
+def _row(m) -> dict:
+    pv = m.summary.get("flange_pv_Pa_m_s", {}).get("max", {})
+    maxima = np.concatenate([np.asarray(r, float) for r in m.contact_radius_maxima] or [np.zeros(0)])
+    return {
+        "mean_pv_GPa_m_s": {
+            k: (None if m.mean_pv.get(k) is None else m.mean_pv[k] / 1e9)
+            for k in ("value", "ci95_low", "ci95_high")
+        },
+        "peak_pv_GPa_m_s": {
+            k: (None if pv.get(k) is None else pv[k] / 1e9) for k in ("value", "ci95_low", "ci95_high")
+        },
+        "corner_contact_share": m.corner_contact_share,
+        "revolutions": int(maxima.size),
+        "revolutions_at_the_corner": int(np.sum(maxima > m.limited_circle_radius_m)),
+        "largest_contact_radius_mm": float(maxima.max() * 1e3) if maxima.size else None,
+        "limited_circle_radius_mm": float(m.limited_circle_radius_m * 1e3),
+        "corner_risk": m.summary.get("corner_risk"),
+        "settled": m.settled,
+        "seeds": m.seeds,
+    }
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--design", required=True, help="R_end [mm], theta_f [deg], Delta_bf [mm]")
+    p.add_argument("--speeds-rpm", default="20000,30000")
+    p.add_argument("--seeds", type=int, default=8)
+    p.add_argument("--first-seed", type=int, default=5000)
+    p.add_argument("--window-revs", type=int, default=4)
+    p.add_argument("--slices", type=int, default=31)
+    p.add_argument("--name", default="unseen_seeds")
+    args = p.parse_args(argv)
+
+    import jaxbearing as jb
+    from jaxbearing.design import steady_design_metrics_points
+    from jaxbearing.flange import DesignVariables
+    from jaxbearing.geometry import rpm_to_rad_s
+    from jaxbearing.run import SteadySettings
+
+    r, t, c = (float(v) for v in args.design.split(","))
+    bearing = dataclasses.replace(jb.reference_bearing(), num_slices=args.slices)
+    found = DesignVariables(r * 1e-3, np.radians(t), c * 1e-3)
+    reference = DesignVariables.of(bearing)
+    speeds = [float(v) for v in args.speeds_rpm.split(",")]
+    op0 = jb.reference_operating_point()
+    ops = [dataclasses.replace(op0, inner_speed=np.asarray(rpm_to_rad_s(v))) for v in speeds]
+    settings = SteadySettings(seeds=args.seeds, window_revs=args.window_revs)
+    t0 = time.perf_counter()
+    metrics = steady_design_metrics_points(
+        bearing, ops * 2, [reference] * len(ops) + [found] * len(ops), settings, first_seed=args.first_seed
+    )
+    wall = time.perf_counter() - t0
+    out = {
+        "design_mm_deg_mm": [r, t, c],
+        "speeds_rpm": speeds,
+        "slices": args.slices,
+        "seeds": list(range(args.first_seed, args.first_seed + args.seeds)),
+        "window_revs": args.window_revs,
+        "reference": [_row(m) for m in metrics[: len(ops)]],
+        "found": [_row(m) for m in metrics[len(ops) :]],
+        "wall_s": wall,
+        "command": "python benchmarks/studies/study_unseen_seeds.py "
+        + " ".join(sys.argv[1:] if argv is None else argv),
+        "commit": subprocess.run(
+            ["git", "-C", str(HERE.parents[2]), "rev-parse", "HEAD"], capture_output=True, text=True
+        ).stdout.strip(),
+        "machine": _common.machine_info(),
+    }
+    path = HERE.parents[1] / "results" / f"{args.name}.json"
+    path.write_text(json.dumps(out, indent=1, default=float))
+    for name in ("reference", "found"):
+        for v, row in zip(speeds, out[name]):
+            e, q = row["mean_pv_GPa_m_s"], row["peak_pv_GPa_m_s"]
+            print(
+                f"{name:9s} {v:7.0f} rpm: mean PV {e['value']:.3f} [{e['ci95_low']:.3f}, {e['ci95_high']:.3f}], "
+                f"peak {q['value']:.2f} [{q['ci95_low']:.2f}, {q['ci95_high']:.2f}] GPa m/s, "
+                f"{row['revolutions_at_the_corner']} of {row['revolutions']} revolutions at the corner, "
+                f"risk <= {row['corner_risk']['upper']:.2g}/rev ({row['corner_risk']['method']})"
+            )
+    print(f"wrote {path} ({wall:.0f} s)")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
