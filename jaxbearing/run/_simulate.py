@@ -280,15 +280,7 @@ def solve(
     controller = _transient_controller(y0_scaled, rtol, atol, error_norm, raceway_loosen, rotation_loosen)
     with checks_without_host_callbacks():  # cacheable program (`_compile_cache`)
         sol = scaled_diffeqsolve(
-            y0_scaled,
-            args,
-            duration,
-            saveat,
-            controller,
-            max_steps,
-            adjoint,
-            progress,
-            solver,
+            y0_scaled, args, duration, saveat, controller, max_steps, adjoint, progress, solver
         )
     return _solution(sol, num_saves, args)
 
