@@ -215,16 +215,15 @@ def frozen_load_gradients(
     tail = statistic == "tail"
     cases = list(cases)
     n = max(1, int(round(window * 1e3 * saves_per_ms)))
-    jobs, owner = _frozen_jobs(
-        cases, _FrozenSample(None, None, None, float(window), n, float(rtol), exponent, tail)
-    )
-    chosen = choose_strategy(strategy, min(int(workers), max(1, len(jobs))))
-    if not jobs:
-        outs = []
-    elif chosen == "vmap":
-        outs = _frozen_samples_batched(jobs)
-    else:
-        outs = parallel_map(_frozen_job, jobs, workers=workers if chosen == "processes" else 1)
+    jobs, owner = [], []
+    for k, (bearing, op, design, states) in enumerate(cases):
+        x = np.asarray(design.as_array(), dtype=float)
+        # the trajectories run with the design, as the settled states did: a bearing of another
+        # design would start every window off its contacts (micrometres against a changed end arc)
+        job = _FrozenSample(design.apply(bearing), op, x, float(window), n, float(rtol), exponent, tail)
+        jobs += [(job, s) for s in states]
+        owner += [k] * len(states)
+    outs = _run_frozen(jobs, strategy, workers)
     per_case = [[o for o, j in zip(outs, owner) if j == k] for k in range(len(cases))]
     if not tail:
         return [_combine(o, window, exponent) for o in per_case]
@@ -235,19 +234,16 @@ def frozen_load_gradients(
     return found
 
 
-def _frozen_jobs(cases, settings: _FrozenSample) -> tuple[list, list]:
-    """(jobs, owner): one (`_FrozenSample`, state) per state of every case, `settings`' window,
-    saves, tolerance and statistic with the case's bearing, operating point and design, and the
-    index of the case each job belongs to."""
-    jobs, owner = [], []
-    for k, (bearing, op, design, states) in enumerate(cases):
-        x = np.asarray(design.as_array(), dtype=float)
-        # the trajectories run with the design, as the settled states did: a bearing of another
-        # design would start every window off its contacts (micrometres against a changed end arc)
-        job = dataclasses.replace(settings, bearing=design.apply(bearing), op=op, x=x)
-        jobs += [(job, s) for s in states]
-        owner += [k] * len(states)
-    return jobs, owner
+def _run_frozen(jobs, strategy: str, workers: int) -> list:
+    """The outputs of every (`_FrozenSample`, state) of `jobs`, in order, by `strategy`
+    (`choose_strategy`): one vmapped program ("vmap", `_frozen_samples_batched`), `workers`
+    processes ("processes") or one after another in this process ("sequential")."""
+    chosen = choose_strategy(strategy, min(int(workers), max(1, len(jobs))))
+    if not jobs:
+        return []
+    if chosen == "vmap":
+        return _frozen_samples_batched(jobs)
+    return parallel_map(_frozen_job, jobs, workers=workers if chosen == "processes" else 1)
 
 
 def _frozen_job(item):
