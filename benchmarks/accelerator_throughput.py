@@ -299,7 +299,8 @@ def gradient_part(members: int) -> dict:
 
     import jaxbearing as jb
     from jaxbearing.design import GRADIENT_WINDOW, forward_jacobian
-    from jaxbearing.design._steady_gradient import _combine, window_integrals
+    from jaxbearing.design._steady_objective import _combine
+    from jaxbearing.design._window_gradient import window_integrals
     from jaxbearing.flange import DesignVariables
 
     gpu, cpu = accelerator(), jax.devices("cpu")[0]

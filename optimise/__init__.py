@@ -19,13 +19,13 @@ from ._problem import (
     any_feasible,
     bounds_from_engineering,
     feasibility_map,
-    load_optimise_toml,
     make_problem,
     operating_envelope,
 )
 from ._search import SearchResult, grid_search, search, start_points
 from ._settings import SteadySettings
 from ._steady import NearOptimal, SteadySearchResult, near_optimal_set, steady_search
+from ._toml import load_optimise_toml
 from ._verify import verification
 
 __all__ = [

@@ -9,24 +9,9 @@ import pathlib
 import numpy as np
 
 
-def plot_search(problem, result, path) -> pathlib.Path:
-    """Write a PNG of every start's path in (R_end, theta_f) over the feasibility map of the
-    design zone (`jaxbearing.design_zone_grid`, at the final Delta_bf, or the start's when no
-    feasible design was found): feasible region shaded, zero lines of each margin, starts as
-    circles, the final design as a star, the near-optimal designs (`_steady.near_optimal_set`)
-    as open diamonds. For a steady search (five margins per iterate), the
-    dynamic corner margin's zero line too, dashed (`_steady`: the limited-circle margin equal to
-    the skew excursion measured at the final design plus the corner margin)."""
-    from jaxbearing.io import pyplot
-
-    plt = pyplot()
-
-    from ._problem import feasibility_map
-
-    x_ref = result.design if result.design is not None else result.start_design
-    r, t, z = feasibility_map(problem, float(x_ref[2]))
-    rr, tt = np.meshgrid(r * 1e3, np.degrees(t), indexing="ij")
-    fig, ax = plt.subplots(figsize=(7, 5))
+def _draw_zone(ax, rr, tt, z) -> None:
+    """The design zone `z` on the (R_end [mm], theta_f [deg]) grid `rr`, `tt`: the feasible
+    region shaded, the zero line of each margin that changes sign on it."""
     feas = np.asarray(z.feasible, dtype=float)
     ax.contourf(rr, tt, feas, levels=[-0.5, 0.5, 1.5], colors=["#f2f2f2", "#b7e1b0"])
     styles = (
@@ -40,7 +25,11 @@ def plot_search(problem, result, path) -> pathlib.Path:
         if m.min() < 0 < m.max():
             ax.contour(rr, tt, m, levels=[0.0], colors=colour, linewidths=1.2)
             ax.plot([], [], color=colour, label=f"{label} margin = 0")
-    h = _history(result)
+
+
+def _draw_corner_margin(ax, rr, tt, z, result, h) -> None:
+    """A steady search's dynamic corner margin (five margins per iterate in the history `h`):
+    its zero line, dashed, where it falls on the grid."""
     margins = np.asarray(h.get("margins", [])) if h else np.zeros(0)
     if margins.ndim == 3 and margins.shape[-1] == 5 and getattr(result, "best_iteration", -1) >= 0:
         # steady search: the dynamic corner margin, with the skew excursion max - rho_c measured
@@ -51,6 +40,11 @@ def plot_search(problem, result, path) -> pathlib.Path:
         if lc.min() < offset < lc.max():
             ax.contour(rr, tt, lc, levels=[offset], colors="tab:purple", linestyles="--", linewidths=1.2)
             ax.plot([], [], color="tab:purple", ls="--", label="dynamic corner margin = 0 (measured skew)")
+
+
+def _draw_paths(ax, result, h) -> None:
+    """Every start's path (its start a circle), the near-optimal designs as open diamonds and
+    the final design as a star."""
     if h:
         xs = np.asarray(h["x"])  # (I, S, 3)
         for s in range(xs.shape[1]):
@@ -78,6 +72,30 @@ def plot_search(problem, result, path) -> pathlib.Path:
             ms=14,
             label="final design",
         )
+
+
+def plot_search(problem, result, path) -> pathlib.Path:
+    """Write a PNG of every start's path in (R_end, theta_f) over the feasibility map of the
+    design zone (`jaxbearing.design_zone_grid`, at the final Delta_bf, or the start's when no
+    feasible design was found): feasible region shaded, zero lines of each margin, starts as
+    circles, the final design as a star, the near-optimal designs (`_steady.near_optimal_set`)
+    as open diamonds. For a steady search (five margins per iterate), the
+    dynamic corner margin's zero line too, dashed (`_steady`: the limited-circle margin equal to
+    the skew excursion measured at the final design plus the corner margin)."""
+    from jaxbearing.io import pyplot
+
+    plt = pyplot()
+
+    from ._problem import feasibility_map
+
+    x_ref = result.design if result.design is not None else result.start_design
+    r, t, z = feasibility_map(problem, float(x_ref[2]))
+    rr, tt = np.meshgrid(r * 1e3, np.degrees(t), indexing="ij")
+    fig, ax = plt.subplots(figsize=(7, 5))
+    _draw_zone(ax, rr, tt, z)
+    h = _history(result)
+    _draw_corner_margin(ax, rr, tt, z, result, h)
+    _draw_paths(ax, result, h)
     ax.set_xlabel("end radius R_end [mm]")
     ax.set_ylabel("layback angle theta_f [deg]")
     free_clearance = problem.bounds.upper[2] > problem.bounds.lower[2]

@@ -139,6 +139,19 @@ def _objective_batch(problem: DesignProblem, u):
     return jax.vmap(problem.objective)(u)
 
 
+def _without_design(status: str, **fields) -> SearchResult:
+    """A `SearchResult` that found no feasible design (`status` says why), with `fields`."""
+    return SearchResult(
+        status=status,
+        feasible=False,
+        design=None,
+        objective=float("nan"),
+        peak_pv=None,
+        margins=None,
+        **fields,
+    )
+
+
 def search(
     problem: DesignProblem,
     *,
@@ -167,13 +180,8 @@ def search(
 
     found, _ = any_feasible(problem)
     if not found:
-        return SearchResult(
-            status="no_feasible_design_in_bounds",
-            feasible=False,
-            design=None,
-            objective=float("nan"),
-            peak_pv=None,
-            margins=None,
+        return _without_design(
+            "no_feasible_design_in_bounds",
             start_design=x_start,
             start_objective=float("nan"),
             start_margins=start_margins,
@@ -199,15 +207,7 @@ def search(
         compile_time_s=compile_time,
     )
     if best[1] < 0:
-        return SearchResult(
-            status="no_feasible_iterate",
-            feasible=False,
-            design=None,
-            objective=float("nan"),
-            peak_pv=None,
-            margins=None,
-            **common,
-        )
+        return _without_design("no_feasible_iterate", **common)
     _, i, s = best
     return SearchResult(
         status="ok",

@@ -22,7 +22,7 @@ from jaxbearing import UserInputError
 from jaxbearing.io import KEYS
 from jaxbearing.sweep import loads_sweep_spec
 from jaxbearing.sweep._spec import _SWEEP_FIELDS
-from optimise._problem import OPTIMISE_TOML_KEYS, load_optimise_toml
+from optimise._toml import OPTIMISE_TOML_KEYS, load_optimise_toml
 
 
 def _settings(n: int):

@@ -223,7 +223,7 @@ def test_lock_file_holding_a_pickle_is_not_unpickled(tmp_path, plant):
 
 def test_toml_inputs_refuse_a_planted_pickle(tmp_path, plant):
     from jaxbearing.sweep import load_sweep_spec
-    from optimise._problem import load_optimise_toml
+    from optimise._toml import load_optimise_toml
 
     path = tmp_path / "input.toml"
     marker = plant(path)

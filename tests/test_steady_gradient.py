@@ -1,4 +1,4 @@
-"""The gradient estimator of the steady objective (issue 13, item 2; design/_steady_gradient.py).
+"""The gradient estimator of the steady objective (issue 13, item 2; design/_steady_objective.py, _window_gradient.py, _frozen_load.py).
 
 Fast checks at a reduced size (11 slices per raceway): the ratio estimator's derivative and
 its jackknife against closed forms, the frozen-load estimator (the default) against central
@@ -19,7 +19,9 @@ import pytest
 
 import jaxbearing as jb
 from jaxbearing.design import ratio_gradient, steady_gradient, tangent_growth
-from jaxbearing.design._steady_gradient import STEADY_FUNCTIONALS, trajectory_states, window_integrals
+from jaxbearing.design._frozen_load import trajectory_states
+from jaxbearing.design._steady_objective import STEADY_FUNCTIONALS
+from jaxbearing.design._window_gradient import window_integrals
 from jaxbearing.dynamics import contact_loads
 from jaxbearing.flange import DesignVariables
 from jaxbearing.run import skid_start
@@ -42,7 +44,7 @@ def test_ratio_gradient_is_the_quotient_rule():
 
 def test_jackknife_of_a_mean_is_the_standard_error():
     """With c = 1 the ratio is the mean of a, whose jackknife SE is exactly s / sqrt(K)."""
-    from jaxbearing.design._steady_gradient import _jackknife_stderr
+    from jaxbearing.design._steady_objective import _jackknife_stderr
 
     rng = np.random.default_rng(1)
     a = rng.normal(size=9)
@@ -180,7 +182,7 @@ def _frozen_window_states(b, op, state, window=1e-3, num_saves=200):
 def test_peak_statistic_combines_as_the_p_mean():
     """`_combine` with exponent p: J = PV_ref (sum A / sum C)^(1/p) and its gradient by the
     chain rule, on fabricated per-sample integrals and Jacobians (A and C linear in x)."""
-    from jaxbearing.design._steady_gradient import _combine
+    from jaxbearing.design._steady_objective import _combine
 
     rng = np.random.default_rng(0)
     vals = rng.uniform(0.5, 2.0, (6, 2))
@@ -203,7 +205,7 @@ def test_peak_statistic_combines_as_the_p_mean():
 def test_tail_statistic_combines_as_the_rockafellar_uryasev_form():
     """`_combine` with a tail threshold q: J = q + PV_ref (sum A / sum C) / (1 - alpha) and its
     gradient at fixed q, on fabricated per-sample integrals and Jacobians (A and C linear in x)."""
-    from jaxbearing.design._steady_gradient import _combine
+    from jaxbearing.design._steady_objective import _combine
     from jaxbearing.run import TAIL_LEVEL
 
     rng = np.random.default_rng(1)
@@ -269,7 +271,7 @@ def test_frozen_load_derivative_matches_central_differences(settled, frozen_wind
     estimator's own 1 ms window from a settled state; for the mean (p = 1), the peak
     statistic's p-mean (p = 8) and the tail statistic (every touching sample's frozen PV,
     `frozen_tail_samples`, whose Jacobian `tail_integrals` sums over the worst 5 %)."""
-    from jaxbearing.design._steady_gradient import frozen_load_integrands, frozen_pv, frozen_tail_samples
+    from jaxbearing.design._frozen_load import frozen_load_integrands, frozen_pv, frozen_tail_samples
 
     b, op, _, _ = settled
     x = jnp.asarray(DesignVariables.of(b).as_array())
@@ -482,7 +484,8 @@ def test_tail_integrals_take_the_threshold_from_their_own_samples():
     dA = sum over the samples above q of their Jacobian; a failed trajectory stays NaN. Combined,
     J = q + PV_ref (sum A / sum C) / (1 - alpha) is the tail mean of the pooled samples (200
     touching: 10 above q, `test_tail_mean_is_the_minimum_of_the_rockafellar_uryasev_function`)."""
-    from jaxbearing.design._steady_gradient import _combine, tail_integrals
+    from jaxbearing.design._frozen_load import tail_integrals
+    from jaxbearing.design._steady_objective import _combine
     from jaxbearing.run import tail_mean
 
     rng = np.random.default_rng(6)

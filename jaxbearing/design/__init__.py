@@ -40,6 +40,7 @@ from ._design import (
     forward_jacobian,
     seated_perturbation,
 )
+from ._frozen_load import frozen_load_gradient, frozen_load_gradients
 from ._sensitivity import METHODS as SENSITIVITY_METHODS
 from ._sensitivity import (
     MODEL_CONSTANTS,
@@ -58,19 +59,16 @@ from ._steady_design import (
     steady_design_metrics,
     steady_design_metrics_points,
 )
-from ._steady_gradient import (
+from ._steady_objective import (
     GRADIENT_WINDOW,
     PEAK_EXPONENT,
     STATISTICS,
     STEADY_FUNCTIONALS,
     SteadyGradient,
-    frozen_load_gradient,
-    frozen_load_gradients,
     paired_central_difference,
     ratio_gradient,
-    steady_gradient,
-    tangent_growth,
 )
+from ._window_gradient import steady_gradient, tangent_growth
 
 __all__ = [
     "CORNER_MARGIN",

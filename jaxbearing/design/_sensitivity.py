@@ -55,7 +55,7 @@ from ..run import (
     simulate_steady_points,
     steady_statistics,
 )
-from ._steady_gradient import paired_central_difference
+from ._steady_objective import paired_central_difference
 
 
 @dataclasses.dataclass(frozen=True)

@@ -24,7 +24,7 @@ confidence interval (Student-t over the seeds' batch means, `jaxbearing.run.stud
 beside the four static design-zone margins of `flange.zone_margins` (relief, height,
 limited circle, clearance; positive when satisfied) and the full settled summary.
 
-- `objective`: the smooth mean PV over contact time of `_steady_gradient` (the accumulators
+- `objective`: the smooth mean PV over contact time of `_steady_objective` (the accumulators
   int w PV dt / int w dt with the smooth contact indicator w = Q / (Q + 1 N), integrated inside
   the solve over the window), per seed, with its Student-t interval over the seeds: the quantity
   the optimiser minimises and whose gradient `steady_gradient` estimates (`mean_pv` is the same
@@ -72,7 +72,7 @@ from ..run import (
     summarise_steady,
     window_statistics,
 )
-from ._steady_gradient import STATISTICS, _functionals
+from ._steady_objective import STATISTICS, _functionals
 
 #: default dynamic corner margin [m]: the largest contact radius this far inside the limited circle
 CORNER_MARGIN = 0.05e-3

@@ -104,6 +104,69 @@ class FlangeContact(eqx.Module):
     face_error: Float[Array, "*batch"]  # tangent-plane error at C, sin(theta_f) rho (1 - cos psi)
 
 
+def _flange_sliding(
+    n, c, p, c_r, roller_velocity, roller_angular_velocity, ring_velocity, ring_angular_velocity
+):
+    """(v_roller(C), v_ring(C), u, d(delta)/dt, |u|, roller surface speed) at the flange contact
+    point C with normal n (from the roller into the flange), roller centre p, ring centre c_r.
+
+    Sliding velocity (paper Eqs. 12 and 26): u = (v + w x (C - p)) - (v_r + w_r x (C - c_r)),
+    minus its component along n: the material sliding velocity, from which PV is formed; the
+    component along n is the approach rate d(delta)/dt. The paper's Figure 7c ranks corner
+    contacts as sliding faster than arc contacts, which is what the roller's own surface speed at
+    the contact, |w x (C - p)| (tangential part; the flange's motion ignored), gives: reported as
+    `roller_surface_speed`, never used in PV."""
+    v_roller = roller_velocity + jnp.cross(roller_angular_velocity, c - p)
+    v_ring = ring_velocity + jnp.cross(ring_angular_velocity, c - c_r)
+    u = v_roller - v_ring
+    approach_rate = jnp.dot(u, n)  # n points from the roller into the flange
+    u = u - approach_rate * n
+    speed = safe_norm(u)
+    spin_surface = jnp.cross(roller_angular_velocity, c - p)
+    surface_speed = safe_norm(spin_surface - jnp.dot(spin_surface, n) * n)
+    return v_roller, v_ring, u, approach_rate, speed, surface_speed
+
+
+def _flange_normal_load(g, approach_rate, e_prime, damping):
+    """(Q, p_max, ellipse semi-axes (2,)) of the flange contact of geometry `g` (`flange_geometry`).
+
+    Hertz point contact of the end surface against the plane (exact elliptic solution, via
+    `jaxbearing.contact`): principal radii R_end, R_end on the arc; R_cor across the corner and
+    rho_c / sin(alpha) along it on the corner torus, blended C1 across the limited circle
+    (`end_principal_curvatures`). Q = K delta^1.5 (softplus of width PENETRATION_WIDTH),
+    p_max = 3Q/(2 pi a b).
+
+    Normal damping (Hunt & Crossley 1975, as on the raceways and pockets): the elastic load is
+    multiplied by s(1 + 1.5 alpha d(delta)/dt), d(delta)/dt = (v_roller(C) - v_ring(C)) . n,
+    alpha = `damping` [s/m] (`jaxbearing.contact.hunt_crossley_factor`)."""
+    stiffness = point_contact_stiffness(g.radius_meridian, g.radius_parallel, e_prime)
+    q = hertz_force(g.interference, stiffness, PENETRATION_WIDTH) * hunt_crossley_factor(
+        approach_rate, damping
+    )
+    # both are 0, with zero derivatives, for Q below jaxbearing.contact's load floor
+    p_max = point_contact_peak_pressure(q, g.radius_meridian, g.radius_parallel, e_prime)
+    semi = jnp.stack(point_contact_ellipse(q, g.radius_meridian, g.radius_parallel, e_prime))
+    return q, p_max, semi
+
+
+def _flange_friction(bearing, g, q, u, v_roller, v_ring, centres, e_prime):
+    """(film, mu, F_t) of the flange contact of geometry `g` at load `q` and sliding velocity u;
+    `centres` = (p, v, c_r, v_r): the roller's and the ring's centres and velocities.
+
+    Lubrication (`_lubrication`): entrainment velocity u_e = P_t((v_1(C) + v_2(C))/2 - v_C)
+    with the contact point's velocity v_C = v + Omega X x (C - p) (Omega: the roller's azimuth
+    rate), Hamrock-Dowson h_min and h_c with the end's principal radii along and across u_e,
+    Lambda = h_min / sigma. mu = mu_f (`bearing.flange_lubrication == "dry"`, the default) or
+    the mixed law f_a(Lambda) mu_f + (1 - f_a) kappa(|u|) ("mixed"). Friction
+    F_t = -mu Q u / sqrt(|u|^2 + u_eps^2)."""
+    p, roller_velocity, c_r, ring_velocity = centres
+    v_c = contact_point_velocity(p, roller_velocity, c_r, ring_velocity, g.contact_point)
+    film = flange_film(bearing, g, q, v_roller, v_ring, v_c, e_prime)
+    mu = flange_friction_coefficient(bearing, film.film_parameter, u)
+    f_t = -mu * q * smooth_direction(u, SLIDING_EPS)
+    return film, mu, f_t
+
+
 def roller_flange_contact(
     bearing: Bearing,
     raceway_radius: ArrayLike,
@@ -123,36 +186,16 @@ def roller_flange_contact(
     """Contact of one roller end with one ring flange (docs/model.md 5; the caller vmaps).
 
     Interference delta = h(n) - (P0 - p) . n with h the support function of the end body
-    (`jaxbearing._roller_end.end_support`); contact point C = its extreme point.
-
-    Sliding velocity (paper Eqs. 12 and 26): u = (v + w x (C - p)) - (v_r + w_r x (C - c_r)),
-    minus its component along n: the material sliding velocity, from which PV is formed. The
-    paper's Figure 7c ranks corner contacts as sliding faster than arc contacts, which is what
-    the roller's own surface speed at the contact, |w x (C - p)| (tangential part; the flange's
-    motion ignored), gives: reported as `roller_surface_speed`, never used in PV.
-
-    Normal damping (Hunt & Crossley 1975, as on the raceways and pockets): the elastic load is
-    multiplied by s(1 + 1.5 alpha d(delta)/dt), d(delta)/dt = (v_roller(C) - v_ring(C)) . n,
-    alpha = `damping` [s/m] (`jaxbearing.contact.hunt_crossley_factor`).
-
-    Hertz point contact of the end surface against the plane (exact elliptic solution, via
-    `jaxbearing.contact`): principal radii R_end, R_end on the arc; R_cor across the corner and
-    rho_c / sin(alpha) along it on the corner torus, blended C1 across the limited circle
-    (`end_principal_curvatures`). Q = K delta^1.5 (softplus of width PENETRATION_WIDTH),
-    p_max = 3Q/(2 pi a b), friction F_t = -mu Q u / sqrt(|u|^2 + u_eps^2), PV = p_max |u|.
-
-    Lubrication (`_lubrication`): entrainment velocity u_e = P_t((v_1(C) + v_2(C))/2 - v_C)
-    with the contact point's velocity v_C = v + Omega X x (C - p) (Omega: the roller's azimuth
-    rate), Hamrock-Dowson h_min and h_c with the end's principal radii along and across u_e,
-    Lambda = h_min / sigma. mu = mu_f (`bearing.flange_lubrication == "dry"`, the default) or
-    the mixed law f_a(Lambda) mu_f + (1 - f_a) kappa(|u|) ("mixed").
+    (`jaxbearing._roller_end.end_support`); contact point C = its extreme point. Sliding velocity
+    u and the roller's surface speed: `_flange_sliding`; normal load Q (Hertz point contact,
+    Hunt-Crossley damping), peak pressure p_max and contact ellipse: `_flange_normal_load`; film,
+    friction coefficient mu and friction force F_t: `_flange_friction`; PV = p_max |u|.
 
     Top edge: `top_edge` = 1 where the exact radial height of C above the raceway,
     g(|C - c_r|_YZ - R_r), exceeds the flange height H_rf: the contact is then computed on the
     plane continued beyond a flange that is not there (reported, not corrected).
 
-    Forces: on the roller F = -Q n + F_t with moment (C - p) x F about its centre; on the ring
-    -F with moment (C - c_r) x (-F) about the ring centre.
+    Forces: on the roller F = -Q n + F_t, moment (C - p) x F; on the ring -F, moment (C - c_r) x (-F).
 
     Arguments: `raceway_radius` R_r of the ring; `side` s = -1 or +1 (flange at -X or +X);
     `ring_sign` g = +1 inner ring, -1 outer ring; roller centre p, unit axis e (about +X),
@@ -169,27 +212,13 @@ def roller_flange_contact(
     c_r = jnp.asarray(ring_centre)
     e_prime = flange_effective_modulus(bearing)
 
-    v_roller = roller_velocity + jnp.cross(roller_angular_velocity, c - p)
-    v_ring = ring_velocity + jnp.cross(ring_angular_velocity, c - c_r)
-    u = v_roller - v_ring
-    approach_rate = jnp.dot(u, n)  # n points from the roller into the flange
-    u = u - approach_rate * n
-    speed = safe_norm(u)
-    spin_surface = jnp.cross(roller_angular_velocity, c - p)
-    surface_speed = safe_norm(spin_surface - jnp.dot(spin_surface, n) * n)
-
-    stiffness = point_contact_stiffness(g.radius_meridian, g.radius_parallel, e_prime)
-    q = hertz_force(g.interference, stiffness, PENETRATION_WIDTH) * hunt_crossley_factor(
-        approach_rate, damping
+    v_roller, v_ring, u, approach_rate, speed, surface_speed = _flange_sliding(
+        n, c, p, c_r, roller_velocity, roller_angular_velocity, ring_velocity, ring_angular_velocity
     )
-    # both are 0, with zero derivatives, for Q below jaxbearing.contact's load floor
-    p_max = point_contact_peak_pressure(q, g.radius_meridian, g.radius_parallel, e_prime)
-    semi = jnp.stack(point_contact_ellipse(q, g.radius_meridian, g.radius_parallel, e_prime))
-
-    v_c = contact_point_velocity(p, roller_velocity, c_r, ring_velocity, c)
-    film = flange_film(bearing, g, q, v_roller, v_ring, v_c, e_prime)
-    mu = flange_friction_coefficient(bearing, film.film_parameter, u)
-    f_t = -mu * q * smooth_direction(u, SLIDING_EPS)
+    q, p_max, semi = _flange_normal_load(g, approach_rate, e_prime, damping)
+    film, mu, f_t = _flange_friction(
+        bearing, g, q, u, v_roller, v_ring, (p, roller_velocity, c_r, ring_velocity), e_prime
+    )
     force = -q * n + f_t
     return FlangeContact(
         interference=g.interference,

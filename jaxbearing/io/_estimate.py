@@ -276,17 +276,31 @@ def _representative(key: str, plus_minus: float, what: str = "") -> tuple[Any, U
     return _est(_REF[key], plus_minus, f"the reference bearing's representative value{what}")
 
 
+#: density of through-hardened bearing steel [kg/m^3] (the inner ring's mass, the materials)
+_STEEL_DENSITY = 7830.0
+
+
 def _estimates(
     dim: BoundaryDimensions, num_rollers: int | None, diameter: float | None, length: float | None
 ) -> dict[str, tuple[Any, Uncertainty | None]]:
     """{key: (value, its Uncertainty, or None for a value the user gave)} of every key that
-    differs from its reference value or is estimated."""
+    differs from its reference value or is estimated: the roller set, then the ring, the roller
+    and flange, the cage, and the materials and lubricant."""
     out = _roller_set(dim, num_rollers, diameter, length)
     dm = out["bearing.pitch_diameter_mm"][0]
     dr = out["roller.diameter_mm"][0]
     lr = out["roller.length_mm"][0]
-    b = dim.width_mm
-    roller = "roller.diameter_mm"
+    out.update(_ring_estimates(dm, dr, dim.width_mm))
+    out.update(_roller_flange_estimates(dr, lr))
+    out.update(_cage_estimates(dm, dr, lr, dim.width_mm))
+    out.update(_material_lubricant_estimates())
+    return out
+
+
+def _ring_estimates(dm: float, dr: float, b: float) -> dict:
+    """The clearance, the inner ring's mass and the tractions of a bearing of pitch diameter
+    `dm`, roller diameter `dr` and width `b` [mm] (`_estimates`)."""
+    out = {}
     clearance = _REF["bearing.radial_clearance_um"] * dm / _REF["bearing.pitch_diameter_mm"]
     out["bearing.radial_clearance_um"] = _est(
         clearance,
@@ -294,9 +308,8 @@ def _estimates(
         f"{_SCALED} in proportion to d_m (an operating clearance: the unmounted ISO 5753-1 "
         "groups are larger; set your mounted clearance); +/- 50 %",
     )
-    rho = 7830.0
     inner_raceway = dm - dr
-    mass = rho * math.pi / 4 * inner_raceway**2 * b * 1e-9
+    mass = _STEEL_DENSITY * math.pi / 4 * inner_raceway**2 * b * 1e-9
     out["bearing.inner_ring_mass_kg"] = _est(
         mass,
         0.5 * mass,
@@ -305,6 +318,14 @@ def _estimates(
     )
     out["bearing.flange_traction"] = _representative("bearing.flange_traction", 0.02)
     out["bearing.pocket_friction"] = _representative("bearing.pocket_friction", 0.03)
+    return out
+
+
+def _roller_flange_estimates(dr: float, lr: float) -> dict:
+    """The roller's profile and the flange of rollers of diameter `dr` and length `lr` [mm],
+    scaled from the reference bearing (`_estimates`)."""
+    out = {}
+    roller = "roller.diameter_mm"
     corner = _ratio("roller.corner_radius_mm", roller) * dr
     out["roller.corner_radius_mm"] = _scaled("roller.corner_radius_mm", roller, dr, 0.3)
     central = min(_ratio("roller.central_length_mm", "roller.length_mm") * lr, lr - 2 * corner)
@@ -322,6 +343,14 @@ def _estimates(
     out["flange.layback_angle_deg"] = _representative("flange.layback_angle_deg", 0.5)
     out["flange.axial_clearance_mm"] = _scaled("flange.axial_clearance_mm", roller, dr, 0.5)
     out["flange.roughness_um"] = _representative("flange.roughness_um", 0.1, " (ground end and flange)")
+    return out
+
+
+def _cage_estimates(dm: float, dr: float, lr: float, b: float) -> dict:
+    """The cage of a bearing of pitch diameter `dm`, roller diameter `dr`, roller length `lr`
+    and width `b` [mm] (`_estimates`)."""
+    out = {}
+    roller = "roller.diameter_mm"
     # cage: diameters about the pitch circle, clearances in proportion to D, width between the
     # roller length and the ring width
     half_gap = (_REF["bearing.pitch_diameter_mm"] - _REF["cage.inner_diameter_mm"]) / _REF[roller]
@@ -349,12 +378,18 @@ def _estimates(
         0.3 * land,
         f"{_SCALED}: {_ratio('cage.land_width_mm', 'cage.width_mm'):.4g} x cage width; +/- 30 %",
     )
+    return out
+
+
+def _material_lubricant_estimates() -> dict:
+    """The materials' and the lubricant's handbook or representative values (`_estimates`)."""
+    out = {}
     steel = "through-hardened bearing steel (AISI 52100 / 100Cr6), handbook value"
     for part in ("ring", "roller"):
         s = f"materials.{part}"
         out[f"{s}.elastic_modulus_GPa"] = _est(208.0, 5.0, f"{steel} (201-210 GPa in handbooks)")
         out[f"{s}.poisson_ratio"] = _est(0.3, 0.01, steel)
-        out[f"{s}.density_kg_m3"] = _est(rho, 30.0, steel)
+        out[f"{s}.density_kg_m3"] = _est(_STEEL_DENSITY, 30.0, steel)
     cage = " (steel; a catalogue cage may be brass, E ~ 100 GPa, rho ~ 8500 kg/m^3, or polyamide)"
     out["materials.cage.elastic_modulus_GPa"] = _representative(
         "materials.cage.elastic_modulus_GPa", 100.0, cage

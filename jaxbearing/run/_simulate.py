@@ -275,6 +275,20 @@ def solve(
         raceway_loosen=raceway_loosen,
         rotation_loosen=rotation_loosen,
     )
+    args, y0_scaled = _transient_start(bearing, op, perturbation, functionals)
+    saveat = _transient_saveat(duration, num_saves)
+    controller = _transient_controller(y0_scaled, rtol, atol, error_norm, raceway_loosen, rotation_loosen)
+    with checks_without_host_callbacks():  # cacheable program (`_compile_cache`)
+        sol = scaled_diffeqsolve(
+            y0_scaled, args, duration, saveat, controller, max_steps, adjoint, progress, solver
+        )
+    return _solution(sol, num_saves, args)
+
+
+def _transient_start(bearing: Bearing, op: OperatingPoint, perturbation, functionals):
+    """(SolveArgs, scaled initial state) of a start-up run: the quasi-static initial state with
+    `perturbation` (`initial_state`), scaled about itself (`Scaling`: the state's scales and the
+    kinematic cage speed's orbit)."""
     y0 = initial_state(bearing, op, perturbation)
     scaling = Scaling(
         nominal=y0,
@@ -282,31 +296,33 @@ def solve(
         orbit_speed=kinematic_cage_speed(bearing, op),
     )
     args = SolveArgs(params=Params(bearing=bearing, operating=op, functionals=functionals), scaling=scaling)
-    y0_scaled = scaling.scale_state(0.0, y0)
+    return args, scaling.scale_state(0.0, y0)
+
+
+def _transient_saveat(duration, num_saves: int):
+    """What `solve` keeps: `num_saves` equally spaced samples over [0, duration] and the smooth
+    functionals at t1, or only the functionals (`num_saves` = 0)."""
     if num_saves:
         samples = diffrax.SubSaveAt(ts=jnp.linspace(0.0, duration, num_saves), fn=_saved_state)
-        saveat = diffrax.SaveAt(subs=[samples, diffrax.SubSaveAt(t1=True, fn=_save_functionals)])
-    else:
-        saveat = diffrax.SaveAt(t1=True, fn=_save_functionals)
+        return diffrax.SaveAt(subs=[samples, diffrax.SubSaveAt(t1=True, fn=_save_functionals)])
+    return diffrax.SaveAt(t1=True, fn=_save_functionals)
+
+
+def _transient_controller(y0_scaled, rtol, atol, error_norm, raceway_loosen, rotation_loosen):
+    """The step controller of `solve`: its `error_norm` by name (None: `TRANSIENT_ERROR_NORM`)
+    with the raceway-normal and rotation loosening (`raceway_normal_norm`), or a given norm."""
     if error_norm is None or isinstance(error_norm, str):
         norm = raceway_normal_norm(
             y0_scaled, raceway_loosen, error_norm or TRANSIENT_ERROR_NORM, rotation_loosen
         )
     else:
         norm = error_norm
-    controller = step_controller(rtol, atol, norm)
-    with checks_without_host_callbacks():  # cacheable program (`_compile_cache`)
-        sol = scaled_diffeqsolve(
-            y0_scaled,
-            args,
-            duration,
-            saveat,
-            controller,
-            max_steps,
-            adjoint,
-            progress,
-            solver,
-        )
+    return step_controller(rtol, atol, norm)
+
+
+def _solution(sol, num_saves: int, args: SolveArgs) -> Solution:
+    """The `Solution` of `solve` from diffrax's: the histories of the saved samples (none
+    without them), the accumulators at t1, the result code and the step counts."""
     if num_saves:
         saved, integrals = sol.ys
         hist = _histories(sol.ts[0], saved, args)

@@ -159,15 +159,40 @@ class _Profile:
         return -float(best.fun)
 
 
-def tail_fit_bounds(rows, rho_lim, confidence, n):
-    """(p^, lower, upper, TailFit) by the peaks-over-threshold fit (module docstring); None when
-    ties leave too few values above the threshold."""
-    values = np.concatenate(rows)
+def _threshold(values, n: int) -> float:
+    """The threshold u of the peaks-over-threshold fit: midway between the k-th and (k+1)-th
+    largest of the `n` `values`, k = max(`MIN_TAIL_EXCEEDANCES`, `TAIL_FRACTION` n); with ties
+    there, the (k+1)-th largest itself (every value above u then exceeds it)."""
     k = max(MIN_TAIL_EXCEEDANCES, math.ceil(TAIL_FRACTION * n))
     srt = np.sort(values)
     u = 0.5 * (srt[n - k - 1] + srt[n - k])
     if srt[n - k] <= u:  # ties at the threshold: every value above u exceeds it
         u = float(srt[n - k - 1])
+    return u
+
+
+def _exceedance_design_effect(rows, u: float, zeta: float) -> float:
+    """The dependence of the exceedances of `u` (module docstring): the design effect of the
+    threshold-exceedance indicator over members (`rows`), or, where larger, that of its lag-1
+    autocorrelation r1 within members, (1 + r1) / (1 - r1); `zeta` the exceedance rate."""
+    counts = [np.sum(r > u) for r in rows]
+    deff = cluster_design_effect(counts, [r.size for r in rows])
+    ind = [(r > u).astype(float) for r in rows if r.size >= 2]
+    if ind:
+        c = np.concatenate([i - zeta for i in ind])
+        num = sum(float(np.sum((i[1:] - zeta) * (i[:-1] - zeta))) for i in ind)
+        den = float(np.sum(c * c))
+        r1 = num / den if den > 0 else 0.0
+        if 0 < r1 < 1:
+            deff = max(deff, (1 + r1) / (1 - r1))
+    return deff
+
+
+def tail_fit_bounds(rows, rho_lim, confidence, n):
+    """(p^, lower, upper, TailFit) by the peaks-over-threshold fit (module docstring); None when
+    ties leave too few values above the threshold."""
+    values = np.concatenate(rows)
+    u = _threshold(values, n)
     excess = values[values > u] - u
     k = int(excess.size)
     if k < MIN_TAIL_EXCEEDANCES // 2:  # ties at the top: too few distinct exceedances to fit
@@ -179,18 +204,7 @@ def tail_fit_bounds(rows, rho_lim, confidence, n):
         return None
     p_hat = zeta * _survival(z, sigma, shape)
     ll_hat = _binomial_ll(k, n, zeta) - nll
-    # dependence: the design effect of the threshold-exceedance indicator over members and the
-    # lag-1 autocorrelation within members (module docstring)
-    counts = [np.sum(r > u) for r in rows]
-    deff = cluster_design_effect(counts, [r.size for r in rows])
-    ind = [(r > u).astype(float) for r in rows if r.size >= 2]
-    if ind:
-        c = np.concatenate([i - zeta for i in ind])
-        num = sum(float(np.sum((i[1:] - zeta) * (i[:-1] - zeta))) for i in ind)
-        den = float(np.sum(c * c))
-        r1 = num / den if den > 0 else 0.0
-        if 0 < r1 < 1:
-            deff = max(deff, (1 + r1) / (1 - r1))
+    deff = _exceedance_design_effect(rows, u, zeta)
     cut = deff * float(_sp_stats.chi2.ppf(confidence, 1))
     profile = _Profile(excess, k, n, z, shape)
 

@@ -1,0 +1,285 @@
+"""The frozen-load estimator of the gradient of the steady-running design objective
+(docs/model.md 17; the objective, its statistics and the ratio estimator: `_steady_objective`).
+
+Estimator. From each of K settled states of design d, a plain solve over a short window saves
+the state at equally spaced times. At every saved state the flange PV of each roller-end/flange
+contact is differentiated in the design at the loads Q0 the dynamics gave there (the load held
+frozen): by Hertz, p_max = c(radii) Q^(1/3), so PV_c(d) (Q0_c / Q_c(d))^(1/3) is the PV at load Q0
+with the contact point, curvatures and sliding velocity of design d. The per-trajectory sums
+A_k, C_k of the smooth-indicator-weighted samples and their Jacobians are combined through the
+ratio estimator, with the jackknife over the trajectories. The tail statistic applies the same
+estimator to the Rockafellar-Uryasev integrand at the 95th percentile of the trajectories' own
+touching samples (`tail_integrals`; `_steady_objective`, the tail statistic).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import diffrax
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from .._errors import UserInputError
+from ..contact import LOAD_FLOOR
+from ..dynamics import Params, State, contact_loads
+from ..flange import DesignVariables
+from ..geometry import Bearing, OperatingPoint
+from ..io import require
+from ..run import (
+    CONTACT_THRESHOLD,
+    STRATEGIES,
+    TAIL_LEVEL,
+    checks_without_host_callbacks,
+    choose_strategy,
+    compiled_program,
+    parallel_map,
+    prepare_from,
+    result_code,
+    scaled_diffeqsolve,
+    stack_trees,
+)
+from ._design import forward_jacobian
+from ._steady_objective import (
+    STEADY_FUNCTIONALS,
+    SteadyGradient,
+    _check_window,
+    _combine,
+    _design_params,
+    _failed_integrals,
+    _functionals,
+)
+
+
+def trajectory_states(
+    bearing, op, start: State, duration: float, num_saves: int, *, rtol=1e-3, atol=1e-6, max_steps=400_000
+):
+    """The physical states at `num_saves` equally spaced times in (0, duration] of a plain
+    solve from `start` (a State with a leading time axis on every leaf)."""
+    params = Params(bearing=bearing, operating=op, functionals=STEADY_FUNCTIONALS)
+    scaling, args, y0, controller = prepare_from(
+        params, jax.tree_util.tree_map(jnp.asarray, start), rtol, atol
+    )
+    ts = jnp.linspace(0.0, duration, num_saves + 1)[1:]
+    saveat = diffrax.SaveAt(ts=ts, fn=lambda t, y, a: a.scaling.unscale(t, y))
+    with checks_without_host_callbacks():
+        sol = scaled_diffeqsolve(y0, args, duration, saveat, controller, max_steps, None, False)
+    return sol.ys, result_code(sol.result)
+
+
+def _reference_loads(bearing, op, x, states):
+    """The flange contact loads Q0 (T, Z, 4) the dynamics gave at the saved `states` (a leading
+    time axis) of design x: the loads the frozen-load estimator holds."""
+    return jax.vmap(lambda s: contact_loads(s, _design_params(bearing, op, x)).flange.normal_force)(states)
+
+
+def frozen_pv(bearing, op, x, state: State, reference_load):
+    """(w(Q0_c), PV_c(x) (Q0_c / Q_c(x))^(1/3) / PV_ref), each (Z, 4), over the flange contacts of
+    one state: the flange PV with design x at the loads Q0 = `reference_load` (Z, 4) the
+    dynamics gave (module docstring, frozen-load estimator), and the smooth contact indicator.
+    Hertz: p_max = c(radii) Q^(1/3), so PV (Q0/Q)^(1/3) is the PV at load Q0 with the contact
+    point, curvatures and sliding velocity of design x."""
+    fl = contact_loads(state, _design_params(bearing, op, x)).flange
+    q0 = reference_load
+    on = (q0 > LOAD_FLOOR) & (fl.normal_force > LOAD_FLOOR)
+    safe_q = jnp.where(on, fl.normal_force, 1.0)
+    ratio = jnp.where(on, (jnp.where(on, q0, 1.0) / safe_q) ** (1.0 / 3.0), 0.0)
+    w = q0 / (q0 + STEADY_FUNCTIONALS.contact_load)
+    return w, fl.pv * ratio / STEADY_FUNCTIONALS.pv_reference
+
+
+def frozen_load_integrands(bearing, op, x, state: State, reference_load, exponent=1.0):
+    """(sum_c w(Q0_c) (PV_c(x) (Q0_c / Q_c(x))^(1/3) / PV_ref)^p, sum_c w(Q0_c)) over the flange
+    contacts of one state, p = `exponent` (`frozen_pv`)."""
+    w, frozen = frozen_pv(bearing, op, x, state, reference_load)
+    return jnp.stack([jnp.sum(w * frozen**exponent), jnp.sum(w)])
+
+
+def frozen_tail_samples(bearing, op, x, states):
+    """The tail statistic's samples along one trajectory (`states`: a leading time axis): per
+    saved state and flange contact, the statistics' hard contact indicator 1(Q0 > 1 N), the
+    frozen PV / PV_ref at x (`frozen_pv`) and its Jacobian in x (leading axis 3)."""
+    q0 = _reference_loads(bearing, op, x, states)
+    pv, dpv = forward_jacobian(
+        lambda v: jax.vmap(lambda s, q: frozen_pv(bearing, op, v, s, q)[1])(states, q0), x
+    )
+    return (q0 > CONTACT_THRESHOLD).astype(float), pv, dpv
+
+
+def tail_integrals(samples) -> tuple[list, float]:
+    """The tail statistic's per-trajectory integrals from `frozen_tail_samples` of every
+    trajectory of one design ((w, pv, dpv) each, or None for a failed one): q, the 95th
+    percentile of the frozen PV / PV_ref over every touching sample, and per trajectory
+    ((A, C), Jacobian (3, 2)) with A = sum w (pv - q)^+, C = sum w, dA = sum w 1(pv > q) dpv
+    (the Rockafellar-Uryasev form at fixed q, `_steady_objective`'s tail statistic). Returns (outs, q)."""
+    touching = [np.asarray(pv)[np.asarray(w) > 0.5] for w, pv, _ in filter(None, samples)]
+    pooled = np.concatenate(touching) if touching else np.zeros(0)
+    if pooled.size == 0:
+        return [_failed_integrals() for _ in samples], float("nan")
+    q = float(np.percentile(pooled, 100.0 * TAIL_LEVEL))
+    outs = []
+    for sample in samples:
+        if sample is None:
+            outs.append(_failed_integrals())
+            continue
+        w, pv, dpv = (np.asarray(a) for a in sample)
+        above = w * (pv > q)
+        a = float(np.sum(w * np.maximum(pv - q, 0.0)))
+        da = np.sum(above[None] * dpv, axis=tuple(range(1, dpv.ndim)))
+        outs.append((np.array([a, float(np.sum(w))]), np.stack([da, np.zeros(3)], axis=1)))
+    return outs, q
+
+
+@dataclasses.dataclass(frozen=True)
+class _FrozenSample:
+    """Picklable frozen-load integrals and Jacobians along one trajectory (`parallel_map`)."""
+
+    bearing: Bearing
+    op: OperatingPoint
+    x: np.ndarray
+    duration: float
+    num_saves: int
+    rtol: float
+    exponent: float = 1.0
+    tail: bool = False  # the tail statistic's samples (`frozen_tail_samples`) instead of sums
+
+    def __call__(self, state):
+        x = jnp.asarray(self.x)
+        state = jax.tree_util.tree_map(jnp.asarray, state)
+        num_saves = self.num_saves
+        args = (self.bearing, self.op, state, jnp.asarray(self.duration), jnp.asarray(self.rtol))
+        trajectory = lambda b, o, s, d, r: trajectory_states(b, o, s, d, num_saves, rtol=r)
+        states, code = compiled_program("trajectory_states", trajectory, args, num_saves)(*args)
+        if int(code) != 0:  # a failed trajectory: no samples (tail), NaN integrals (sums)
+            return None if self.tail else _failed_integrals()
+        if self.tail:
+            args = (self.bearing, self.op, x, states)
+            return tuple(
+                map(np.asarray, compiled_program("frozen_tail_samples", frozen_tail_samples, args)(*args))
+            )
+        args = (self.bearing, self.op, x, states, np.float64(self.exponent))
+        val, jac = compiled_program("frozen_load_jacobian", _frozen_jacobian, args)(*args)
+        return np.asarray(val), np.asarray(jac)
+
+
+def _frozen_jacobian(bearing, op, x, states, exponent=1.0):
+    """Sum over the saved states of the frozen-load integrands (`frozen_load_integrands`) and
+    their Jacobian in x."""
+    q0 = _reference_loads(bearing, op, x, states)
+
+    def total(v):
+        per = jax.vmap(lambda s, q: frozen_load_integrands(bearing, op, v, s, q, exponent))(states, q0)
+        return jnp.sum(per, axis=0)
+
+    return forward_jacobian(total, x)
+
+
+def frozen_load_gradient(
+    bearing: Bearing, op: OperatingPoint, design: DesignVariables, states, **options
+) -> SteadyGradient:
+    """The frozen-load estimate (module docstring) of the steady objective and its gradient at
+    `design` from `states`: `frozen_load_gradients` of this one case, with its `options`."""
+    return frozen_load_gradients([(bearing, op, design, states)], **options)[0]
+
+
+def frozen_load_gradients(
+    cases,
+    *,
+    window: float = 1.0e-3,
+    saves_per_ms: int = 200,
+    rtol: float = 1e-3,
+    workers: int = 1,
+    strategy: str = "auto",
+    statistic: str = "mean",
+) -> list[SteadyGradient]:
+    """The frozen-load estimate (module docstring) of the steady objective and its gradient for
+    every case (bearing, op, design, states), e.g. every start and operating point of one
+    iteration of the design search; one `SteadyGradient` per case, in order. From each of a
+    case's `states` (states of settled running of that design), a plain solve with `design`
+    applied to `bearing` (its other parameters kept) over `window` seconds saves the state every
+    1 / `saves_per_ms` ms; at every saved state the flange PV is differentiated in the design at
+    the loads the dynamics gave (`frozen_load_integrands`), summed, and combined through the
+    ratio estimator; jackknife over the trajectories. `statistic`: "mean" (PV over contact
+    time), "peak" (its p-mean) or "tail" (the mean of its worst 5 %, at the 95th percentile of the
+    trajectories' own touching samples: `tail_integrals`; `STATISTICS`). Every trajectory of
+    every case is one member of one call (`strategy`, as the steady-running engine's
+    `choose_strategy`): "vmap" (the default on an accelerator) integrates and differentiates
+    them all in one vmapped program; on a CPU they run `workers` processes at a time
+    ("processes"), or one after another ("sequential")."""
+    _check_window(window)
+    require("saves_per_ms", saves_per_ms, lambda v: (v >= 1) & (v == np.round(v)), "an integer >= 1")
+    if strategy not in STRATEGIES:
+        raise UserInputError(f"strategy = {strategy!r}: must be one of {', '.join(map(repr, STRATEGIES))}")
+    exponent = float(_functionals(statistic).pv_exponent)
+    tail = statistic == "tail"
+    cases = list(cases)
+    n = max(1, int(round(window * 1e3 * saves_per_ms)))
+    jobs, owner = [], []
+    for k, (bearing, op, design, states) in enumerate(cases):
+        x = np.asarray(design.as_array(), dtype=float)
+        # the trajectories run with the design, as the settled states did: a bearing of another
+        # design would start every window off its contacts (micrometres against a changed end arc)
+        job = _FrozenSample(design.apply(bearing), op, x, float(window), n, float(rtol), exponent, tail)
+        jobs += [(job, s) for s in states]
+        owner += [k] * len(states)
+    outs = _run_frozen(jobs, strategy, workers)
+    per_case = [[o for o, j in zip(outs, owner) if j == k] for k in range(len(cases))]
+    if not tail:
+        return [_combine(o, window, exponent) for o in per_case]
+    found = []
+    for o in per_case:
+        integrals, q = tail_integrals(o)
+        found.append(_combine(integrals, window, tail_threshold=q * STEADY_FUNCTIONALS.pv_reference))
+    return found
+
+
+def _run_frozen(jobs, strategy: str, workers: int) -> list:
+    """The outputs of every (`_FrozenSample`, state) of `jobs`, in order, by `strategy`
+    (`choose_strategy`): one vmapped program ("vmap", `_frozen_samples_batched`), `workers`
+    processes ("processes") or one after another in this process ("sequential")."""
+    chosen = choose_strategy(strategy, min(int(workers), max(1, len(jobs))))
+    if not jobs:
+        return []
+    if chosen == "vmap":
+        return _frozen_samples_batched(jobs)
+    return parallel_map(_frozen_job, jobs, workers=workers if chosen == "processes" else 1)
+
+
+def _frozen_job(item):
+    """One (`_FrozenSample`, state) of `frozen_load_gradients` (picklable for `parallel_map`)."""
+    job, state = item
+    return job(state)
+
+
+def _frozen_samples_batched(jobs) -> list:
+    """Every (`_FrozenSample`, state) of `jobs` as one member of one vmapped program: its
+    trajectory and the frozen-load integrals and Jacobian along it."""
+    num_saves, tail = jobs[0][0].num_saves, jobs[0][0].tail
+
+    def one(b, o, x, s, d, r, p):
+        states, code = trajectory_states(b, o, s, d, num_saves, rtol=r)
+        if tail:
+            return frozen_tail_samples(b, o, x, states), code
+        return _frozen_jacobian(b, o, x, states, p), code
+
+    args = stack_trees(
+        [
+            (
+                job.bearing,
+                job.op,
+                jnp.asarray(job.x),
+                state,
+                np.float64(job.duration),
+                np.float64(job.rtol),
+                np.float64(job.exponent),
+            )
+            for job, state in jobs
+        ]
+    )
+    name = "frozen_tail_members" if tail else "frozen_load_members"
+    outs, codes = jax.device_get(compiled_program(name, jax.vmap(one), args, num_saves)(*args))
+    if tail:
+        return [tuple(a[i] for a in outs) if int(codes[i]) == 0 else None for i in range(len(jobs))]
+    vals, jacs = outs
+    return [(vals[i], jacs[i]) if int(codes[i]) == 0 else _failed_integrals() for i in range(len(jobs))]
