@@ -46,7 +46,7 @@ AGGREGATES = ("max", "mean")
 
 def _settings(args) -> dict:
     """Merge the optional TOML file with the command-line options (options win)."""
-    from ._problem import load_optimise_toml
+    from ._toml import load_optimise_toml
 
     s = load_optimise_toml(args.bounds_file) if args.bounds_file else {}
     for key, value in (

@@ -51,7 +51,6 @@ from jaxbearing.flange import (
 )
 from jaxbearing.io import check_model_inputs, check_solver_arguments, is_concrete, require
 
-from ._toml import load_optimise_toml  # noqa: F401  (the command line reads it from here)
 
 MM = 1e-3
 DEG = math.pi / 180
