@@ -51,7 +51,6 @@ from jaxbearing.flange import (
 )
 from jaxbearing.io import check_model_inputs, check_solver_arguments, is_concrete, require
 
-
 MM = 1e-3
 DEG = math.pi / 180
 #: scale of the design-zone margins (constraints are margin / MARGIN_SCALE)
