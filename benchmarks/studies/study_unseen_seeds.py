@@ -8,7 +8,8 @@ Both designs at every speed, every seed one member of one call of the steady-run
 reference bearing at 1000 N. Per design and speed: mean and peak flange PV with 95 % intervals,
 the corner-contact share of contact time, how many revolutions reached the limited circle, and
 the corner-contact risk per revolution with its bounds (`jaxbearing.run.corner_risk`). Writes
-benchmarks/results/NAME.json with the command, the commit and the machine.
+the results file `--name` names (under benchmarks/results) with the command, the commit and the
+machine.
 """
 
 from __future__ import annotations
