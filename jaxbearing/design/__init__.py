@@ -23,6 +23,11 @@
   differences of settled runs, or the static skid equilibrium for the cage slip), `Sensitivity`,
   `SensitivityInput`, `Effect`, `sensitivity_inputs`, `static_cage_slip`,
   `parse_sensitivity_statistics`.
+- designs robust to the model's constants: `robustness` (a design against a reference at every
+  corner of the uncertain constants' ranges, `DEFAULT_CONSTANTS`, and every operating point,
+  settled on the caller's seeds: mean and peak PV with 95 % intervals and whether the design's
+  lies below), `Robustness`, `RobustnessRow`, `RobustnessCorner`, `robustness_corners`,
+  `write_robustness_json`.
 
 The `optimise` package searches designs with these.
 
@@ -40,6 +45,9 @@ from ._design import (
     forward_jacobian,
     seated_perturbation,
 )
+from ._robustness import DEFAULT_CONSTANTS, Robustness, RobustnessRow, robustness, write_robustness_json
+from ._robustness import Corner as RobustnessCorner
+from ._robustness import corners as robustness_corners
 from ._sensitivity import METHODS as SENSITIVITY_METHODS
 from ._sensitivity import (
     MODEL_CONSTANTS,
@@ -74,6 +82,7 @@ from ._steady_gradient import (
 
 __all__ = [
     "CORNER_MARGIN",
+    "DEFAULT_CONSTANTS",
     "GRADIENT_ATOL",
     "GRADIENT_HORIZON",
     "GRADIENT_MODE_NOTE",
@@ -86,6 +95,9 @@ __all__ = [
     "STATISTICS",
     "STEADY_FUNCTIONALS",
     "DesignMetrics",
+    "Robustness",
+    "RobustnessCorner",
+    "RobustnessRow",
     "Effect",
     "Sensitivity",
     "SensitivityInput",
@@ -99,6 +111,8 @@ __all__ = [
     "paired_central_difference",
     "parse_sensitivity_statistics",
     "ratio_gradient",
+    "robustness",
+    "robustness_corners",
     "seated_perturbation",
     "sensitivity",
     "sensitivity_inputs",
@@ -107,4 +121,5 @@ __all__ = [
     "steady_design_metrics_points",
     "steady_gradient",
     "tangent_growth",
+    "write_robustness_json",
 ]
