@@ -156,7 +156,7 @@ def test_json_is_plain_data(fake, tmp_path):
     assert [c["name"] for c in data["corners"]] == [c.name for c in res.corners]
     assert data["not_lower"][0] == {"corner": res.corners[1].name, "point": 0, "statistic": "mean_pv"}
     assert data["rows"][3]["design_cage_slip"]["value"] == pytest.approx(res.row(1, 1).design_cage_slip.value)
-    assert [c["key"] for c in data["constants"]] == list(module.DEFAULT_CONSTANTS)
+    assert [c["key"] for c in data["constants"]] == list(module.ROBUSTNESS_CONSTANTS)
 
 
 def test_disjoint_means_wholly_below():

@@ -24,7 +24,7 @@
   `SensitivityInput`, `Effect`, `sensitivity_inputs`, `static_cage_slip`,
   `parse_sensitivity_statistics`.
 - designs robust to the model's constants: `robustness` (a design against a reference at every
-  corner of the uncertain constants' ranges, `DEFAULT_CONSTANTS`, and every operating point,
+  corner of the uncertain constants' ranges, `ROBUSTNESS_CONSTANTS`, and every operating point,
   settled on the caller's seeds: mean and peak PV with 95 % intervals and whether the design's
   lies below), `Robustness`, `RobustnessRow`, `RobustnessCorner`, `robustness_corners`,
   `write_robustness_json`.
@@ -45,9 +45,15 @@ from ._design import (
     forward_jacobian,
     seated_perturbation,
 )
-from ._robustness import DEFAULT_CONSTANTS, Robustness, RobustnessRow, robustness, write_robustness_json
-from ._robustness import Corner as RobustnessCorner
-from ._robustness import corners as robustness_corners
+from ._robustness import (
+    ROBUSTNESS_CONSTANTS,
+    Robustness,
+    RobustnessCorner,
+    RobustnessRow,
+    robustness,
+    robustness_corners,
+    write_robustness_json,
+)
 from ._sensitivity import METHODS as SENSITIVITY_METHODS
 from ._sensitivity import (
     MODEL_CONSTANTS,
@@ -82,7 +88,6 @@ from ._steady_gradient import (
 
 __all__ = [
     "CORNER_MARGIN",
-    "DEFAULT_CONSTANTS",
     "GRADIENT_ATOL",
     "GRADIENT_HORIZON",
     "GRADIENT_MODE_NOTE",
@@ -90,6 +95,7 @@ __all__ = [
     "GRADIENT_WINDOW",
     "MODEL_CONSTANTS",
     "PEAK_EXPONENT",
+    "ROBUSTNESS_CONSTANTS",
     "SENSITIVITY_METHODS",
     "SENSITIVITY_STATISTICS",
     "STATISTICS",

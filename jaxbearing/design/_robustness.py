@@ -23,7 +23,7 @@ The drag coefficient is not a constant of the model apart from the oil fraction:
 forces and torques are proportional to the oil-air mixture's density (White's C_d(Re) for the
 rollers, forces/_drag.py), so the oil fraction's range carries the drag coefficient's
 uncertainty (`MODEL_CONSTANTS`). The default constants are therefore the traction asymptote and
-the oil fraction (`DEFAULT_CONSTANTS`).
+the oil fraction (`ROBUSTNESS_CONSTANTS`).
 
 The cage slip of every run is kept: it shows that the constants acted (at high speed a lower
 traction asymptote lowers the drive of the roller set, and the cage slips more; docs/validation.md,
@@ -34,7 +34,6 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
-import json
 import math
 from collections.abc import Sequence
 from pathlib import Path
@@ -44,7 +43,7 @@ import numpy as np
 from .._errors import UserInputError
 from ..flange import DEFAULT_FLANGE_LOAD, DesignVariables, check_design, with_design, zone_margins
 from ..geometry import OperatingPoint, rad_s_to_rpm
-from ..io import Config, require
+from ..io import Config, require, write_json
 from ..run import Estimate, Perturbation, SteadySettings, simulate_steady_points
 from ._sensitivity import SensitivityInput, perturbed, sensitivity_inputs
 from ._steady_design import CORNER_MARGIN, _metrics
@@ -52,13 +51,13 @@ from ._steady_gradient import _functionals
 
 #: the constants varied by default: the traction curve's asymptote and the oil fraction (which
 #: carries the drag coefficient's uncertainty, module docstring)
-DEFAULT_CONSTANTS = ("lubricant.traction_d", "lubricant.oil_fraction")
+ROBUSTNESS_CONSTANTS = ("lubricant.traction_d", "lubricant.oil_fraction")
 #: the statistics compared (attribute names of `RobustnessRow`'s estimates)
 COMPARED = ("mean_pv", "peak_pv")
 
 
 @dataclasses.dataclass(frozen=True)
-class Corner:
+class RobustnessCorner:
     """One combination of the constants: `signs` (-1, +1 per constant; all 0 at the nominal
     point), `values` {key: value}, and a short `name` ("nominal", or "traction_d-, oil_fraction+")."""
 
@@ -102,7 +101,7 @@ class Robustness:
 
     constants: tuple[SensitivityInput, ...]
     steps: tuple[float, ...]
-    corners: tuple[Corner, ...]
+    corners: tuple[RobustnessCorner, ...]
     points: tuple[tuple[float, float], ...]
     design: dict
     reference: dict
@@ -154,11 +153,11 @@ def write_robustness_json(result: Robustness, path, **extra) -> Path:
     """Write `result.to_dict()` (and `extra` plain data, e.g. the command) as strict JSON."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(json.dumps(result.to_dict() | extra, indent=1, allow_nan=False) + "\n")
+    write_json(path, result.to_dict() | extra)
     return path
 
 
-def corners(cfg: Config, constants: Sequence[str] = DEFAULT_CONSTANTS):
+def robustness_corners(cfg: Config, constants: Sequence[str] = ROBUSTNESS_CONSTANTS):
     """(the chosen `SensitivityInput`s, their steps h, the corners with their configurations):
     the nominal point, then the 2^k corners x_i +/- h_i (module docstring). Unknown or repeated
     constants: one line naming `constants`."""
@@ -173,11 +172,11 @@ def corners(cfg: Config, constants: Sequence[str] = DEFAULT_CONSTANTS):
         raise UserInputError(f"constants = {keys!r}: give one or more different keys of {', '.join(inputs)}")
     chosen = tuple(inputs[k] for k in keys)
     steps = tuple(perturbed(cfg, i, i.plus_minus)[0] for i in chosen)
-    out = [(Corner("nominal", (0,) * len(keys), {i.key: i.value for i in chosen}), cfg)]
+    out = [(RobustnessCorner("nominal", (0,) * len(keys), {i.key: i.value for i in chosen}), cfg)]
     for signs in itertools.product((-1, 1), repeat=len(keys)):
         values = {i.key: i.value + s * h for i, s, h in zip(chosen, signs, steps)}
         name = ", ".join(f"{i.key.split('.')[-1]}{'+' if s > 0 else '-'}" for i, s in zip(chosen, signs))
-        out.append((Corner(name, signs, values), cfg.replace(values)))
+        out.append((RobustnessCorner(name, signs, values), cfg.replace(values)))
     return chosen, steps, out
 
 
@@ -201,7 +200,7 @@ def robustness(
     settings: SteadySettings | None = None,
     *,
     first_seed: int,
-    constants: Sequence[str] = DEFAULT_CONSTANTS,
+    constants: Sequence[str] = ROBUSTNESS_CONSTANTS,
     flange_load: float = DEFAULT_FLANGE_LOAD,
 ) -> Robustness:
     """`design` against `reference` (default: the configuration's own design) over the corners
@@ -216,7 +215,7 @@ def robustness(
     ops = [cfg.operating_point()] if ops is None else list(ops)
     if not ops:
         raise UserInputError("ops: no operating point given; give one or more")
-    chosen, steps, cases = corners(cfg, constants)
+    chosen, steps, cases = robustness_corners(cfg, constants)
     base = cfg.bearing()
     reference = DesignVariables.of(base) if reference is None else reference
     designs = (design, reference)
