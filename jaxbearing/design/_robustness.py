@@ -23,7 +23,8 @@ The drag coefficient is not a constant of the model apart from the oil fraction:
 forces and torques are proportional to the oil-air mixture's density (White's C_d(Re) for the
 rollers, forces/_drag.py), so the oil fraction's range carries the drag coefficient's
 uncertainty (`MODEL_CONSTANTS`). The default constants are therefore the traction asymptote and
-the oil fraction (`ROBUSTNESS_CONSTANTS`).
+the oil fraction (`ROBUSTNESS_CONSTANTS`). Each constant moves alone, as in the sensitivity study:
+moving D with A kept moves the whole curve, kappa(0) = A + D included, by the same amount.
 
 The cage slip of every run is kept: it shows that the constants acted (at high speed a lower
 traction asymptote lowers the drive of the roller set, and the cage slips more; docs/validation.md,
