@@ -117,13 +117,14 @@ def main(argv=None) -> int:
         return 0
     cfg = reference_config().replace({"bearing.num_slices": args.slices})
     settings = SteadySettings(seeds=args.seeds, window_revs=args.window_revs, progress=True)
+    started_at = commit()
     t = time.perf_counter()
     res = robustness(cfg, default_design(), ops=envelope(cfg), settings=settings, first_seed=args.first_seed)
     wall = time.perf_counter() - t
     command = "taskset -c 1 python benchmarks/studies/study_robust_design.py " + " ".join(
         sys.argv[1:] if argv is None else argv
     )
-    write_robustness_json(res, args.out, command=command.strip(), commit=commit(), wall_time_s=wall)
+    write_robustness_json(res, args.out, command=command.strip(), commit=started_at, wall_time_s=wall)
     print(table(res))
     print(f"wrote {args.out} ({wall / 60:.1f} min)")
     return 0
