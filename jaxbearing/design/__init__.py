@@ -23,6 +23,11 @@
   differences of settled runs, or the static skid equilibrium for the cage slip), `Sensitivity`,
   `SensitivityInput`, `Effect`, `sensitivity_inputs`, `static_cage_slip`,
   `parse_sensitivity_statistics`.
+- designs robust to the model's constants: `robustness` (a design against a reference at every
+  corner of the uncertain constants' ranges, `ROBUSTNESS_CONSTANTS`, and every operating point,
+  settled on the caller's seeds: mean and peak PV with 95 % intervals and whether the design's
+  lies below), `Robustness`, `RobustnessRow`, `RobustnessCorner`, `robustness_corners`,
+  `write_robustness_json`.
 
 The `optimise` package searches designs with these.
 
@@ -41,6 +46,15 @@ from ._design import (
     seated_perturbation,
 )
 from ._frozen_load import frozen_load_gradient, frozen_load_gradients
+from ._robustness import (
+    ROBUSTNESS_CONSTANTS,
+    Robustness,
+    RobustnessCorner,
+    RobustnessRow,
+    robustness,
+    robustness_corners,
+    write_robustness_json,
+)
 from ._sensitivity import METHODS as SENSITIVITY_METHODS
 from ._sensitivity import (
     MODEL_CONSTANTS,
@@ -79,11 +93,15 @@ __all__ = [
     "GRADIENT_WINDOW",
     "MODEL_CONSTANTS",
     "PEAK_EXPONENT",
+    "ROBUSTNESS_CONSTANTS",
     "SENSITIVITY_METHODS",
     "SENSITIVITY_STATISTICS",
     "STATISTICS",
     "STEADY_FUNCTIONALS",
     "DesignMetrics",
+    "Robustness",
+    "RobustnessCorner",
+    "RobustnessRow",
     "Effect",
     "Sensitivity",
     "SensitivityInput",
@@ -97,6 +115,8 @@ __all__ = [
     "paired_central_difference",
     "parse_sensitivity_statistics",
     "ratio_gradient",
+    "robustness",
+    "robustness_corners",
     "seated_perturbation",
     "sensitivity",
     "sensitivity_inputs",
@@ -105,4 +125,5 @@ __all__ = [
     "steady_design_metrics_points",
     "steady_gradient",
     "tangent_growth",
+    "write_robustness_json",
 ]
