@@ -1,7 +1,7 @@
 """The state of the design search on steady running, and its checkpoint.
 
 After every iteration the whole state (iterates, optimiser and multiplier states, continuation
-states, history, best design, the envelope's active set) is written atomically to
+states, history, the envelope's active set) is written atomically to
 DIR/checkpoint.npz, data only (`jaxbearing.io.save_tree`: arrays in `.npz`, structure as JSON),
 and checked for type and shape against a fresh state when read back. A `checkpoint.pkl` of an
 older version is refused, never unpickled: a pickle can run code. A checkpoint resumes only a
@@ -30,20 +30,7 @@ CHECKPOINT = "checkpoint.npz"
 LEGACY_CHECKPOINT = "checkpoint.pkl"
 #: version of the measured objective, margins and state layout, part of a checkpoint's
 #: fingerprint: a checkpoint of another version is refused, not resumed
-MEASUREMENT_VERSION = 6
-
-
-@jax.tree_util.register_dataclass
-@dataclasses.dataclass
-class Best:
-    """The feasible design of the lowest upper 95 % bound of the objective so far (`objective`:
-    its value; inf: none yet)."""
-
-    objective: float = float("inf")
-    iteration: int = -1
-    start: int = -1
-    x: np.ndarray | None = None  # the design in SI units (3,)
-    ci: tuple | None = None  # the objective's 95 % interval [GPa m/s]
+MEASUREMENT_VERSION = 7
 
 
 @jax.tree_util.register_dataclass
@@ -87,7 +74,6 @@ class SearchState:
     lam: np.ndarray  # (S, 5) multipliers
     chains: list  # per start: None or per operating point the settled states to continue from
     history: History
-    best: Best
     evaluations: int  # settled ensembles run
     envelope: Envelope
 
@@ -165,8 +151,6 @@ def checked_state(path: pathlib.Path, state, template: SearchState, num_iteratio
         raise bad("history")
     if any(not isinstance(v, list) or len(v) != it + 1 for v in vars(state.history).values()):
         raise bad("history length")
-    if not isinstance(state.best, Best):
-        raise bad("best design")
     if not isinstance(state.envelope, Envelope):
         raise bad("envelope")
     for name, v in vars(template.envelope).items():

@@ -44,7 +44,7 @@ from ._lagrangian import Hyper, IterationReport, augmented_lagrangian_step
 from ._problem import MARGIN_SCALE, DesignProblem, any_feasible
 from ._search import start_points
 from ._settings import SteadySettings
-from ._state import CHECKPOINT, Best, History, SearchState, fingerprint, resumed_state, save_checkpoint
+from ._state import CHECKPOINT, History, SearchState, fingerprint, resumed_state, save_checkpoint
 from ._verify import verification
 
 #: names of the five constraints of the steady search (static zone margins, then dynamic)
@@ -138,7 +138,6 @@ def _iteration(problem: DesignProblem, settings: SteadySettings, hyper: Hyper, s
         lam_next.append(np.asarray(act))
         margins = np.concatenate([ev.static_margins, [ev.dynamic_margin]])
         x = np.asarray(problem.bounds.from_scaled(us))
-        _consider(state, ev, margins, x, it, s)
         for name, value in _row(ev, x, margins).items():
             rows[name].append(value)
     if it < hyper.num_iterations:
@@ -161,22 +160,16 @@ def _row(ev: Evaluation, x, margins) -> dict:
     )
 
 
-def _consider(state: SearchState, ev: Evaluation, margins, x, it: int, s: int) -> None:
-    """Make start `s`'s evaluation at iteration `it` the best design so far when it is feasible
-    and the upper 95 % bound of its objective is lower (the progress line's; the returned design
-    is chosen from the whole history, `choose`)."""
-    feasible = bool(np.all(margins > 0) and np.isfinite(ev.objective))
-    best_high = np.inf if state.best.ci is None else float(state.best.ci[1])
-    if feasible and ev.objective_ci[1] < best_high:
-        state.best = Best(ev.objective, it, s, x, ev.objective_ci)
-
-
-def _report(rows: dict, best: Best) -> IterationReport:
+def _report(rows: dict, history: History) -> IterationReport:
+    """The iteration's rows and the best feasible objective so far (`tied_with_best`: the lowest
+    upper bound of the objective; inf: none yet)."""
+    h = History(**history.as_arrays())
+    _, best = tied_with_best(h)
     return IterationReport(
         x=np.stack(rows["x"]),
         objective=np.asarray(rows["objective"]),
         margins=np.stack(rows["margins"]),
-        best=float(best.objective),
+        best=float("inf") if best is None else float(h.objective[best]),
         ci=rows["ci"],
         gradient=np.stack(rows["gradient"]),
     )
@@ -231,7 +224,6 @@ def steady_search(
         lam=np.zeros((u.shape[0], len(CONSTRAINT_NAMES))),
         chains=chains,
         history=History(),
-        best=Best(),
         evaluations=0,
         envelope=Envelope.fresh(u.shape[0], problem.num_operating_points),
     )
@@ -245,7 +237,7 @@ def steady_search(
         if path is not None:
             save_checkpoint(path, key, state)
         if callback is not None:
-            callback(it, _report(rows, state.best))
+            callback(it, _report(rows, state.history))
     result = _result(state, x_start, num_iterations, resumed, settings.choose)
     if verify and result.feasible:
         result.verification = verification(problem, settings, result.design, x_start)

@@ -154,7 +154,6 @@ def test_steady_checkpoint_of_the_wrong_shape_is_refused(tmp_path):
         lam=np.zeros((2, 5)),
         chains=[None, None],
         history=steady.History(),
-        best=steady.Best(),
         evaluations=0,
         envelope=Envelope.fresh(2, 1),
     )
