@@ -43,12 +43,14 @@ from ..run import (
 from ._design import forward_jacobian
 from ._steady_objective import (
     STEADY_FUNCTIONALS,
+    Statistic,
     SteadyGradient,
     _check_window,
     _combine,
     _design_params,
     _failed_integrals,
     _functionals,
+    statistic_of,
 )
 
 
@@ -191,7 +193,7 @@ def frozen_load_gradients(
     rtol: float = 1e-3,
     workers: int = 1,
     strategy: str = "auto",
-    statistic: str = "mean",
+    statistic: Statistic | str = Statistic.MEAN,
 ) -> list[SteadyGradient]:
     """The frozen-load estimate (module docstring) of the steady objective and its gradient for
     every case (bearing, op, design, states), e.g. every start and operating point of one
@@ -212,7 +214,7 @@ def frozen_load_gradients(
     if strategy not in STRATEGIES:
         raise UserInputError(f"strategy = {strategy!r}: must be one of {', '.join(map(repr, STRATEGIES))}")
     exponent = float(_functionals(statistic).pv_exponent)
-    tail = statistic == "tail"
+    tail = statistic_of(statistic) is Statistic.TAIL
     cases = list(cases)
     n = max(1, int(round(window * 1e3 * saves_per_ms)))
     jobs, owner = [], []
