@@ -307,7 +307,9 @@ def test_nu_under_an_axial_load_carries_none_at_its_flanges_and_nup_carries_it()
     f_a = 200.0
     nu, nu_free_of_load = _run("NU", axial_load_N=f_a), _run("NU")
     for name, h in nu.histories.items():
-        assert np.array_equal(np.asarray(h), np.asarray(nu_free_of_load.histories[name]), equal_nan=True), name
+        assert np.array_equal(np.asarray(h), np.asarray(nu_free_of_load.histories[name]), equal_nan=True), (
+            name
+        )
     q_nu = np.asarray(nu.histories["flange_force"])
     assert np.all(q_nu[:, :, :2] == 0.0)
     cos_f = float(np.cos(jb.reference_bearing().flange.layback_angle))

@@ -265,7 +265,9 @@ def test_nu_inner_ring_floats_under_axial_load():
         reaction = -(f_a + raceway + flanges)
         assert flanges == 0.0 and reaction == pytest.approx(-f_a, rel=0.01)
     rates, loads_nup = axial(b, 0.3e-3)
-    assert float(rates.axial_velocity) < 0 and np.sum(np.asarray(loads_nup.flange.force_on_ring)[:, 0, 0]) < -f_a
+    assert (
+        float(rates.axial_velocity) < 0 and np.sum(np.asarray(loads_nup.flange.force_on_ring)[:, 0, 0]) < -f_a
+    )
 
 
 def test_axial_and_tilt_rates_follow_the_equations():
