@@ -34,7 +34,7 @@ from ..run import (
     checks_without_host_callbacks,
     choose_strategy,
     compiled_program,
-    parallel_map,
+    map_members,
     prepare_from,
     result_code,
     scaled_diffeqsolve,
@@ -238,14 +238,11 @@ def frozen_load_gradients(
 
 def _run_frozen(jobs, strategy: str, workers: int) -> list:
     """The outputs of every (`_FrozenSample`, state) of `jobs`, in order, by `strategy`
-    (`choose_strategy`): one vmapped program ("vmap", `_frozen_samples_batched`), `workers`
-    processes ("processes") or one after another in this process ("sequential")."""
+    (`choose_strategy`) through the engine's member dispatcher (`run.map_members`): one vmapped
+    program ("vmap", `_frozen_samples_batched`), `workers` processes ("processes") or one after
+    another in this process ("sequential")."""
     chosen = choose_strategy(strategy, min(int(workers), max(1, len(jobs))))
-    if not jobs:
-        return []
-    if chosen == "vmap":
-        return _frozen_samples_batched(jobs)
-    return parallel_map(_frozen_job, jobs, workers=workers if chosen == "processes" else 1)
+    return map_members(jobs, chosen, workers, _frozen_job, _frozen_samples_batched)
 
 
 def _frozen_job(item):

@@ -52,7 +52,6 @@ import dataclasses
 import jax
 import numpy as np
 
-from .._errors import UserInputError
 from ..flange import (
     DEFAULT_FLANGE_LOAD,
     MARGIN_NAMES,
@@ -62,7 +61,7 @@ from ..flange import (
     zone_margins,
 )
 from ..geometry import Bearing, OperatingPoint
-from ..io import require
+from ..io import per_point, require
 from ..run import (
     Estimate,
     Perturbation,
@@ -169,16 +168,8 @@ def steady_design_metrics_points(
     `first_seed` selects the seeds (first_seed .. first_seed + seeds - 1): a verification uses
     seeds a search never saw. `initial_states`: None, or per point None or one state per seed."""
     ops = list(ops)
-    designs = [design] * len(ops) if isinstance(design, DesignVariables) else list(design)
-    if len(designs) != len(ops):
-        raise UserInputError(
-            f"design: {len(designs)} given, expected one, or one per operating point ({len(ops)})"
-        )
-    bases = [bearing] * len(ops) if isinstance(bearing, Bearing) else list(bearing)
-    if len(bases) != len(ops):
-        raise UserInputError(
-            f"bearing: {len(bases)} given, expected one, or one per operating point ({len(ops)})"
-        )
+    designs = per_point("design", design, DesignVariables, len(ops))
+    bases = per_point("bearing", bearing, Bearing, len(ops))
     for b, d in zip(bases, designs):
         check_design(b, d)
     require("corner_margin", corner_margin, lambda v: np.isfinite(v) & (v >= 0), ">= 0 m")

@@ -30,6 +30,7 @@ from ._checks import (
     check_solver_arguments,
     count,
     is_concrete,
+    per_point,
     real,
     require,
 )
@@ -129,6 +130,7 @@ __all__ = [
     "reference_config",
     "reference_operating_point",
     "remove_stale_temporaries",
+    "per_point",
     "require",
     "save_tree",
     "set_command_line",

@@ -29,7 +29,8 @@
   `summarise_steady`; the steady-running engine under it, `settle_members` (many
   `Member`s, each a case and a seed, with one `SteadySettings`: one after another, one process per
   core, or vmapped on accelerators, `STRATEGIES`, `choose_strategy`, `stack_trees`; an
-  `EngineRun`) and `window_statistics`
+  `EngineRun`; the members' starts resolved in one step, `resolve_starts`; the one member
+  dispatcher, `map_members`, which the gradient estimators use too) and `window_statistics`
   (`revolution_statistic_keys`); `solve_from` / `prepare_from` (continue from any state),
   `scaled_diffeqsolve` (diffrax's integration of the scaled state that `solve` and `solve_from`
   run, for callers that build their own programs around it); `SteadySettings`, the one
@@ -123,6 +124,7 @@ from ._settled_statistics import (
 from ._simulate import SolveArgs, flange_functionals, scaled_diffeqsolve, scaled_field, solve
 from ._solve_from import prepare_from, solve_from
 from ._start_cache import start_cache_dir
+from ._starts import map_members, resolve_starts
 from ._statistics import (
     TAIL_LEVEL,
     CornerCount,
@@ -214,6 +216,8 @@ __all__ = [
     "solve",
     "solve_from",
     "steady_statistics",
+    "map_members",
+    "resolve_starts",
     "settled_statistics",
     "SettledStatistics",
     "PerEvent",

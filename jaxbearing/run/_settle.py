@@ -118,15 +118,11 @@ def simulate_steady_points(
     one `SteadyResult` per point, in order. `bearing`: one bearing, or one per point (several
     designs, each at its operating points). `initial_states`: None, or per point None or one
     state per seed. The wall and compilation times of each result are those of the whole call."""
-    from ..io import validate_bearing
+    from ..io import per_point, validate_bearing
 
     settings = (settings if settings is not None else SteadySettings()).replace(**changes)
     ops = list(ops)
-    bearings = [bearing] * len(ops) if isinstance(bearing, Bearing) else list(bearing)
-    if len(bearings) != len(ops):
-        raise UserInputError(
-            f"bearing: {len(bearings)} given, expected one, or one per operating point ({len(ops)})"
-        )
+    bearings = per_point("bearing", bearing, Bearing, len(ops))
     for b, op in zip(bearings, ops):
         validate_bearing(b, op)
     given = _given_states(initial_states, len(ops), settings.seeds)

@@ -25,7 +25,6 @@ from ._statistics import (
 )
 from ._summary import CONTACT_THRESHOLD
 
-
 #: the estimate of a statistic that was not measured
 _NOT_MEASURED = Estimate(float("nan"), float("nan"), float("nan"), 0)
 
