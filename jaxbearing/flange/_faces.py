@@ -9,7 +9,12 @@ rib (flange) face is a surface of revolution about the ring axis whose meridian 
 of signed curvature kappa_rib = 1/R_rib, tangent to today's cone (layback angle theta_f, foot at
 the raceway edge) at the height h_t above the raceway (kappa_rib = 0: today's cone;
 kappa_rib > 0: concave, the arc's centre on the roller side, conforming with the end as the
-spherical ribs of tapered roller bearings; kappa_rib < 0: convex, a crowned rib).
+spherical ribs of tapered roller bearings do, whose rib radius is 1.05-1.2 times the end radius).
+The formulas hold for a convex rib (kappa_rib < 0) as well, but `check_faces` rejects it: a
+convex rib touches a circle of the end (the corner circle, or the ridge circle of a toroidal end)
+at two points once |kappa_rib| rho > sin(alpha) (rho the circle's radius, alpha the normal's angle
+from the roller axis), for the reference corner circle already at |R_rib| ~ 120 mm, and a
+single-point contact model does not hold there.
 
 Both curvatures are parameters, not radii, so the cone (kappa_rib = 0) and the flat end
 (kappa_end = 0) are ordinary values with finite derivatives.
@@ -157,10 +162,10 @@ def check_faces(faces: Faces, bearing: Bearing) -> None:
     make a contact geometry with `bearing`'s roller; traced values pass (check outside `jit`).
 
     R_end > D/2 (kappa_end in [0, 2/D)); 0 < R_cor < D/2; 0 <= e < R_ce and e < R_end; theta_f
-    in [0, 45) deg; kappa_rib < kappa_end (R_rib > R_end: a concave rib must not conform more
-    closely than the end, or the curvature sum along the meridian is not positive; for a flat end
-    kappa_rib < 1/R_cor) and kappa_rib > -1/H_rf (a convex rib's radius exceeds the flange
-    height); 0 <= h_t <= H_rf; H_rf > 0; Delta_bf >= 0."""
+    in [0, 45) deg; 0 <= kappa_rib < kappa_end (a cone or a concave rib with R_rib > R_end: the
+    curvature sum along the meridian, kappa_end - kappa_rib, must be positive; for a flat end
+    kappa_rib < 1/R_cor; convex ribs are excluded, module docstring); 0 <= h_t <= H_rf;
+    H_rf > 0; Delta_bf >= 0."""
     leaves = (faces, bearing.roller.diameter)
     if not is_concrete(*leaves):
         return
@@ -195,12 +200,11 @@ def check_faces(faces: Faces, bearing: Bearing) -> None:
     require("faces.flange_height", faces.flange_height, lambda v: v > 0, "> 0 m")
     k_end = _value(faces.end_curvature)
     upper = k_end if k_end > 0 else 1.0 / _value(faces.corner_radius)
-    lower = -1.0 / _value(faces.flange_height)
     require(
         "faces.rib_curvature",
         faces.rib_curvature,
-        lambda v: (v < upper) & (v > lower),
-        f"in ({lower:g}, {upper:g}) 1/m (R_rib > R_end concave, < -H_rf convex; 0 the cone)",
+        lambda v: (v >= 0) & (v < upper),
+        f"in [0, {upper:g}) 1/m (1/R_rib: 0 the cone, positive a concave rib with R_rib > R_end)",
     )
     h_rf = _value(faces.flange_height)
     require(
