@@ -60,21 +60,22 @@ from ._geometry import unit
 Scalar = Float[Array, ""]
 Vec3 = Float[Array, "3"]
 
-#: Newton steps of the one-dimensional maximisation over a centre circle, started from the best
-#: of `START_ANGLES` angles; convergence is quadratic.
+#: Newton steps of the one-dimensional maximisation over a centre circle, from each of
+#: `START_ANGLES` angles and again from the deepest end (`_circle_max`); convergence is quadratic.
 NEWTON_STEPS = 8
 
-#: Stated accuracy [rad] of the circle angle after `NEWTON_STEPS` steps (the last step
-#: |F'/F''|, reported as `FaceContact.solve_error`): met over e in [0, 0.9 R_ce], kappa_rib in
-#: [0, 0.95 kappa_end], h_t in [0, H_rf], tilt and skew up to 10 mrad, axial offsets of 20 um,
-#: all four flanges (tests/test_faces.py, hypothesis-sampled; 2e4 random samples gave at most
-#: 7e-14 rad, and 1.4e-12 rad at 20 mrad). The contact point then moves by less than
-#: rho 1e-12 ~ 1e-15 m, the interference (stationary in the angle) by far less.
-NEWTON_ACCURACY = 1e-12
+#: Stated accuracy [m] of the ball centre on its circle after the Newton steps: the next step
+#: times the circle's radius, radius |F'/F''| (reported as `FaceContact.solve_error`). Met over
+#: e in [0, 0.9 R_ce], kappa_rib in [0, 0.95 kappa_end], h_t in [0, H_rf], tilt and skew up to
+#: 10 mrad, axial offsets of 20 um and all four flanges (tests/test_faces.py, hypothesis-sampled;
+#: 2e4 random samples gave at most 7e-14 rad, 2.3e-16 m, and 1.4e-12 rad, 4.7e-15 m, at
+#: 20 mrad). The contact point is then exact to round-off, the interference (stationary in the
+#: angle) by far more.
+NEWTON_ACCURACY = 1e-14
 
 _X = np.array([1.0, 0.0, 0.0])
 
-#: start angles of the maximisation over a centre circle (the best of them starts Newton's method)
+#: start angles of the maximisation over a centre circle (Newton's method runs from each)
 START_ANGLES = 16
 _STARTS = 2 * np.pi * np.arange(START_ANGLES) / START_ANGLES
 
@@ -89,6 +90,7 @@ class FaceContact(eqx.Module):
     rib_point: Vec3  # C - delta n, on the rib face
     contact_height: Scalar  # g ((C - c_r) . e_rad - R_r)
     contact_radius: Scalar  # rho_c, distance of C from the roller axis
+    corner_contact_radius: Scalar  # rho_c of the corner alone (the same roller with flat ends)
     on_arc: Scalar  # 1 arc, 0 corner (smooth weight of the curvature blend)
     end_curvatures: Float[Array, 2]  # end: (along its meridian t_E, along its parallel p_E)
     rib_curvatures: Float[Array, 2]  # rib: (along its meridian, along its generator) = (-kappa_rib, 0)
@@ -98,7 +100,7 @@ class FaceContact(eqx.Module):
     curvature_sums: Float[Array, 2]  # its eigenvalues (larger, smaller): the Hertz 1/R_x, 1/R_y
     top_edge: Scalar  # 1 where C lies above the flange height H_rf
     face_error: Scalar  # tangent-surface error at C, sin(theta_C) (rho_C - (C - c_r) . e_rad)
-    solve_error: Float[Array, 2]  # last Newton step |F'/F''| [rad] of the (arc, corner) solves
+    solve_error: Float[Array, 2]  # radius |F'/F''| [m]: the next Newton step, (arc, corner)
 
 
 class _Frame(eqx.Module):
@@ -161,11 +163,14 @@ def _tangent_solve(g, y):
 
 
 def _circle_max(frame: _Frame, faces: Faces, centre: Vec3, radius) -> tuple[Vec3, Array]:
-    """(Q*, last step): the point of the circle (centre, axis x_end, radius) deepest in the rib.
+    """(Q*, its error): the point of the circle (centre, axis x_end, radius) deepest in the rib,
+    and radius |F'/F''| at it, how far one more Newton step would move it [m].
 
     F(phi) = d(Q(phi)), Q = centre + radius (cos(phi) r0 + sin(phi) s0); F' = grad d . Q',
-    F'' = (k/S) (m . Q')^2 - grad d . (Q - centre) (`_rib`). Started from the best of
-    `START_ANGLES` angles, so the maximum found is the circle's global one."""
+    F'' = (k/S) (m . Q')^2 - grad d . (Q - centre) (`_rib`). Newton's method runs from each
+    of `START_ANGLES` angles, and again (with implicit derivatives) from the deepest of their
+    ends, so the maximum found is the circle's global one even where the depth has two maxima
+    of nearly equal height (a two-point contact, of which the model keeps the deeper point)."""
     _, n_c, _, _ = _rib(frame, faces, centre)
     perp = n_c - jnp.dot(n_c, frame.x_end) * frame.x_end
     r0 = jnp.where(safe_norm(perp) > 1e-12, unit(perp), frame.fallback)
@@ -179,12 +184,13 @@ def _circle_max(frame: _Frame, faces: Faces, centre: Vec3, radius) -> tuple[Vec3
         dq = radius * (jnp.cos(phi) * s0 - jnp.sin(phi) * r0)
         return jnp.dot(n, dq), curv * jnp.dot(m, dq) ** 2 - jnp.dot(n, point(phi) - centre)
 
-    starts = jnp.asarray(_STARTS)
-    depths = jax.vmap(lambda phi: _rib(frame, faces, point(phi))[0])(starts)
-    start = jax.lax.stop_gradient(starts[jnp.argmax(depths)])
-    phi = jax.lax.custom_root(lambda t: derivatives(t)[0], start, _newton(derivatives), _tangent_solve)
+    newton = _newton(derivatives)
+    roots = jax.vmap(lambda t: newton(None, t))(jnp.asarray(_STARTS))
+    depths = jax.vmap(lambda phi: _rib(frame, faces, point(phi))[0])(roots)
+    start = jax.lax.stop_gradient(roots[jnp.argmax(depths)])
+    phi = jax.lax.custom_root(lambda t: derivatives(t)[0], start, newton, _tangent_solve)
     g1, g2 = derivatives(jax.lax.stop_gradient(phi))
-    step = jnp.abs(g1) / jnp.where(g2 != 0, jnp.abs(g2), 1.0)
+    step = radius * jnp.abs(g1) / jnp.where(g2 != 0, jnp.abs(g2), 1.0)
     return point(phi), jax.lax.stop_gradient(step)
 
 
@@ -266,6 +272,7 @@ def face_contact(
     r_ce = corner_centre_radius(roller, faces)
     corner = _branch(fr, faces, corner_centre, r_ce, faces.corner_radius)
     sin_arc = safe_norm(arc[2] - jnp.dot(arc[2], fr.x_end) * fr.x_end)
+    sin_corner = safe_norm(corner[2] - jnp.dot(corner[2], fr.x_end) * fr.x_end)
     on_arc = sin_arc < k * (face_limited_circle(roller, faces) - e)
     delta, c, n = (jnp.where(on_arc, a, b) for a, b in zip(arc[:3], corner[:3]))
     sin_a = safe_norm(n - jnp.dot(n, fr.x_end) * fr.x_end)
@@ -285,6 +292,7 @@ def face_contact(
         rib_point=c - delta * n,
         contact_height=ring_sign * (along - raceway_radius),
         contact_radius=rho,
+        corner_contact_radius=r_ce + faces.corner_radius * sin_corner,
         on_arc=w,
         end_curvatures=jnp.stack([k_m, k_p]),
         rib_curvatures=jnp.stack([-faces.rib_curvature, jnp.zeros_like(k_m)]),

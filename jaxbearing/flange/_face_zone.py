@@ -77,8 +77,6 @@ def face_design_zone(
     centre = jnp.array([0.0, 0.0, 1.0]) * (radius + roller.diameter / 2)
     ring = jnp.zeros(3)
     c = face_contact(bearing, faces, radius, 1.0, 1.0, centre, x, ring)
-    flat = eqx.tree_at(lambda f: f.end_curvature, faces, jnp.zeros_like(faces.end_curvature))
-    corner = face_contact(bearing, flat, radius, 1.0, 1.0, centre, x, ring)
     protrusion = face_protrusion(roller, faces)
     clearance = faces.axial_clearance - 2 * protrusion * jnp.cos(faces.layback_angle)
     a11, a22 = c.relative_curvature[0], c.relative_curvature[2]
@@ -93,7 +91,7 @@ def face_design_zone(
     clear = clearance - min_clearance
     return FaceZone(
         contact_radius=c.contact_radius,
-        corner_contact_radius=corner.contact_radius,
+        corner_contact_radius=c.corner_contact_radius,
         contact_height=c.contact_height,
         limited_circle_radius=rho_lim,
         arc_protrusion=protrusion,
