@@ -9,7 +9,7 @@ rib (flange) face is a surface of revolution about the ring axis whose meridian 
 of signed curvature kappa_rib = 1/R_rib, tangent to today's cone (layback angle theta_f, foot at
 the raceway edge) at the height h_t above the raceway (kappa_rib = 0: today's cone;
 kappa_rib > 0: concave, the arc's centre on the roller side, conforming with the end as the
-spherical ribs of tapered roller bearings do, whose rib radius is 1.05-1.2 times the end radius).
+spherical ribs of tapered roller bearings do, whose rib radius is 1.05-1.18 times the end radius).
 The formulas hold for a convex rib (kappa_rib < 0) as well, but `check_faces` rejects it: a
 convex rib touches a circle of the end (the corner circle, or the ridge circle of a toroidal end)
 at two points once |kappa_rib| rho > sin(alpha) (rho the circle's radius, alpha the normal's angle
