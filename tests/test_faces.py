@@ -70,12 +70,12 @@ _zone = jax.jit(face_design_zone)
 
 
 @jax.jit
-def _contacts(bearing, faces, radius, side, ring_sign, p, axis):
+def _contacts(bearing, faces, radius, side, ring_sign, p, axis, ring_axis):
     """face_contact and today's flange_geometry over a batch of poses (one compiled program)."""
 
     def one(r, s, g, pp, e):
-        new = face_contact(bearing, faces, r, s, g, pp, e, jnp.zeros(3))
-        old = flange_geometry(bearing, r, s, g, pp, e, jnp.zeros(3))
+        new = face_contact(bearing, faces, r, s, g, pp, e, jnp.zeros(3), ring_axis)
+        old = flange_geometry(bearing, r, s, g, pp, e, jnp.zeros(3), ring_axis)
         return new, old
 
     return jax.vmap(one)(radius, side, ring_sign, p, axis)
@@ -100,18 +100,24 @@ def _batch(bearing):
 
 
 # -- (a) e = 0 and R_rib = inf: today's contact to round-off --------------------------------------
-@pytest.mark.parametrize("flat", [False, True], ids=["arc-end", "flat-end"])
-def test_today_faces_reproduce_flange_geometry(flat):
+@pytest.mark.parametrize(
+    ("flat", "ring_tilt"),
+    [(False, 0.0), (True, 0.0), (False, 2e-3)],
+    ids=["arc-end", "flat-end", "tilted-ring"],
+)
+def test_today_faces_reproduce_flange_geometry(flat, ring_tilt):
     """At e = 0, kappa_rib = 0 (h_t any) `face_contact` gives `flange_geometry`'s interference,
     contact point, contact height, contact radius, arc weight and Hertz curvature sums (the
     plane adds none) to round-off, at 8 poses (aligned, axial offset, tilt, skew, combined, and
-    two large enough to put the contact on the corner) on all four flanges; and the same
+    two large enough to put the contact on the corner) on all four flanges, also with the
+    ring's axis tilted by 2 mrad about Y (`ring_axis`, a misaligned ring); and the same
     Hertz stiffness through the model's exact law. Round-off: the arc branch adds R_end = 80 mm
     to a distance near -R_end, so lengths agree to a few 1e-17 m (1e-16 asserted; measured at
     most 1.7e-17 m in the interference, 9e-18 m in the contact point)."""
     bearing = _f64(BEARING.with_flat_ends() if flat else BEARING)
     faces = faces_of(bearing, rib_tangent_height=0.7e-3)
-    new, old = _contacts(bearing, faces, *_batch(bearing))
+    ring_axis = np.array([math.cos(ring_tilt), 0.0, -math.sin(ring_tilt)])
+    new, old = _contacts(bearing, faces, *_batch(bearing), ring_axis)
     np.testing.assert_allclose(new.interference, old.interference, rtol=0, atol=1e-16)
     np.testing.assert_allclose(new.contact_point, old.contact_point, rtol=0, atol=1e-16)
     np.testing.assert_allclose(new.contact_height, old.contact_height, rtol=0, atol=1e-16)

@@ -18,10 +18,13 @@ grows at unit rate along its own gradient. So each branch is
     delta = R + max over the centre circle of d(Q(phi)),    C = Q* + R n(Q*),
 
 a one-dimensional maximisation in the circle's angle phi: Newton's method on F'(phi) = 0 from
-the angle where the circle's radius points along the normal at the circle's centre
-(`NEWTON_STEPS` steps, derivatives by implicit differentiation, `jax.lax.custom_root`). For e = 0
-the arc's circle is a point (the sphere's centre) and the maximisation is trivial; for the cone d
-is linear and the start is the root. The arc branch holds while its contact lies inside the
+`START_ANGLES` angles and again from the deepest of their ends (`NEWTON_STEPS` steps each,
+accuracy `NEWTON_ACCURACY`, derivatives by implicit differentiation, `jax.lax.custom_root`).
+Angles are measured from the direction in which the circle's radius points along the normal at
+the circle's centre, so for the cone (d linear) the first start is the root. For e = 0 the arc's
+circle is a point (the sphere's centre) and the maximisation is trivial. The end body lies inside
+the union of the arc's balls, which makes the arc's result the body's deepest point while it is
+on the cap. The arc branch holds while its contact lies inside the
 limited circle, sin(alpha) < kappa_end (rho_lim - e), alpha the angle between the normal and the
 roller axis (docs/model.md 4's switch with rho shifted by e); at the switch the two branches have
 the same contact point and normal, so delta is continuous and C1 in the pose, as today.
