@@ -34,7 +34,8 @@ jax.config.update("jax_enable_x64", True)
 #: test_settle alone and cold) from test_cmd_simulate to test_settle. Since cut (CPU seconds of
 #: the file alone and cold, before and after, side by side on one core): test_steady_gradient
 #: by 23 s (one integration per trajectory for every statistic, one vmapped program),
-#: test_rosenbrock by 15 s (its Tsit5 program the settled runs'), test_validate by 1 s.
+#: test_rosenbrock by 15 s (its Tsit5 program the settled runs'), test_validate by 1 s, test_speed by
+#: 3 s (one worker pool fewer).
 FILE_SECONDS = {
     "test_engine.py": 114,
     "test_notebooks.py": 98,
@@ -43,7 +44,7 @@ FILE_SECONDS = {
     "test_settle.py": 69,
     "test_rosenbrock.py": 54,
     "test_cmd_simulate.py": 51,
-    "test_speed.py": 49,
+    "test_speed.py": 46,
     "test_sweep_distributed.py": 44,
     "test_design.py": 33,
     "test_outputs.py": 30,
