@@ -5,10 +5,15 @@ layback angle theta_f and the axial clearance Delta_bf, inside the design zone (
 limit, limited circle, actual axial clearance), robustly over an envelope of speeds and loads.
 The search is a multi-start projected augmented Lagrangian driven by optax (`_search`); the
 objective's gradients come from forward-mode differentiation through the diffrax solve
-(`jaxbearing.design.design_metrics`). Command line: `optimise run --help`.
+(`jaxbearing.design.design_metrics`). The search on settled running, `steady_search`, takes one
+`SteadySettings`; its choices are typed: `Statistic` (the PV statistic minimised), `Estimator`
+(the gradient estimate), `CornerConstraint` (the dynamic corner constraint) and `Choice` (which
+of the tied designs is returned); the command line and the TOML files name them by their values.
+Command line: `optimise run --help`.
 """
 
 import jaxbearing  # noqa: F401  (enables 64-bit floats)
+from jaxbearing.design import Statistic
 from jaxbearing.flange import MARGIN_NAMES
 
 from ._grid import steady_grid
@@ -23,7 +28,7 @@ from ._problem import (
     operating_envelope,
 )
 from ._search import SearchResult, grid_search, search, start_points
-from ._settings import SteadySettings
+from ._settings import Choice, CornerConstraint, Estimator, SteadySettings
 from ._steady import NearOptimal, SteadySearchResult, near_optimal_set, steady_search
 from ._toml import load_optimise_toml
 from ._verify import verification
@@ -31,6 +36,10 @@ from ._verify import verification
 __all__ = [
     "MARGIN_NAMES",
     "Bounds",
+    "Choice",
+    "CornerConstraint",
+    "Estimator",
+    "Statistic",
     "DesignProblem",
     "NearOptimal",
     "SearchResult",

@@ -32,6 +32,7 @@ from ._cli_settings import (
     _provenance,
     _settings,
     check_start_design,
+    constant_corners,
     objective_of,
     problem_from_settings,
     steady_settings_from,
@@ -118,6 +119,13 @@ def build_parser() -> argparse.ArgumentParser:
     )
     r.add_argument(
         "--weights", help="weights of the operating points (speeds x loads, speed-major) (default: equal)"
+    )
+    r.add_argument(
+        "--uncertain-constants",
+        help="steady objective: run every operating point also at every corner of these model constants' "
+        "ranges (comma-separated keys, e.g. lubricant.traction_d,lubricant.oil_fraction; ranges as "
+        "`jaxbearing sensitivity` states them), so that the worst corner enters the objective "
+        "(default: none)",
     )
     r.add_argument(
         "--aggregate",
@@ -265,7 +273,7 @@ def run(args) -> int:
         raise UserInputError(f"{args.config}: {exc}") from None
     bearing, op = cfg.bearing(), cfg.operating_point()
     s = _settings(args)
-    problem, options = problem_from_settings(bearing, op, s)
+    problem, options = problem_from_settings(bearing, op, s, constant_corners=constant_corners(cfg, s))
     steady = steady_settings_from(s) if objective_of(s) == "steady" else None
     # every input is checked before --out is made, so a rejected command leaves no directory
     check_output_dir(args.out, "--out")

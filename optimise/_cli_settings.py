@@ -58,6 +58,10 @@ def _settings(args) -> dict:
         ("speeds_rpm", _floats(args.speeds_rpm, "--speeds-rpm") if args.speeds_rpm else None),
         ("loads_N", _floats(args.loads_N, "--loads-N") if args.loads_N else None),
         ("weights", _floats(args.weights, "--weights") if args.weights else None),
+        (
+            "uncertain_constants",
+            [k.strip() for k in args.uncertain_constants.split(",")] if args.uncertain_constants else None,
+        ),
         ("aggregate", args.aggregate),
         ("objective", args.objective),
         ("starts", args.starts),
@@ -104,8 +108,30 @@ def _clearance_step(s: dict):
     return "auto" if v == "auto" else _positive(s, "clearance_step_mm", 0.0, strict=False) * 1e-3
 
 
-def problem_from_settings(bearing, op, s: dict):
-    """DesignProblem and search options from merged settings (engineering units)."""
+def constant_corners(cfg, s: dict):
+    """(name, bearing) of every corner of `uncertain_constants`' ranges and the nominal point
+    (`jaxbearing.design.robustness_corners`), or None without; only the steady objective runs
+    them (one line otherwise)."""
+    keys = s.get("uncertain_constants")
+    if not keys:
+        return None
+    if objective_of(s) != "steady":
+        raise UserInputError(
+            f"uncertain_constants = {keys}: only the steady objective runs a bearing per operating point "
+            "(objective = 'steady')"
+        )
+    from jaxbearing.design import robustness_corners
+
+    try:
+        _, _, corners = robustness_corners(cfg, keys)
+    except UserInputError as exc:
+        raise UserInputError(f"uncertain_constants: {exc}") from None
+    return [(corner.name, c.bearing()) for corner, c in corners]
+
+
+def problem_from_settings(bearing, op, s: dict, constant_corners=None):
+    """DesignProblem and search options from merged settings (engineering units);
+    `constant_corners`: see `make_problem`."""
     from ._problem import DEFAULT_DURATION, bounds_from_engineering, make_problem
 
     bounds = bounds_from_engineering(
@@ -118,6 +144,7 @@ def problem_from_settings(bearing, op, s: dict):
         speeds_rpm=s.get("speeds_rpm"),
         loads_N=s.get("loads_N"),
         weights=s.get("weights"),
+        constant_corners=constant_corners,
         duration=_positive(s, "duration_ms", DEFAULT_DURATION * 1e3) * 1e-3,
         flange_load=_positive(s, "flange_load_N", 100.0),
         min_clearance=_positive(s, "min_clearance_mm", SEARCH_DEFAULTS["min_clearance_mm"], strict=False)

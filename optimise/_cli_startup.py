@@ -80,14 +80,12 @@ def _result_json(problem, options, res) -> dict:
     import numpy as np
 
     from jaxbearing.flange import MARGIN_NAMES
+    from jaxbearing.io import finite_or_none as fin
 
     design = _engineering
 
     def margins(m):
         return None if m is None else {f"{n}_margin_mm": float(v) * 1e3 for n, v in zip(MARGIN_NAMES, m)}
-
-    def fin(v):
-        return float(v) if v is not None and np.isfinite(v) else None
 
     ops = problem.operating
     h = res.history

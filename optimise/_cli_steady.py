@@ -100,14 +100,9 @@ def _print_found(res, settings, plot_path) -> None:
 def _print_verification(problem, v: dict) -> None:
     """Both designs at every operating point on the verification's seeds, the verdict on the
     mean PV and on the tail."""
-    import numpy as np
 
-    from jaxbearing.geometry import rad_s_to_rpm
-
-    speeds = np.asarray(rad_s_to_rpm(np.asarray(problem.operating.inner_speed))).ravel()
-    loads = np.asarray(problem.operating.radial_load).ravel()
     for k in range(problem.num_operating_points):
-        where = f" at {speeds[k]:.0f} rpm, {loads[k]:.0f} N" if problem.num_operating_points > 1 else ""
+        where = f" at {problem.point_label(k)}" if problem.num_operating_points > 1 else ""
         for name in ("reference", "optimum"):
             row = v[name] if "mean_pv_GPa_m_s" in v[name] else v[name]["per_operating_point"][k]
             label = name if where else f"{name:9s}"
@@ -194,14 +189,15 @@ def _steady_result_json(problem, options, settings, res) -> dict:
             "the upper 95 % bound of its corner-contact risk per cage revolution at its worst operating point"
         ),
         "choice_rule": (
-            f"choose = {settings.choose!r}: 'safest' returns the tied design of the lowest corner-risk bound "
+            f"choose = {settings.choose.value!r}: 'safest' returns the tied design of the lowest corner-risk bound "
             "(then the largest dynamic corner margin), 'best' the one of the lowest upper bound of the objective"
         ),
         "bounds": problem.bounds.engineering(),
         "operating_points": [
             {"speed_rpm": float(w) * 60 / (2 * math.pi), "load_N": float(f)}
-            for w, f in zip(
-                np.asarray(problem.operating.inner_speed), np.asarray(problem.operating.radial_load)
+            | ({} if problem.point_constants is None else {"constants": problem.point_constants[k]})
+            for k, (w, f) in enumerate(
+                zip(np.asarray(problem.operating.inner_speed), np.asarray(problem.operating.radial_load))
             )
         ],
         "weights": [float(v) for v in np.asarray(problem.weights)],

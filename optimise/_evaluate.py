@@ -37,7 +37,7 @@ from jaxbearing.flange import MARGIN_NAMES, DesignVariables
 from jaxbearing.run import CORNER_RISK_CONFIDENCE, shared_workers, tolerance_bound
 
 from ._problem import PV_SCALE, DesignProblem
-from ._settings import SteadySettings, clearance_step_for
+from ._settings import CornerConstraint, Estimator, SteadySettings, clearance_step_for
 
 
 @dataclasses.dataclass
@@ -110,15 +110,16 @@ def operating_points(problem: DesignProblem) -> list:
 
 
 def settled_metrics(
-    problem: DesignProblem, settings: SteadySettings, ops, designs, *, verification: bool = False, **kwargs
+    problem: DesignProblem, settings: SteadySettings, points, designs, *, verification: bool = False, **kwargs
 ):
-    """`steady_design_metrics_points` of (design, operating point) pairs, one engine call, with
-    the problem's constraints and the search's (or, with `verification`, the verification's)
-    settled-run settings (`SteadySettings.measurement`); `kwargs`: `first_seed`,
-    `initial_states`."""
+    """`steady_design_metrics_points` of (design, operating point index) pairs, one engine
+    call, each point with its bearing (`DesignProblem.bearing_at`), with the problem's
+    constraints and the search's (or, with `verification`, the verification's) settled-run
+    settings (`SteadySettings.measurement`); `kwargs`: `first_seed`, `initial_states`."""
+    ops = operating_points(problem)
     return steady_design_metrics_points(
-        problem.bearing,
-        ops,
+        [problem.bearing_at(k) for k in points],
+        [ops[k] for k in points],
         designs,
         settings.measurement(verification=verification),
         corner_margin=settings.corner_margin,
@@ -152,7 +153,7 @@ def _gradients(settings: SteadySettings, cases, gradient: bool) -> list[SteadyGr
     """The gradient estimates of `cases` (bearing, op, design, states) by `settings.estimator`."""
     if not gradient:
         return [SteadyGradient.missing() for _ in cases]
-    if settings.estimator == "frozen":
+    if settings.estimator is Estimator.FROZEN:
         return frozen_load_gradients(
             cases,
             window=settings.gradient_window,
@@ -210,7 +211,7 @@ def evaluate_starts(
     listed = settled_metrics(
         problem,
         settings,
-        [ops[k] for _, _, k in jobs],
+        [k for _, _, k in jobs],
         [_shift_clearance(designs[s], shifts[j]) for s, j, _ in jobs],
         initial_states=None
         if all(c is None for c in chains)
@@ -219,7 +220,7 @@ def evaluate_starts(
     metrics = dict(zip(jobs, listed))
     keys = [(s, k) for (s, j, k) in jobs if j == 0]
     cases = [
-        (designs[s].apply(problem.bearing), ops[k], designs[s], metrics[(s, 0, k)].sample_states)
+        (designs[s].apply(problem.bearing_at(k)), ops[k], designs[s], metrics[(s, 0, k)].sample_states)
         for s, k in keys
     ]
     gradients = dict(zip(keys, _gradients(settings, cases, gradient)))
@@ -244,9 +245,7 @@ def evaluate_starts(
 
 def simulated_ms(m) -> float:
     """Simulated ms of one operating point's settled ensemble: every seed's settling and window."""
-    return sum(r["settle_time_ms"] for r in m.summary["per_seed"]) + len(m.seeds) * m.summary.get(
-        "window_ms", 0.0
-    )
+    return m.simulated_ms
 
 
 def _shift_clearance(design: DesignVariables, dh: float) -> DesignVariables:
@@ -279,28 +278,25 @@ def _with_clearance_difference(g: SteadyGradient, plus, minus, h: float) -> Stea
     return dataclasses.replace(g, gradient=grad, gradient_stderr=se)
 
 
-def _num(v) -> float:
-    return float("nan") if v is None else float(v)
-
-
 def corner_margin_of(settings: SteadySettings, m) -> float:
     """The dynamic corner margin [m] of one operating point's metrics `m` that the search
     constrains (`SteadySettings.corner_constraint`): rho_lim - `corner_margin` minus the normal
     tolerance bound of the per-revolution largest contact radius at `corner_risk_level`
     ("risk"; the prediction bound where fewer than three revolutions touched a flange), the
     prediction bound ("prediction") or its mean ("mean")."""
-    if settings.corner_constraint == "mean":
-        return _num(m.corner_margin["value"])
-    if settings.corner_constraint == "risk":
+    if settings.corner_constraint is CornerConstraint.MEAN:
+        return float(m.corner_margin.value)
+    if settings.corner_constraint is CornerConstraint.RISK:
         bound = tolerance_bound(m.contact_radius_maxima, settings.corner_risk_level, CORNER_RISK_CONFIDENCE)
         if np.isfinite(bound):
             return float(m.limited_circle_radius_m - settings.corner_margin - bound)
-    return _num(m.corner_margin_bound)
+    return float(m.corner_margin_bound)
 
 
 def _risk_upper(m) -> float:
-    risk = m.summary.get("corner_risk") or {}
-    return _num(risk.get("upper"))
+    """The upper 95 % bound of the corner-contact risk per revolution (NaN: not estimated)."""
+    risk = None if m.statistics is None else m.statistics.corner_risk
+    return float("nan") if risk is None else float(risk.upper)
 
 
 def _measured_record(settings: SteadySettings, u, m, g, width) -> PointRecord:
@@ -308,15 +304,15 @@ def _measured_record(settings: SteadySettings, u, m, g, width) -> PointRecord:
     j = m.objective
     margin = corner_margin_of(settings, m)
     return PointRecord(
-        value=_num(j["value"]) / PV_SCALE,
-        ci=(_num(j["ci95_low"]) / PV_SCALE, _num(j["ci95_high"]) / PV_SCALE),
+        value=float(j.value) / PV_SCALE,
+        ci=(float(j.ci95_low) / PV_SCALE, float(j.ci95_high) / PV_SCALE),
         gradient=g.gradient * width / PV_SCALE,
         gradient_stderr=g.gradient_stderr * width / PV_SCALE,
         estimator_value=g.value / PV_SCALE,
         corner_margin=margin,
         measured_corner_margin=margin,
         measured_at=np.asarray(u, dtype=float),
-        corner_contact_share=_num(m.corner_contact_share["value"]),
+        corner_contact_share=float(m.corner_contact_share.value),
         settled=m.settled,
         simulated=True,
         corner_risk=_risk_upper(m),

@@ -218,6 +218,13 @@ class DesignProblem(eqx.Module):
     #: `initial_skew`: axial scatter scaled to each design's play), or a Perturbation, or None
     perturbation: Perturbation | str | None = eqx.field(static=True, default="seated")
     initial_skew: float = eqx.field(static=True, default=DEFAULT_SKEW)
+    #: per operating point, the bearing it runs with (stacked, leading axis K): the corners of
+    #: the model's uncertain constants as further operating points (`make_problem`'s
+    #: `constant_corners`); None: every point runs `bearing`
+    point_bearings: Bearing | None = None
+    #: per operating point, the name of its corner of the constants ("nominal",
+    #: "traction_d-, oil_fraction+"); None without corners
+    point_constants: tuple[str, ...] | None = eqx.field(static=True, default=None)
 
     def __check_init__(self):
         """Every setting before anything is traced: the solver arguments
@@ -248,6 +255,18 @@ class DesignProblem(eqx.Module):
     def num_operating_points(self) -> int:
         return int(np.shape(self.operating.inner_speed)[0])
 
+    def point_label(self, k: int) -> str:
+        """Operating point k in words: "10000 rpm, 1000 N", with its corner of the constants."""
+        rpm = float(np.asarray(self.operating.inner_speed)[k]) * 60 / (2 * math.pi)
+        text = f"{rpm:.0f} rpm, {float(np.asarray(self.operating.radial_load)[k]):.0f} N"
+        return text if self.point_constants is None else f"{text}, {self.point_constants[k]}"
+
+    def bearing_at(self, k: int) -> Bearing:
+        """The bearing operating point k runs with (`point_bearings`, else `bearing`)."""
+        if self.point_bearings is None:
+            return self.bearing
+        return jax.tree_util.tree_map(lambda a: a[k], self.point_bearings)
+
     def design(self, u) -> DesignVariables:
         return DesignVariables.from_array(self.bounds.from_scaled(u))
 
@@ -255,6 +274,11 @@ class DesignProblem(eqx.Module):
     def peak_pv(self, u: Float[Array, 3]) -> Float[Array, " K"]:
         """Smooth peak PV [GPa m/s] at every operating point (one vmapped batch)."""
         import diffrax
+
+        if self.point_bearings is not None:
+            raise UserInputError(
+                "uncertain constants: the start-up objective runs one bearing; use the steady objective"
+            )
 
         design = self.design(u)
         if isinstance(self.perturbation, str):
@@ -312,9 +336,14 @@ def make_problem(
     speeds_rpm: Sequence[float] | None = None,
     loads_N: Sequence[float] | None = None,
     weights: Sequence[float] | None = None,
+    constant_corners: Sequence[tuple[str, Bearing]] | None = None,
     **kwargs,
 ) -> DesignProblem:
-    """A DesignProblem over the (speed x load) envelope around `base_op`."""
+    """A DesignProblem over the (speed x load) envelope around `base_op`. `constant_corners`:
+    (name, bearing) pairs, the bearing with the model's uncertain constants at one corner of
+    their ranges (`jaxbearing.design.robustness_corners`): every envelope point runs at every
+    corner, as a further operating point of the same weight, so that the smooth maximum takes
+    the worst corner too (docs/model.md 17)."""
     ops = operating_envelope(base_op, speeds_rpm, loads_N)
     k = int(np.shape(ops.inner_speed)[0])
     if weights is None:
@@ -327,6 +356,15 @@ def make_problem(
             )
         if not np.all(np.isfinite(w) & (w >= 0)) or w.sum() <= 0:
             raise UserInputError(f"weights = {w.tolist()}: must be >= 0 with a positive sum")
+    if constant_corners:
+        names = tuple(name for name, _ in constant_corners for _ in range(k))
+        each = [b for _, b in constant_corners for _ in range(k)]
+        kwargs |= dict(
+            point_bearings=jax.tree_util.tree_map(lambda *a: jnp.stack(a), *each),
+            point_constants=names,
+        )
+        ops = jax.tree_util.tree_map(lambda a: jnp.concatenate([a] * len(constant_corners)), ops)
+        w = np.tile(w, len(constant_corners))
     return DesignProblem(
         bearing=bearing, operating=ops, weights=jnp.asarray(w), bounds=bounds or Bounds(), **kwargs
     )

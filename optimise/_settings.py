@@ -12,30 +12,70 @@ take.
 from __future__ import annotations
 
 import dataclasses
+import enum
 
 import jax
 import numpy as np
 
 from jaxbearing import UserInputError, run
-from jaxbearing.design import CORNER_MARGIN, STATISTICS
+from jaxbearing.design import CORNER_MARGIN, Statistic
 from jaxbearing.io import require
 from jaxbearing.run import available_cpus
 
 from ._problem import DesignProblem
 
-#: gradient estimators: "frozen" (the frozen-load estimate, `jaxbearing.design.frozen_load_gradients`)
-#: or "window" (short-window forward-mode sensitivities, `jaxbearing.design.steady_gradient`)
-ESTIMATORS = ("frozen", "window")
+
+class Estimator(enum.StrEnum):
+    """How the search estimates the gradient of the steady objective: `FROZEN` (the frozen-load
+    estimate, `jaxbearing.design.frozen_load_gradients`) or `WINDOW` (short-window forward-mode
+    sensitivities, `jaxbearing.design.steady_gradient`). The value is the command line's name."""
+
+    FROZEN = "frozen"
+    WINDOW = "window"
+
+
+class CornerConstraint(enum.StrEnum):
+    """The statistic of the per-revolution largest contact radius the dynamic corner constraint
+    keeps inside the limited circle (`SteadySettings.corner_constraint`, docs/model.md 17):
+    `RISK` (the normal tolerance bound that one revolution exceeds with probability
+    `corner_risk_level` at most, at 95 % confidence: the corner-contact risk's upper bound below
+    the level), `PREDICTION` (the upper 95 % prediction bound of one further revolution) or
+    `MEAN` (its expectation per revolution)."""
+
+    RISK = "risk"
+    PREDICTION = "prediction"
+    MEAN = "mean"
+
+
+class Choice(enum.StrEnum):
+    """Which of the statistically tied feasible designs the search returns: `SAFEST` (the one of
+    the lowest corner-risk bound) or `BEST` (the lowest upper 95 % bound of the objective)."""
+
+    SAFEST = "safest"
+    BEST = "best"
+
+
+#: the names of the choices, as the command line and the TOML files give them
+ESTIMATORS = tuple(e.value for e in Estimator)
 #: a point left out of the envelope's active set still runs while its corner margin is below
 #: this [m] (`next_active`): one step of the default search moved the limited-circle margin by
 #: up to 0.25 mm and the dynamic corner margin by up to 0.28 mm (results/optimise_steady_default_run.json),
 #: so a margin above it does not bind within a step. Without it, margins alike at every speed
 #: kept every point running (benchmarks/results/bench_envelope_active_set.json)
 CORNER_WATCH = 0.3e-3
-#: the dynamic corner constraint's statistic (`SteadySettings.corner_constraint`)
-CORNER_CONSTRAINTS = ("risk", "prediction", "mean")
-#: which of the statistically tied feasible designs the search returns (`SteadySettings.choose`)
-CHOICES = ("safest", "best")
+CORNER_CONSTRAINTS = tuple(c.value for c in CornerConstraint)
+CHOICES = tuple(c.value for c in Choice)
+
+
+def _member(kind: type[enum.StrEnum], name: str, value):
+    """`value` (a member of `kind`, or its name as text) as a member of `kind`, or a one-line
+    error naming the setting and the valid names: the one place text maps to the choices."""
+    try:
+        return kind(value)
+    except ValueError:
+        raise UserInputError(
+            f"{name} = {value!r}: must be one of {', '.join(repr(m.value) for m in kind)}"
+        ) from None
 
 
 #: `clearance_step="auto"` gives the search a signal for Delta_bf where an operating point is
@@ -66,37 +106,31 @@ class SteadySettings:
     window_revs: int = 2
     settle: object = "auto"
     gradient_window: float = 1.0e-3
-    estimator: str = "frozen"
+    estimator: Estimator = Estimator.FROZEN
     corner_margin: float = CORNER_MARGIN
     rtol: float = 1e-3
     workers: int = 0  # 0: one per CPU
     verify_seeds: int = 4
     verify_first_seed: int = 1000
     verify_window_revs: int = 4
-    #: the statistic of flange PV minimised: "mean" (over contact time), "peak" (its p-mean) or
-    #: "tail" (the mean of its worst 5 %, `jaxbearing.design.STATISTICS`)
-    statistic: str = "mean"
+    #: the statistic of flange PV minimised (`jaxbearing.design.Statistic`): the mean over
+    #: contact time, the peak (its p-mean) or the tail (the mean of its worst 5 %)
+    statistic: Statistic = Statistic.MEAN
     #: half-step of the common-random-number central difference in Delta_bf [m] (0: off), or
     #: "auto": `CLEARANCE_STEP` where the envelope is misaligned by more than
     #: `CLEARANCE_MISALIGNMENT`, else off (`clearance_step_for`); the frozen-load estimator
     #: cannot see the clearance (`evaluate_starts`)
     clearance_step: float | str = "auto"
-    #: the dynamic corner constraint: "risk" (the margin on the contact radius that one revolution
-    #: exceeds with probability `corner_risk_level` at most, at 95 % confidence: the normal
-    #: tolerance bound of the per-revolution largest contact radius, `run.tolerance_bound`; the
-    #: corner-contact risk's upper bound below the level), "prediction" (on the upper 95 %
-    #: prediction bound of one revolution's largest contact radius: it holds for a further
-    #: revolution with 95 % probability) or "mean" (on its expectation per revolution)
-    corner_constraint: str = "risk"
+    #: the dynamic corner constraint (`CornerConstraint`; `RISK`: the normal tolerance bound of
+    #: the per-revolution largest contact radius, `run.tolerance_bound`)
+    corner_constraint: CornerConstraint = CornerConstraint.RISK
     #: the corner-contact risk per cage revolution the search keeps below at every operating
     #: point ("risk" constraint) and the verification must bound (its upper 95 % bound,
     #: `run.corner_risk`), else the design is reported unverified in the tail
     #: (`tail_verification`)
     corner_risk_level: float = 1e-3
-    #: the design returned: "safest" (of the feasible designs statistically tied with the one of
-    #: the lowest upper 95 % bound of the objective, the one of the lowest corner-risk bound) or
-    #: "best" (the lowest upper bound of the objective itself)
-    choose: str = "safest"
+    #: the design returned among the statistically tied feasible ones (`Choice`)
+    choose: Choice = Choice.SAFEST
     #: the envelope's active set (`next_active`): an operating point whose weight in the smooth
     #: max stays below this is not simulated (0: every point, every iteration) ...
     skip_weight: float = 1e-3
@@ -104,15 +138,17 @@ class SteadySettings:
     recheck_every: int = 3
 
     def __post_init__(self):
-        """One-line errors naming the setting, before anything runs."""
+        """One-line errors naming the setting, before anything runs; a choice given by its name
+        (text) is stored as its member."""
+        for name, kind in (
+            ("estimator", Estimator),
+            ("corner_constraint", CornerConstraint),
+            ("choose", Choice),
+            ("statistic", Statistic),
+        ):
+            object.__setattr__(self, name, _member(kind, name, getattr(self, name)))
         for name in ("seeds", "verify_seeds"):
             require(name, getattr(self, name), lambda v: (v >= 1) & (v == np.round(v)), "an integer >= 1")
-        if self.corner_constraint not in CORNER_CONSTRAINTS:
-            raise UserInputError(
-                f"corner_constraint = {self.corner_constraint!r}: must be one of {', '.join(CORNER_CONSTRAINTS)}"
-            )
-        if self.choose not in CHOICES:
-            raise UserInputError(f"choose = {self.choose!r}: must be one of {', '.join(CHOICES)}")
         require("skip_weight", self.skip_weight, lambda v: (v >= 0) & (v < 1), "in [0, 1)")
         require(
             "corner_risk_level",
@@ -136,16 +172,10 @@ class SteadySettings:
                 f"verify_first_seed = {self.verify_first_seed}: must be >= seeds = {self.seeds} "
                 "(verification uses seeds the search never saw)"
             )
-        if self.statistic not in STATISTICS:
+        if self.statistic is not Statistic.MEAN and self.estimator is not Estimator.FROZEN:
             raise UserInputError(
-                f"statistic = {self.statistic!r}: must be one of {', '.join(map(repr, STATISTICS))}"
+                f"statistic = {self.statistic.value!r} needs estimator = 'frozen' (not {self.estimator.value!r})"
             )
-        if self.statistic != "mean" and self.estimator != "frozen":
-            raise UserInputError(
-                f"statistic = {self.statistic!r} needs estimator = 'frozen' (not {self.estimator!r})"
-            )
-        if self.estimator not in ESTIMATORS:
-            raise UserInputError(f"estimator = {self.estimator!r}: must be one of {', '.join(ESTIMATORS)}")
         require("gradient_window", self.gradient_window, lambda v: np.isfinite(v) & (v > 0), "> 0 s")
         require("corner_margin", self.corner_margin, lambda v: np.isfinite(v) & (v >= 0), ">= 0 m")
         require("rtol", self.rtol, lambda v: np.isfinite(v) & (v > 0) & (v < 1), "in (0, 1)")

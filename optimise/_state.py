@@ -82,7 +82,8 @@ def fingerprint(problem: DesignProblem, settings: SteadySettings, hyper: Hyper, 
     """A hash of everything that decides the search's result (for resuming): the bearing and
     operating points, bounds, constraints, envelope, measurement settings, step sizes, starts."""
     leaves = [
-        np.asarray(v).tobytes() for v in jax.tree_util.tree_leaves((problem.bearing, problem.operating))
+        np.asarray(v).tobytes()
+        for v in jax.tree_util.tree_leaves((problem.bearing, problem.operating, problem.point_bearings))
     ]
     text = repr(
         (

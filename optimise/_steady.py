@@ -43,7 +43,7 @@ from ._evaluate import Evaluation, evaluate_starts, in_shared_pool
 from ._lagrangian import Hyper, IterationReport, augmented_lagrangian_step
 from ._problem import MARGIN_SCALE, DesignProblem, any_feasible
 from ._search import start_points
-from ._settings import SteadySettings
+from ._settings import Choice, SteadySettings
 from ._state import CHECKPOINT, History, SearchState, fingerprint, resumed_state, save_checkpoint
 from ._verify import verification
 
@@ -264,13 +264,13 @@ def tied_with_best(h: History) -> tuple[np.ndarray, tuple | None]:
     return feasible & (ci[..., 0] <= high[best]), best
 
 
-def choose(h: History, how: str) -> tuple | None:
-    """The (iteration, start) the search returns (`SteadySettings.choose`): "best", the feasible
-    evaluation of the lowest upper bound of the objective; "safest", of those tied with it
+def choose(h: History, how: Choice | str) -> tuple | None:
+    """The (iteration, start) the search returns (`SteadySettings.choose`): `Choice.BEST`, the
+    feasible evaluation of the lowest upper bound of the objective; `Choice.SAFEST`, of those tied with it
     (`tied_with_best`), the lowest upper bound of the corner-contact risk per revolution, then
     the largest dynamic corner margin. None without a feasible evaluation."""
     tied, best = tied_with_best(h)
-    if best is None or how == "best":
+    if best is None or Choice(how) is Choice.BEST:
         return best
     risk = np.asarray(h.corner_risk, float)
     risk = np.where(np.isfinite(risk), risk, 1.0)  # an unknown risk is not the safest

@@ -21,6 +21,7 @@ OPTIMISE_TOML_KEYS = {
         "temperature_GPa_m_s",
         "skip_weight",
         "recheck_every",
+        "uncertain_constants",
     ),
     "search": (
         "objective",
@@ -55,7 +56,9 @@ def load_optimise_toml(path: str) -> dict:
         [constraints]  min_clearance_mm = 0.0, flange_load_N = 100
         [envelope]     speeds_rpm = [...], loads_N = [...], weights = [...],
                        aggregate = "max" | "mean", temperature_GPa_m_s = 0.1,
-                       skip_weight = 1e-3, recheck_every = 3 (steady: the active set)
+                       skip_weight = 1e-3, recheck_every = 3 (steady: the active set),
+                       uncertain_constants = ["lubricant.traction_d", ...] (steady: every
+                       point also at every corner of these constants' ranges)
         [search]       objective = "steady" | "startup", starts, iterations, learning_rate,
                        rtol; steady: seeds, window_revs, settle, gradient_window_ms, estimator,
                        corner_margin_mm, corner_constraint, choose, clearance_step_mm, statistic,
@@ -123,6 +126,9 @@ def _checked_toml_value(path, name: str, key: str, value):
     elif key in _INTS:
         if isinstance(value, bool) or not isinstance(value, int):
             raise bad("an integer")
+    elif key == "uncertain_constants":
+        if not (isinstance(value, list) and value and all(isinstance(v, str) for v in value)):
+            raise bad("a list of configuration keys (strings)")
     elif key == "settle":
         if value != "auto" and not _is_number(value):
             raise bad('"auto" or a settling time in ms')

@@ -12,9 +12,10 @@ user's level at every operating point.
 from __future__ import annotations
 
 import jax.numpy as jnp
+import numpy as np
 
 from jaxbearing.flange import DesignVariables
-from jaxbearing.run import revolutions_needed
+from jaxbearing.run import Estimate, revolutions_needed
 
 from ._evaluate import in_shared_pool, operating_points, settled_metrics
 from ._problem import PV_SCALE, DesignProblem
@@ -25,6 +26,8 @@ def _estimates(m) -> dict:
     """One design's verification row: the issue's `mean_pv`, `p95_pv` [Pa m/s, SI] and
     `corner_contact_share`, each as value / ci95_low / ci95_high / n, and the same in the
     engineering units the documentation and the CLI print (GPa m/s, mm)."""
+    st = m.statistics
+    nothing = Estimate(np.nan, np.nan, np.nan, 0)
     return {
         "mean_pv": _scaled(m.mean_pv, 1.0) | {"unit": "Pa m/s"},
         "p95_pv": _scaled(m.p95_pv, 1.0) | {"unit": "Pa m/s"},
@@ -32,27 +35,26 @@ def _estimates(m) -> dict:
         "p95_pv_GPa_m_s": _scaled(m.p95_pv),
         "objective_GPa_m_s": _scaled(m.objective),
         # the expected largest PV of a cage revolution (what the "peak" statistic aims at)
-        "peak_pv_GPa_m_s": _scaled(m.summary.get("flange_pv_Pa_m_s", {}).get("max", {})),
+        "peak_pv_GPa_m_s": _scaled(nothing if st is None else st.flange_pv_Pa_m_s.max),
         # the mean of the worst 5 % of PV over contact time (the "tail" statistic)
-        "tail_pv_GPa_m_s": _scaled(m.summary.get("flange_pv_contact_time_Pa_m_s", {}).get("tail95", {})),
-        "corner_contact_share": dict(m.corner_contact_share),
+        "tail_pv_GPa_m_s": _scaled(nothing if st is None else st.flange_pv_contact_time_Pa_m_s.tail95),
+        "corner_contact_share": m.corner_contact_share.as_dict(),
         "corner_margin_mm": _scaled(m.corner_margin, 1e-3),
         # the margin on the upper 95 % prediction bound of one revolution's largest contact radius
         "corner_margin_bound_mm": float(m.corner_margin_bound) * 1e3,
         # how far zero corner contact in these seeds bounds the tail (upper 95 % bounds)
-        "corner_contact_bound": m.summary.get("corner_contact_bound"),
+        "corner_contact_bound": None if st is None else st.corner_contact_bound.as_dict(),
         # the probability per revolution of reaching the corner, with its bounds (`run.corner_risk`)
-        "corner_risk": m.summary.get("corner_risk"),
+        "corner_risk": None if st is None or st.corner_risk is None else st.corner_risk.as_dict(),
         "settled": m.settled,
         "seeds": m.seeds,
     }
 
 
-def _scaled(est: dict, unit: float = PV_SCALE) -> dict:
-    return {
-        k: (None if est.get(k) is None else float(est[k]) / unit) if k != "n" else est.get("n", 0)
-        for k in ("value", "ci95_low", "ci95_high", "n")
-    }
+def _scaled(est: Estimate, unit: float = PV_SCALE) -> dict:
+    """`est` divided by `unit`, as {"value", "ci95_low", "ci95_high", "n"} (None for NaN)."""
+    d = est.as_dict()
+    return {k: v if k == "n" or v is None else v / unit for k, v in d.items()}
 
 
 @in_shared_pool
@@ -68,7 +70,7 @@ def verification(problem: DesignProblem, settings: SteadySettings, design, refer
     metrics = settled_metrics(
         problem,
         settings,
-        ops * 2,
+        list(range(len(ops))) * 2,
         [d for d in designs for _ in ops],
         verification=True,
         first_seed=settings.verify_first_seed,

@@ -205,10 +205,10 @@ if _COMPILE_LOG:
 
     _cc._build = _logged_build
 
-    import jaxbearing.run._dispatch as _dispatch
     import jaxbearing.run._initial as _initial
     import jaxbearing.run._member as _member
     import jaxbearing.run._start_cache as _start_cache
+    import jaxbearing.run._starts as _starts
 
     _plain_skid = _initial._static_skid_start
 
@@ -220,7 +220,7 @@ if _COMPILE_LOG:
         per.setdefault("skid", []).append([key[:12], "read" if stored else "solved"])
         return _plain_skid(bearing, op, perturbation)
 
-    _initial._static_skid_start = _member._static_skid_start = _dispatch._static_skid_start = _logged_skid
+    _initial._static_skid_start = _member._static_skid_start = _starts._static_skid_start = _logged_skid
 
     import jax._src.compiler as _compiler
 

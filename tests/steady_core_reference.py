@@ -46,7 +46,9 @@ def setting() -> dict:
 
 
 def _estimate(block) -> list:
-    return [block.get(k) for k in ("value", "ci95_low", "ci95_high")]
+    """[value, ci95_low, ci95_high] of a summary block or an `Estimate` (None for NaN)."""
+    d = block if isinstance(block, dict) else block.as_dict()
+    return [d.get(k) for k in ("value", "ci95_low", "ci95_high")]
 
 
 def compute() -> dict:
@@ -96,7 +98,11 @@ def compute() -> dict:
     problem = make_problem(b, op)
     # the corner constraint of the recording (the default then)
     settings = optimise.SteadySettings(
-        seeds=2, window_revs=2, settle=0.005, workers=1, corner_constraint="prediction"
+        seeds=2,
+        window_revs=2,
+        settle=0.005,
+        workers=1,
+        corner_constraint=optimise.CornerConstraint.PREDICTION,
     )
     with tempfile.TemporaryDirectory() as tmp:
         res = optimise.steady_search(

@@ -240,9 +240,10 @@ def test_several_operating_points_in_one_engine_call_equal_their_single_runs():
 def test_continuing_seeds_share_their_case_time_constant(monkeypatch):
     """Members continuing from given states with the settling verdict (the design search's
     default) solve one static skid equilibrium per case, not one per seed: the verdict uses
-    only its time constant, so both seeds' verdicts carry the same one. (A short run: from
+    only its time constant, so both seeds' verdicts carry the same one. It is solved in the
+    engine's one start step (`resolve_starts`), never inside a member's program. (A short run: from
     the quasi-static states, settling capped at 1 ms, a 2-revolution window.)"""
-    import jaxbearing.run._dispatch as settle
+    import jaxbearing.run._starts as starts
 
     bearing, op = _small()
     seeds = [jb.Perturbation(seed=k) for k in range(2)]
@@ -250,11 +251,17 @@ def test_continuing_seeds_share_their_case_time_constant(monkeypatch):
     # the batch-mates test built it; eagerly, each call compiles every operation again, 5-7 s)
     continuing = [Member(bearing, op, p, kinematic_start(bearing, op, p)) for p in seeds]
     fresh = Member(bearing, op, jb.Perturbation(seed=5))
-    assert settle._continuing_cases([fresh, *continuing], OPTIONS) == {1: 1, 2: 1}
-    assert settle._continuing_cases(continuing, OPTIONS.replace(settle="off")) == {}
+    assert starts.continuing_cases([fresh, *continuing], OPTIONS) == {1: 1, 2: 1}
+    assert starts.continuing_cases(continuing, OPTIONS.replace(settle="off")) == {}
     solved = []
-    real = settle._static_skid_start
-    monkeypatch.setattr(settle, "_static_skid_start", lambda *a: solved.append(a[2].seed) or real(*a))
+    import jaxbearing.run._member as member_module
+
+    def solved_in_a_member(*a):  # the starts are resolved before any member runs
+        raise AssertionError("a member program solved its own static skid equilibrium")
+
+    monkeypatch.setattr(member_module, "_static_skid_start", solved_in_a_member)
+    real = starts._static_skid_start
+    monkeypatch.setattr(starts, "_static_skid_start", lambda *a: solved.append(a[2].seed) or real(*a))
     capped = OPTIONS.replace(settle_cap_ms=1.0, strategy="sequential")
     runs = settle_members(continuing, capped).runs
     assert solved == [0]

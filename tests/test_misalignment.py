@@ -226,32 +226,48 @@ def test_axial_load_is_carried_by_the_inner_flanges():
 
 
 def test_nu_inner_ring_floats_under_axial_load():
-    """The same axial load on an NU bearing (`bearing.type = "NU"`: no inner flanges; the
-    configuration rejects it, docs/model.md 5.3, so this is the model's own answer): at every
+    """The same axial load on an NU bearing (`bearing.type = "NU"`: no inner flanges). Free
+    axially (which the configuration rejects for this reason, docs/model.md 5.3): at every
     axial position of the ring, from centred to 0.3 mm, its inner flanges exert exactly nothing
     and the ring's axial force is F_a plus the raceways' axial traction alone, positive
-    throughout: no position balances it, the ring floats. The NUP at 0.3 mm pushes it back."""
+    throughout: no position balances it, the ring would be pushed off the rollers. The NUP at
+    0.3 mm pushes it back. Held axially (the accepted NU configuration: the shaft's locating
+    bearing carries F_a): the ring's axial rates are exactly zero and the reaction the locating
+    bearing supplies, R = -(F_a + F_raceways.X + F_inner flanges.X), is -F_a to within the
+    raceways' axial traction (below 1 %), none of it through the flanges."""
     b = jb.reference_bearing()
     nu = eqx.tree_at(lambda b: b.flange_presence, b, jnp.array([0.0, 0.0, 1.0, 1.0]))
     f_a = 300.0
     op = _op(axial_load=f_a, axial_freedom=1)
     y = kinematic_start(b, op, jb.Perturbation(axial=0.0, skew=0.0))  # no scatter
 
-    def axial(bearing, x):
+    def axial(bearing, x, op=op):
         s = eqx.tree_at(lambda s: s.inner_ring.axial, y, jnp.asarray(x, dtype=float))
         params = Params(bearing=bearing, operating=op)
-        return float(_rates(0.0, s, params).inner_ring.axial_velocity * b.inner_ring_mass), _loads(s, params)
+        return _rates(0.0, s, params).inner_ring, _loads(s, params)
 
     for x in (0.0, 0.1e-3, 0.2e-3, 0.3e-3):
-        net, loads = axial(nu, x)
+        rates, loads = axial(nu, x)
+        net = float(rates.axial_velocity * b.inner_ring_mass)
         fl = loads.flange
         assert np.all(np.asarray(fl.normal_force)[:, :2] == 0.0)
         assert np.all(np.asarray(fl.force_on_ring)[:, :2] == 0.0)
         raceway = float(np.sum(np.asarray(loads.inner.force_on_ring)[:, 0]))
         assert net == pytest.approx(f_a + raceway, rel=1e-12)
         assert net > 0.99 * f_a
-    net_nup, loads_nup = axial(b, 0.3e-3)
-    assert net_nup < 0 and np.sum(np.asarray(loads_nup.flange.force_on_ring)[:, 0, 0]) < -f_a
+        # held by the locating bearing (axial freedom off): the same contacts, no axial motion
+        held_op = _op(axial_load=f_a)
+        validate_bearing(nu, held_op)
+        held, held_loads = axial(nu, x, held_op)
+        assert float(held.axial) == 0.0 and float(held.axial_velocity) == 0.0
+        flanges = float(np.sum(np.asarray(held_loads.flange.force_on_ring)[:, :2, 0]))
+        raceway = float(np.sum(np.asarray(held_loads.inner.force_on_ring)[:, 0]))
+        reaction = -(f_a + raceway + flanges)
+        assert flanges == 0.0 and reaction == pytest.approx(-f_a, rel=0.01)
+    rates, loads_nup = axial(b, 0.3e-3)
+    assert (
+        float(rates.axial_velocity) < 0 and np.sum(np.asarray(loads_nup.flange.force_on_ring)[:, 0, 0]) < -f_a
+    )
 
 
 def test_axial_and_tilt_rates_follow_the_equations():

@@ -24,6 +24,7 @@ import optimise._settings as search_settings
 import optimise._steady as steady
 import optimise._verify as verify
 from jaxbearing import UserInputError
+from jaxbearing.run import CornerCount, Estimate
 from optimise._cli import main
 
 SMALL = "[bearing]\nnum_slices = 11\n"
@@ -66,7 +67,7 @@ def test_bad_steady_settings_are_one_line(kw, text):
 @pytest.mark.parametrize(
     "args,text",
     [
-        (["--estimator", "lss"], "estimator = 'lss': must be one of frozen, window"),
+        (["--estimator", "lss"], "estimator = 'lss': must be one of 'frozen', 'window'"),
         (["--objective", "peak"], "objective = 'peak': must be 'steady' or 'startup'"),
         (["--seeds", "0"], "seeds = 0"),
         (["--settle", "soon"], "settle = 'soon'"),
@@ -77,8 +78,11 @@ def test_bad_steady_settings_are_one_line(kw, text):
         (["--clearance-step-mm", "-0.01"], "clearance_step_mm = -0.01: must be >= 0"),
         (["--clearance-step-mm", "soon"], "clearance_step_mm = 'soon': expected a float"),
         (["--skip-weight", "1.5"], "skip_weight = 1.5: must be in [0, 1)"),
-        (["--corner-constraint", "p99"], "corner_constraint = 'p99': must be one of risk, prediction, mean"),
-        (["--choose", "cheapest"], "choose = 'cheapest': must be one of safest, best"),
+        (
+            ["--corner-constraint", "p99"],
+            "corner_constraint = 'p99': must be one of 'risk', 'prediction', 'mean'",
+        ),
+        (["--choose", "cheapest"], "choose = 'cheapest': must be one of 'safest', 'best'"),
         (["--recheck-every", "0"], "recheck_every = 0: must be > 0"),
         (["--corner-risk-level", "2"], "corner_risk_level = 2.0: must be in (0, 1) per revolution"),
     ],
@@ -232,9 +236,16 @@ def _metrics_stand_in(calls):
         pv = 1e9 * float(design.end_radius) / 0.08  # lower for a smaller end radius here
 
         def est(v, hw):
-            return {"value": v, "ci95_low": v - hw, "ci95_high": v + hw, "n": seeds}
+            return Estimate(v, v - hw, v + hw, seeds)
 
         share = 0.01 if design.end_radius < 0.075 else 0.0
+        nothing = Estimate(math.nan, math.nan, math.nan, 0)
+        revs = 4 * seeds
+        counted = (
+            CornerCount(revs, 0, 0.17, seeds, 0, 0.5)
+            if share == 0
+            else CornerCount(revs, revs, 1.0, seeds, seeds, 1.0)
+        )
         return types.SimpleNamespace(
             mean_pv=est(pv, 0.05e9),
             p95_pv=est(2 * pv, 0.1e9),
@@ -242,7 +253,13 @@ def _metrics_stand_in(calls):
             corner_contact_share=est(share, 0.0),
             corner_margin=est(1e-4, 1e-5),
             corner_margin_bound=0.5e-4,
-            summary={"corner_contact_bound": {"per_revolution_upper95": 0.17 if share == 0 else 1.0}},
+            simulated_ms=0.0,
+            statistics=types.SimpleNamespace(
+                flange_pv_Pa_m_s=types.SimpleNamespace(max=nothing),
+                flange_pv_contact_time_Pa_m_s=types.SimpleNamespace(tail95=nothing),
+                corner_contact_bound=counted,
+                corner_risk=None,
+            ),
             settled=True,
             seeds=list(range(first_seed, first_seed + seeds)),
         )
@@ -373,7 +390,7 @@ def _engine_stand_in(seen, samples=False):
         for d in designs:
             x = 1 + 2000 * float(d.axial_clearance) + float(d.end_radius)
             per_seed = [1e9 * x + 1e8 * k for k in range(seeds)]
-            est = {"value": float(np.mean(per_seed)), "ci95_low": 0.0, "ci95_high": 1e10, "n": seeds}
+            est = Estimate(float(np.mean(per_seed)), 0.0, 1e10, seeds)
             out.append(
                 types.SimpleNamespace(
                     objective=est,
@@ -382,9 +399,10 @@ def _engine_stand_in(seen, samples=False):
                     corner_margin_bound=1e-4,
                     corner_contact_share=est,
                     mean_pv=est,
+                    statistics=None,
                     settled=True,
                     seeds=list(range(seeds)),
-                    summary={"per_seed": [{"settle_time_ms": 1.0}] * seeds, "window_ms": 2.0},
+                    simulated_ms=3.0 * seeds,
                     final_states=[("state", float(d.axial_clearance))] * seeds,
                     sample_states=[("sample", float(d.end_radius))] if samples else [],
                     contact_radius_maxima=[],  # no revolutions: the risk margin falls back
@@ -542,8 +560,8 @@ def _envelope_engine(seen):
         for k, op in enumerate(ops):
             w = float(op.inner_speed) / 1000.0
             j = 1e9 * w * w
-            est = {"value": j, "ci95_low": 0.95 * j, "ci95_high": 1.05 * j, "n": seeds}
-            margin = {"value": 1e-3 / w, "ci95_low": 0.0, "ci95_high": 1.0, "n": seeds}
+            est = Estimate(j, 0.95 * j, 1.05 * j, seeds)
+            margin = Estimate(1e-3 / w, 0.0, 1.0, seeds)
             steps = 0 if initial_states is None or initial_states[k] is None else initial_states[k][0][1]
             out.append(
                 types.SimpleNamespace(
@@ -551,11 +569,12 @@ def _envelope_engine(seen):
                     objective_per_seed=[j] * seeds,
                     corner_margin=margin,
                     corner_margin_bound=0.5e-3 / w,
-                    corner_contact_share={"value": 0.0},
+                    corner_contact_share=Estimate(0.0, 0.0, 0.0, seeds),
                     mean_pv=est,
+                    statistics=None,
                     settled=True,
                     seeds=list(range(seeds)),
-                    summary={"per_seed": [{"settle_time_ms": 1.0}] * seeds, "window_ms": 2.0},
+                    simulated_ms=3.0 * seeds,
                     final_states=[(w, steps + 1)] * seeds,
                     sample_states=[],
                     contact_radius_maxima=[],  # no revolutions: the risk margin falls back
@@ -708,9 +727,10 @@ def test_verification_reports_every_operating_point(monkeypatch, capsys):
         out = inner(bearing, ops, designs, *args, **kw)
         for m, op in zip(out, ops):
             fast = float(op.inner_speed) > 3000.0
-            for est in (m.mean_pv, m.objective):
-                hw = 0.05e9 if fast else 1e9
-                est["ci95_low"], est["ci95_high"] = est["value"] - hw, est["value"] + hw
+            hw = 0.05e9 if fast else 1e9
+            for name in ("mean_pv", "objective"):
+                est = getattr(m, name)
+                setattr(m, name, Estimate(est.value, est.value - hw, est.value + hw, est.n))
         return out
 
     monkeypatch.setattr(evaluation, "steady_design_metrics_points", engine)
@@ -865,3 +885,78 @@ def test_risk_corner_margin_is_the_tolerance_bound_inside_the_limited_circle():
     )
     m.contact_radius_maxima = [np.array([3.0e-3, 0.0]), np.array([3.1e-3])]  # two in contact
     assert evaluation.corner_margin_of(settings, m) == 1e-4
+
+
+def test_uncertain_constants_run_every_point_at_every_corner(tmp_path, config, monkeypatch, capsys):
+    """`optimise run --uncertain-constants lubricant.traction_d,lubricant.oil_fraction`: every
+    operating point also runs at every corner of the two constants' ranges (and the nominal
+    point), as further points of the envelope; the engine gets each point with its corner's
+    bearing, the verification and result.json name the corner of each point. Stand-ins for the
+    search's ensemble and `steady_design_metrics_points` (the engine is the same as without)."""
+    import jaxbearing as jb
+    from jaxbearing.design import robustness_corners
+
+    monkeypatch.setattr(steady, "evaluate_starts", _stand_in_starts)
+    seen = []
+    inner = _metrics_stand_in([])
+
+    def engine(bearings, ops, designs, settings, **kw):
+        seen.extend(
+            (float(b.lubricant.traction_d), float(b.lubricant.oil_fraction), float(op.inner_speed))
+            for b, op in zip(bearings, ops)
+        )
+        return inner(bearings, ops, designs, settings, **kw)
+
+    monkeypatch.setattr(evaluation, "steady_design_metrics_points", engine)
+    out = tmp_path / "robust"
+    keys = "lubricant.traction_d,lubricant.oil_fraction"
+    args = [*ARGS, "--speeds-rpm", "10000,30000", "--uncertain-constants", keys, "--out", str(out)]
+    assert main(["run", "--config", config, *args]) == 0
+    r = json.loads((out / "result.json").read_text())
+    _, _, corners = robustness_corners(jb.load_config(config), keys.split(","))
+    names = [c.name for c, _ in corners]
+    assert [p["constants"] for p in r["operating_points"]] == [n for n in names for _ in range(2)]
+    assert len(r["verification"]["optimum"]["per_operating_point"]) == 10
+    expected = [
+        (c.values["lubricant.traction_d"], c.values["lubricant.oil_fraction"])
+        for c, _ in corners
+        for _ in range(2)
+    ]
+    assert len(seen) == 20  # the reference and the found design at the 10 points, one engine call
+    for i, (d, f, _) in enumerate(seen):
+        assert (d, f) == pytest.approx(expected[i % 10])
+    assert "at 30000 rpm, 1000 N, traction_d+, oil_fraction-" in capsys.readouterr().out
+    # a key without a stated range: one line naming the setting
+    bad = [*ARGS, "--uncertain-constants", "roller.length_mm", "--out", str(tmp_path / "bad")]
+    assert main(["run", "--config", config, *bad]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: uncertain_constants: constants = 'roller.length_mm'") or (
+        "uncertain_constants" in err and err.count("\n") == 1
+    )
+
+
+def test_problem_with_constant_corners_runs_each_point_with_its_bearing():
+    """`make_problem(..., constant_corners=...)`: K envelope points x C corners, corner-major,
+    each with its corner's bearing (`DesignProblem.bearing_at`) and the envelope's weights
+    repeated; without corners every point runs the problem's bearing; the start-up objective
+    refuses corners in one line."""
+    import dataclasses as dc
+
+    import jaxbearing as jb
+    from optimise import make_problem
+
+    b, op = jb.reference_bearing(), jb.reference_operating_point()
+    low = dc.replace(b, lubricant=dc.replace(b.lubricant, traction_d=jnp.asarray(0.03)))
+    plain = make_problem(b, op, speeds_rpm=[10e3, 30e3], weights=[1.0, 2.0])
+    assert plain.bearing_at(1) is b and plain.point_constants is None
+    p = make_problem(
+        b, op, speeds_rpm=[10e3, 30e3], weights=[1.0, 2.0], constant_corners=[("nominal", b), ("low D", low)]
+    )
+    assert p.num_operating_points == 4 and p.point_constants == ("nominal", "nominal", "low D", "low D")
+    assert np.asarray(p.weights).tolist() == [1.0, 2.0, 1.0, 2.0]
+    assert [float(p.bearing_at(k).lubricant.traction_d) for k in range(4)] == pytest.approx(
+        [0.04, 0.04, 0.03, 0.03]
+    )
+    assert p.point_label(3) == "30000 rpm, 1000 N, low D"
+    with pytest.raises(UserInputError, match="start-up objective"):
+        p.peak_pv(jnp.full(3, 0.5))

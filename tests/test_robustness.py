@@ -55,19 +55,19 @@ def _fake_engine(seen: dict):
         return [SimpleNamespace(bearing=b) for b in bearings]
 
     def est(v, h):
-        return {"value": v, "ci95_low": v - h, "ci95_high": v + h, "n": 2}
+        return Estimate(v, v - h, v + h, 2)
 
     def metrics(result, design, margins, corner_margin, functionals):
         d = float(result.bearing.lubricant.traction_d)
         mine = float(design.end_radius) == float(DESIGN.end_radius)
         mean = (2.0 if d < 0.04 - 1e-9 else 1.0) if mine else 2.0
-        summary = {
-            "flange_pv_Pa_m_s": {"max": est((3.0 if mine else 5.0) * GPA, 0.1 * GPA)},
-            "cage_slip": est(0.1 + 10 * (0.04 - d), 0.01),
-        }
+        statistics = SimpleNamespace(
+            flange_pv_Pa_m_s=SimpleNamespace(max=est((3.0 if mine else 5.0) * GPA, 0.1 * GPA)),
+            cage_slip=est(0.1 + 10 * (0.04 - d), 0.01),
+        )
         return SimpleNamespace(
             mean_pv=est(mean * GPA, 0.1 * GPA),
-            summary=summary,
+            statistics=statistics,
             settled=True,
             design={"end_radius_m": float(design.end_radius)},
         )

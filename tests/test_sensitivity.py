@@ -11,6 +11,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+from types import SimpleNamespace as NS
 
 import numpy as np
 import pytest
@@ -121,11 +122,11 @@ def _fake_settled(statistic):
     def statistics(windows, edges, bearing, op):
         (w,) = windows
         v = statistic(w["x"], w["k"])
-        return {
-            "cage_slip": {"value": v},
-            "flange_pv_Pa_m_s": {"mean": {"value": 2 * v}, "max": {"value": None}},
-            "contact_height_m": {"max": {"value": v}},
-        }
+        return NS(
+            cage_slip=NS(value=v),
+            flange_pv_Pa_m_s=NS(mean=NS(value=2 * v), max=NS(value=math.nan)),
+            contact_height_m=NS(max=NS(value=v)),
+        )
 
     return points, statistics
 
@@ -135,7 +136,7 @@ def test_crn_differences_recover_closed_forms(monkeypatch):
     # offset c_k cancels in each pair; the effect is 2 x u with an interval of zero width
     points, stats = _fake_settled(lambda x, k: x**2 + 0.3 * k)
     monkeypatch.setattr(module, "simulate_steady_points", points)
-    monkeypatch.setattr(module, "steady_statistics", stats)
+    monkeypatch.setattr(module, "settled_statistics", stats)
     cfg = reference_config().replace({"bearing.num_slices": 5})
     settings = module.SteadySettings(seeds=3, window_revs=2)
     r = sensitivity(cfg, ["cage_slip", "mean_pv", "peak_pv"], settings)
@@ -162,7 +163,7 @@ def test_crn_interval_is_student_t_over_seeds(monkeypatch):
 
     points, stats = _fake_settled(statistic)
     monkeypatch.setattr(module, "simulate_steady_points", points)
-    monkeypatch.setattr(module, "steady_statistics", stats)
+    monkeypatch.setattr(module, "settled_statistics", stats)
     cfg = reference_config().replace({"bearing.num_slices": 5})
     r = sensitivity(cfg, ["cage_slip"], module.SteadySettings(seeds=4, window_revs=2))
     i = [x.key for x in r.inputs].index("lubricant.traction_d")
@@ -252,7 +253,7 @@ progress = false
 "lubricant.oil_fraction" = 0.01
 """
 #: Student-t 97.5 % quantile at 1 degree of freedom: the batch-means interval of a 2-revolution
-#: window (`run.steady_statistics`, Student-t over b - 1 = 1 batch)
+#: window (`run.settled_statistics`, Student-t over b - 1 = 1 batch)
 _T975_1 = 12.706204736174698
 
 

@@ -158,10 +158,10 @@ def test_corner_contact_bound_counts_revolutions_and_seeds():
         },
     ]
     b = corner_contact_bound(seeds, rho)
-    assert (b["revolutions"], b["revolutions_with_corner_contact"]) == (7, 1)
-    assert (b["seeds"], b["seeds_with_corner_contact"]) == (2, 1)
-    assert b["per_revolution_upper95"] == upper_probability_bound(1, 7)
-    assert b["per_seed_upper95"] == upper_probability_bound(1, 2)
+    assert (b.revolutions, b.revolutions_with_corner_contact) == (7, 1)
+    assert (b.seeds, b.seeds_with_corner_contact) == (2, 1)
+    assert b.per_revolution_upper95 == upper_probability_bound(1, 7)
+    assert b.per_seed_upper95 == upper_probability_bound(1, 2)
 
 
 def test_max_contact_radius_bound_is_the_normal_prediction_bound():
@@ -181,15 +181,42 @@ def test_max_contact_radius_bound_is_the_normal_prediction_bound():
     x = np.array([1.0e-3, 1.2e-3, 1.1e-3, 0.9e-3])
     b = max_contact_radius_bound(seeds)
     expected = x.mean() + stats.t.ppf(0.95, 3) * x.std(ddof=1) * np.sqrt(1 + 1 / 4)
-    assert b["value"] == pytest.approx(expected, rel=1e-12) and b["revolutions"] == 4
-    assert np.isnan(
-        max_contact_radius_bound([{"contact_radius_m.max_in_contact": np.array([1e-3])}])["value"]
-    )
+    assert b.value == pytest.approx(expected, rel=1e-12) and b.revolutions == 4
+    assert np.isnan(max_contact_radius_bound([{"contact_radius_m.max_in_contact": np.array([1e-3])}]).value)
     rng = np.random.default_rng(0)
     trials = 20_000
     draws = rng.normal(2.0e-3, 0.03e-3, size=(trials, 9))
     exceeded = sum(
-        draws[i, 8] > max_contact_radius_bound([{"contact_radius_m.max_in_contact": draws[i, :8]}])["value"]
+        draws[i, 8] > max_contact_radius_bound([{"contact_radius_m.max_in_contact": draws[i, :8]}]).value
         for i in range(trials)
     )
     assert abs(exceeded / trials - 0.05) < 4 * np.sqrt(0.05 * 0.95 / trials)
+
+
+def test_settled_statistics_has_every_statistic_as_a_field_and_writes_the_summary_from_them():
+    """`SettledStatistics`: every per-revolution statistic (`revolution_statistic_keys`) is one
+    field (`estimates()` names each once), each the Student-t interval over the seeds of the
+    seeds' means; the summary block (`as_dict`) nests the same numbers by group and reduction."""
+    import jaxbearing as jb
+    from jaxbearing.run import SettledStatistics, revolution_statistic_keys, settled_statistics
+
+    rng = np.random.default_rng(3)
+    keys = revolution_statistic_keys()
+    seeds = [{k: rng.uniform(1.0, 2.0, size=3) for k in keys} for _ in range(3)]
+    for s in seeds:
+        s["contact_radius_m.max_in_contact"] = rng.uniform(1e-3, 2e-3, size=3)
+    b, op = jb.reference_bearing(), jb.reference_operating_point()
+    st = settled_statistics([], [], b, op, per_revolution=seeds)
+    assert isinstance(st, SettledStatistics)
+    est = st.estimates()
+    assert list(sorted(est)) == sorted(keys)
+    x = [float(np.mean(s["flange_pv_Pa_m_s.max"])) for s in seeds]
+    assert st.flange_pv_Pa_m_s.max.value == pytest.approx(np.mean(x), rel=1e-12)
+    assert st.flange_pv_Pa_m_s.max.n == 3 and st.cage_slip is est["cage_slip"]
+    block = st.as_dict()
+    for key in keys:
+        group, _, red = key.partition(".")
+        got = block[group][red] if red else block[group]
+        assert got == est[key].as_dict()
+    assert block["max_contact_radius_bound"]["revolutions"] == 9
+    assert block["limited_circle_radius_m"] == st.limited_circle_radius_m

@@ -32,18 +32,21 @@ def test_steady_design_metrics_report_intervals_and_margins(small):
     )
     assert m.summary["settle_mode"] == "fixed" and m.summary["settle_time_ms"] == pytest.approx(0.5)
     for est in (m.mean_pv, m.p95_pv, m.corner_contact_share, m.corner_margin):
-        assert est["ci95_low"] <= est["value"] <= est["ci95_high"] and est["n"] == 2
-    assert 0 < m.mean_pv["value"] < m.p95_pv["value"]
+        assert est.ci95_low <= est.value <= est.ci95_high and est.n == 2
+    assert 0 < m.mean_pv.value < m.p95_pv.value
     # the arc end at R_end 80 mm keeps its contacts inside the limited circle
-    assert m.corner_contact_share["value"] == 0.0 and m.corner_margin["value"] > 0
-    rho_lim = m.summary["limited_circle_radius_m"]
-    widest = m.summary["contact_radius_m"]["max_in_contact"]["value"]
-    assert widest >= m.summary["contact_radius_m"]["p99"]["value"]
-    assert m.corner_margin["value"] == pytest.approx(rho_lim - jb.design.CORNER_MARGIN - widest)
+    assert m.corner_contact_share.value == 0.0 and m.corner_margin.value > 0
+    st = m.statistics
+    rho_lim = st.limited_circle_radius_m
+    widest = st.contact_radius_m.max_in_contact.value
+    assert widest >= st.contact_radius_m.p99.value
+    assert m.corner_margin.value == pytest.approx(rho_lim - jb.design.CORNER_MARGIN - widest)
     # the prediction bound of one further revolution over the 4 revolutions lies above their mean
-    bound = m.summary["max_contact_radius_bound"]
-    assert bound["revolutions"] == 4 and bound["value"] > widest
-    assert m.corner_margin_bound == pytest.approx(rho_lim - jb.design.CORNER_MARGIN - bound["value"])
+    bound = st.max_contact_radius_bound
+    assert bound.revolutions == 4 and bound.value > widest
+    assert m.corner_margin_bound == pytest.approx(rho_lim - jb.design.CORNER_MARGIN - bound.value)
+    # the summary is written from the same statistics
+    assert m.summary["contact_radius_m"]["max_in_contact"]["value"] == widest
     assert set(m.static_margins) == set(MARGIN_NAMES)
     assert m.design["axial_clearance_m"] == pytest.approx(0.15e-3)
 

@@ -370,6 +370,9 @@ CLI_CHECKS = {
     ("optimise", "run", "--verify-seeds"): [
         "test_optimise_steady.py::test_verify_seeds_option_reaches_the_verification"
     ],
+    ("optimise", "run", "--uncertain-constants"): [
+        "test_optimise_steady.py::test_uncertain_constants_run_every_point_at_every_corner"
+    ],
     ("optimise", "run", "--corner-risk-level"): [
         "test_optimise_steady.py::test_tail_verification_needs_the_risk_bounded_at_every_operating_point"
     ],

@@ -1,6 +1,6 @@
 """Is the default 3-speed design better than the reference whatever the model's unmeasured
 constants are? `jaxbearing.design.robustness` of the design found by the default search
-(`optimise_3speed_default_run_4_iterations.json`) against the reference bearing's own design,
+(`optimise_3speed_risk_run.json`; `--design-file` for another) against the reference bearing's own design,
 at every corner of the traction asymptote D and the oil fraction (which carries the drag
 coefficient), ranges as `jaxbearing.design.sensitivity_inputs` states them, and every speed of
 `examples/optimise.toml`'s envelope, settled, on seeds from 5000 (never used by the search or
@@ -34,7 +34,7 @@ from jaxbearing.run import SteadySettings
 
 ROOT = Path(__file__).resolve().parents[2]
 OUT = ROOT / "benchmarks/results/study_robust_design.json"
-DESIGN_FILE = ROOT / "benchmarks/results/optimise_3speed_default_run_4_iterations.json"
+DESIGN_FILE = ROOT / "benchmarks/results/optimise_3speed_risk_run.json"
 ENVELOPE_FILE = ROOT / "examples/optimise.toml"
 
 
@@ -46,15 +46,21 @@ def parse(argv):
     p.add_argument("--first-seed", type=int, default=5000, help="first seed (default 5000)")
     p.add_argument("--out", type=Path, default=OUT, help="results file (default the study's)")
     p.add_argument(
+        "--design-file",
+        type=Path,
+        default=DESIGN_FILE,
+        help="a search's result.json whose design is checked (default the 3-speed default run's)",
+    )
+    p.add_argument(
         "--time-members", action="store_true", help="time one member at 11 and 31 slices (default off)"
     )
     return p.parse_args(argv)
 
 
-def default_design() -> DesignVariables:
+def default_design(path: Path = DESIGN_FILE) -> DesignVariables:
     import json
 
-    d = json.loads(DESIGN_FILE.read_text())["design"]
+    d = json.loads(path.read_text())["design"]
     return DesignVariables(
         d["end_radius_mm"] * 1e-3, math.radians(d["layback_angle_deg"]), d["axial_clearance_mm"] * 1e-3
     )
@@ -119,7 +125,13 @@ def main(argv=None) -> int:
     settings = SteadySettings(seeds=args.seeds, window_revs=args.window_revs, progress=True)
     started_at = commit()
     t = time.perf_counter()
-    res = robustness(cfg, default_design(), ops=envelope(cfg), settings=settings, first_seed=args.first_seed)
+    res = robustness(
+        cfg,
+        default_design(args.design_file),
+        ops=envelope(cfg),
+        settings=settings,
+        first_seed=args.first_seed,
+    )
     wall = time.perf_counter() - t
     command = "taskset -c 1 python benchmarks/studies/study_robust_design.py " + " ".join(
         sys.argv[1:] if argv is None else argv

@@ -30,23 +30,24 @@ sys.path.insert(0, str(HERE.parents[1]))
 import _common  # noqa: E402
 
 
+def _gpa(est) -> dict:
+    """An estimate in GPa m/s, {"value", "ci95_low", "ci95_high"} (None for NaN)."""
+    d = est.as_dict()
+    return {k: None if d[k] is None else d[k] / 1e9 for k in ("value", "ci95_low", "ci95_high")}
+
+
 def _row(m) -> dict:
-    pv = m.summary.get("flange_pv_Pa_m_s", {}).get("max", {})
+    st = m.statistics
     maxima = np.concatenate([np.asarray(r, float) for r in m.contact_radius_maxima] or [np.zeros(0)])
     return {
-        "mean_pv_GPa_m_s": {
-            k: (None if m.mean_pv.get(k) is None else m.mean_pv[k] / 1e9)
-            for k in ("value", "ci95_low", "ci95_high")
-        },
-        "peak_pv_GPa_m_s": {
-            k: (None if pv.get(k) is None else pv[k] / 1e9) for k in ("value", "ci95_low", "ci95_high")
-        },
-        "corner_contact_share": m.corner_contact_share,
+        "mean_pv_GPa_m_s": _gpa(m.mean_pv),
+        "peak_pv_GPa_m_s": _gpa(st.flange_pv_Pa_m_s.max) if st is not None else None,
+        "corner_contact_share": m.corner_contact_share.as_dict(),
         "revolutions": int(maxima.size),
         "revolutions_at_the_corner": int(np.sum(maxima > m.limited_circle_radius_m)),
         "largest_contact_radius_mm": float(maxima.max() * 1e3) if maxima.size else None,
         "limited_circle_radius_mm": float(m.limited_circle_radius_m * 1e3),
-        "corner_risk": m.summary.get("corner_risk"),
+        "corner_risk": None if st is None or st.corner_risk is None else st.corner_risk.as_dict(),
         "settled": m.settled,
         "seeds": m.seeds,
     }

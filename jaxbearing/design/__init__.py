@@ -14,7 +14,7 @@
 - its gradient: `steady_gradient` (an ensemble of short-window forward-mode sensitivities from
   settled states, `GRADIENT_WINDOW`), `frozen_load_gradient` (`frozen_load_gradients`: many cases, one call; `frozen_load_statistics`: several statistics from the same trajectories), `ratio_gradient`, `paired_central_difference` (common-random-number differences),
   `SteadyGradient`, `tangent_growth` (finite-time growth of the tangents) and the smooth
-  accumulators they differentiate, `STEADY_FUNCTIONALS` (`STATISTICS`: the mean, and the
+  accumulators they differentiate, `STEADY_FUNCTIONALS` (`STATISTICS`, by `Statistic`: the mean, and the
   peak statistic's p-mean with p = `PEAK_EXPONENT`).
 
 - which uncertain inputs matter (docs/model.md 18): `sensitivity` (the effect, derivative x
@@ -78,6 +78,7 @@ from ._steady_objective import (
     PEAK_EXPONENT,
     STATISTICS,
     STEADY_FUNCTIONALS,
+    Statistic,
     SteadyGradient,
     paired_central_difference,
     ratio_gradient,
@@ -97,6 +98,7 @@ __all__ = [
     "SENSITIVITY_METHODS",
     "SENSITIVITY_STATISTICS",
     "STATISTICS",
+    "Statistic",
     "STEADY_FUNCTIONALS",
     "DesignMetrics",
     "Robustness",

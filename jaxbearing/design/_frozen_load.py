@@ -34,7 +34,7 @@ from ..run import (
     checks_without_host_callbacks,
     choose_strategy,
     compiled_program,
-    parallel_map,
+    map_members,
     prepare_from,
     result_code,
     scaled_diffeqsolve,
@@ -43,12 +43,14 @@ from ..run import (
 from ._design import forward_jacobian
 from ._steady_objective import (
     STEADY_FUNCTIONALS,
+    Statistic,
     SteadyGradient,
     _check_window,
     _combine,
     _design_params,
     _failed_integrals,
     _functionals,
+    statistic_of,
 )
 
 
@@ -198,14 +200,17 @@ def frozen_load_gradient(
     return frozen_load_gradients([(bearing, op, design, states)], **options)[0]
 
 
-def frozen_load_gradients(cases, *, statistic: str = "mean", **options) -> list[SteadyGradient]:
+def frozen_load_gradients(
+    cases, *, statistic: Statistic | str = Statistic.MEAN, **options
+) -> list[SteadyGradient]:
     """The frozen-load estimate (module docstring) of the steady objective and its gradient for
     every case (bearing, op, design, states), e.g. every start and operating point of one
     iteration of the design search; one `SteadyGradient` per case, in order. `statistic`:
     "mean" (PV over contact time), "peak" (its p-mean) or "tail" (the mean of its worst 5 %);
     the other `options` and how the trajectories run: `frozen_load_statistics`, of this one
     statistic."""
-    return [found[statistic] for found in frozen_load_statistics(cases, statistics=(statistic,), **options)]
+    key = statistic_of(statistic)
+    return [found[key] for found in frozen_load_statistics(cases, statistics=(key,), **options)]
 
 
 def frozen_load_statistics(
@@ -237,11 +242,11 @@ def frozen_load_statistics(
     require("saves_per_ms", saves_per_ms, lambda v: (v >= 1) & (v == np.round(v)), "an integer >= 1")
     if strategy not in STRATEGIES:
         raise UserInputError(f"strategy = {strategy!r}: must be one of {', '.join(map(repr, STRATEGIES))}")
-    statistics = tuple(dict.fromkeys([statistics] if isinstance(statistics, str) else statistics))
+    statistics = tuple(
+        dict.fromkeys(statistic_of(s) for s in ([statistics] if isinstance(statistics, str) else statistics))
+    )
     if not statistics:
         raise UserInputError("statistics = (): must name at least one of 'mean', 'peak', 'tail'")
-    for statistic in statistics:
-        _functionals(statistic)  # a one-line error for an unknown one
     cases = list(cases)
     n = max(1, int(round(window * 1e3 * saves_per_ms)))
     jobs, owner = [], []
@@ -268,14 +273,11 @@ def _combine_statistic(statistic: str, samples: list, window: float) -> SteadyGr
 
 def _run_frozen(jobs, strategy: str, workers: int) -> list:
     """The outputs of every (`_FrozenSample`, state) of `jobs`, in order, by `strategy`
-    (`choose_strategy`): one vmapped program ("vmap", `_frozen_samples_batched`), `workers`
-    processes ("processes") or one after another in this process ("sequential")."""
+    (`choose_strategy`) through the engine's member dispatcher (`run.map_members`): one vmapped
+    program ("vmap", `_frozen_samples_batched`), `workers` processes ("processes") or one after
+    another in this process ("sequential")."""
     chosen = choose_strategy(strategy, min(int(workers), max(1, len(jobs))))
-    if not jobs:
-        return []
-    if chosen == "vmap":
-        return _frozen_samples_batched(jobs)
-    return parallel_map(_frozen_job, jobs, workers=workers if chosen == "processes" else 1)
+    return map_members(jobs, chosen, workers, _frozen_job, _frozen_samples_batched)
 
 
 def _frozen_job(item):

@@ -181,11 +181,8 @@ def robustness_corners(cfg: Config, constants: Sequence[str] = ROBUSTNESS_CONSTA
     return chosen, steps, out
 
 
-def _estimate(d: dict, scale: float = 1.0) -> Estimate:
-    def num(x):
-        return float("nan") if x is None else float(x) * scale
-
-    return Estimate(num(d.get("value")), num(d.get("ci95_low")), num(d.get("ci95_high")), int(d.get("n", 0)))
+#: an estimate of nothing (no measured seed)
+_NOTHING = Estimate(math.nan, math.nan, math.nan, 0)
 
 
 def _lower(a: Estimate, b: Estimate) -> bool:
@@ -257,12 +254,12 @@ def _row(corner: int, point: int, mine, ref) -> RobustnessRow:
     """One (corner, point) row from the two designs' `SteadyDesignMetrics`."""
 
     def peak(m) -> Estimate:
-        return _estimate(m.summary.get("flange_pv_Pa_m_s", {}).get("max", {}))
+        return _NOTHING if m.statistics is None else m.statistics.flange_pv_Pa_m_s.max
 
     def slip(m) -> Estimate:
-        return _estimate(m.summary.get("cage_slip", {}))
+        return _NOTHING if m.statistics is None else m.statistics.cage_slip
 
-    dm, rm = _estimate(mine.mean_pv), _estimate(ref.mean_pv)
+    dm, rm = mine.mean_pv, ref.mean_pv
     dp, rp = peak(mine), peak(ref)
     return RobustnessRow(
         corner=corner,

@@ -49,11 +49,12 @@ from ..geometry import kinematic_cage_speed
 from ..io import KEY_BY_PATH, Config, Uncertainty
 from ..run import (
     Perturbation,
+    SettledStatistics,
     SteadySettings,
     compiled_program,
     initial_state,
+    settled_statistics,
     simulate_steady_points,
-    steady_statistics,
 )
 from ._steady_objective import paired_central_difference
 
@@ -61,37 +62,30 @@ from ._steady_objective import paired_central_difference
 @dataclasses.dataclass(frozen=True)
 class Statistic:
     """A settled statistic a sensitivity study ranks the inputs by: its name on the command
-    line, label, SI unit, the factor and unit it is printed in, and where it is read from a
-    seed's statistics block (`run.steady_statistics`)."""
+    line, label, SI unit, the factor and unit it is printed in, and the field it is read from
+    in a seed's statistics (`run.SettledStatistics`)."""
 
     name: str
     label: str
     unit: str
     shown_factor: float
     shown_unit: str
-    read: Callable[[Mapping], float]
-
-
-def _value(*path: str) -> Callable[[Mapping], float]:
-    def read(block: Mapping) -> float:
-        node = block
-        for p in path:
-            node = node.get(p) if isinstance(node, Mapping) else None
-        v = node.get("value") if isinstance(node, Mapping) else None
-        return float("nan") if v is None else float(v)
-
-    return read
+    read: Callable[[SettledStatistics], float]
 
 
 #: the statistics of `sensitivity`, per cage revolution of settled running
 STATISTICS = {
     s.name: s
     for s in (
-        Statistic("cage_slip", "cage slip", "1", 100.0, "%", _value("cage_slip")),
-        Statistic("mean_pv", "mean flange PV", "Pa m/s", 1e-9, "GPa m/s", _value("flange_pv_Pa_m_s", "mean")),
-        Statistic("peak_pv", "peak flange PV", "Pa m/s", 1e-9, "GPa m/s", _value("flange_pv_Pa_m_s", "max")),
+        Statistic("cage_slip", "cage slip", "1", 100.0, "%", lambda s: s.cage_slip.value),
         Statistic(
-            "contact_height", "largest contact height", "m", 1e3, "mm", _value("contact_height_m", "max")
+            "mean_pv", "mean flange PV", "Pa m/s", 1e-9, "GPa m/s", lambda s: s.flange_pv_Pa_m_s.mean.value
+        ),
+        Statistic(
+            "peak_pv", "peak flange PV", "Pa m/s", 1e-9, "GPa m/s", lambda s: s.flange_pv_Pa_m_s.max.value
+        ),
+        Statistic(
+            "contact_height", "largest contact height", "m", 1e3, "mm", lambda s: s.contact_height_m.max.value
         ),
     )
 }
@@ -285,12 +279,12 @@ def static_effect(cfg: Config, item: SensitivityInput) -> Effect:
 
 
 # -- CRN central differences of settled ensembles -------------------------------------------------
-def _per_seed(result) -> dict[int, Mapping]:
-    """{seed: the statistics block of that seed's window alone} of a `SteadyResult`."""
+def _per_seed(result) -> dict[int, SettledStatistics]:
+    """{seed: the statistics of that seed's window alone} of a `SteadyResult`."""
     out = {}
     for r in result.runs:
         if r.measured and r.window:
-            out[r.seed] = steady_statistics([r.window], [r.edges], result.bearing, result.operating)
+            out[r.seed] = settled_statistics([r.window], [r.edges], result.bearing, result.operating)
     return out
 
 

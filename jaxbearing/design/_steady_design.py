@@ -28,9 +28,9 @@ limited circle, clearance; positive when satisfied) and the full settled summary
   int w PV dt / int w dt with the smooth contact indicator w = Q / (Q + 1 N), integrated inside
   the solve over the window), per seed, with its Student-t interval over the seeds: the quantity
   the optimiser minimises and whose gradient `steady_gradient` estimates (`mean_pv` is the same
-  average over the saved samples with the hard 1 N threshold); with `statistic="peak"` the
+  average over the saved samples with the hard 1 N threshold); with `Statistic.PEAK` the
   p-mean PV_ref (int w (PV/PV_ref)^p dt / int w dt)^(1/p), p = `PEAK_EXPONENT`, which weights
-  the peaks; with `statistic="tail"` the tail mean of PV over contact time per revolution, the
+  the peaks; with `Statistic.TAIL` the tail mean of PV over contact time per revolution, the
   mean of its worst 5 % of the saved touching samples (`run.tail_mean`) (`STATISTICS`);
 - `objectives_per_seed`: per seed, the objective of every statistic the run's accumulators give
   (the mean and the tail integrate the same ones, so one ensemble gives both);
@@ -52,7 +52,6 @@ import dataclasses
 import jax
 import numpy as np
 
-from .._errors import UserInputError
 from ..flange import (
     DEFAULT_FLANGE_LOAD,
     MARGIN_NAMES,
@@ -62,9 +61,11 @@ from ..flange import (
     zone_margins,
 )
 from ..geometry import Bearing, OperatingPoint
-from ..io import require
+from ..io import per_point, require
 from ..run import (
+    Estimate,
     Perturbation,
+    SettledStatistics,
     SteadySettings,
     simulate_steady_points,
     steady_revolution_maxima,
@@ -72,7 +73,7 @@ from ..run import (
     summarise_steady,
     window_statistics,
 )
-from ._steady_objective import STATISTICS, _functionals
+from ._steady_objective import STATISTICS, Statistic, _functionals
 
 #: default dynamic corner margin [m]: the largest contact radius this far inside the limited circle
 CORNER_MARGIN = 0.05e-3
@@ -80,20 +81,25 @@ CORNER_MARGIN = 0.05e-3
 
 @dataclasses.dataclass
 class SteadyDesignMetrics:
-    """The steady-running objective of one design (module docstring). Estimates are dicts
-    {"value", "ci95_low", "ci95_high", "n"}; `static_margins` [m] by `MARGIN_NAMES`."""
+    """The steady-running objective of one design (module docstring). Estimates are
+    `run.Estimate`s (value and 95 % interval); `statistics`: every statistic of the settled
+    run (`run.SettledStatistics`; None when no seed was measured); `summary`: the run's
+    summary.json block; `static_margins` [m] by `MARGIN_NAMES`."""
 
     design: dict
-    objective: dict
+    objective: Estimate
     objective_per_seed: list
-    mean_pv: dict
-    p95_pv: dict
-    corner_contact_share: dict
-    corner_margin: dict
+    mean_pv: Estimate
+    p95_pv: Estimate
+    corner_contact_share: Estimate
+    corner_margin: Estimate
     static_margins: dict
     settled: bool
     seeds: list
     summary: dict
+    statistics: SettledStatistics | None = dataclasses.field(default=None, repr=False)
+    #: simulated time of the ensemble [ms]: every seed's settling and window
+    simulated_ms: float = 0.0
     #: the state at the end of every seed's run (numpy leaves), to continue from
     final_states: list = dataclasses.field(default_factory=list, repr=False)
     #: settled states of every seed (window start and end): samples for `steady_gradient`
@@ -113,12 +119,12 @@ class SteadyDesignMetrics:
     limited_circle_radius_m: float = float("nan")
 
     def as_dict(self) -> dict:
-        """Everything but the states and the per-revolution maxima, as plain (JSON-able) values."""
-        return {
-            f.name: getattr(self, f.name)
-            for f in dataclasses.fields(self)
-            if f.name not in ("final_states", "sample_states", "contact_radius_maxima")
-        }
+        """Everything but the states, the per-revolution maxima and the statistics (the summary
+        holds them), as plain (JSON-able) values; estimates as {"value", "ci95_low",
+        "ci95_high", "n"}."""
+        skip = ("final_states", "sample_states", "contact_radius_maxima", "statistics")
+        out = {f.name: getattr(self, f.name) for f in dataclasses.fields(self) if f.name not in skip}
+        return {k: v.as_dict() if isinstance(v, Estimate) else v for k, v in out.items()}
 
 
 def steady_design_metrics(
@@ -140,7 +146,7 @@ def steady_design_metrics(
 
 
 def steady_design_metrics_points(
-    bearing: Bearing,
+    bearing: Bearing | list[Bearing],
     ops,
     design: DesignVariables | list[DesignVariables],
     settings: SteadySettings | None = None,
@@ -149,7 +155,7 @@ def steady_design_metrics_points(
     flange_load: float = DEFAULT_FLANGE_LOAD,
     first_seed: int = 0,
     initial_states=None,
-    statistic: str = "mean",
+    statistic: Statistic | str = Statistic.MEAN,
     perturbation: Perturbation = Perturbation(),
     **changes,
 ) -> list[SteadyDesignMetrics]:
@@ -162,18 +168,17 @@ def steady_design_metrics_points(
     `first_seed` selects the seeds (first_seed .. first_seed + seeds - 1): a verification uses
     seeds a search never saw. `initial_states`: None, or per point None or one state per seed."""
     ops = list(ops)
-    designs = [design] * len(ops) if isinstance(design, DesignVariables) else list(design)
-    if len(designs) != len(ops):
-        raise UserInputError(
-            f"design: {len(designs)} given, expected one, or one per operating point ({len(ops)})"
-        )
-    for d in designs:
-        check_design(bearing, d)
+    designs = per_point("design", design, DesignVariables, len(ops))
+    bases = per_point("bearing", bearing, Bearing, len(ops))
+    for b, d in zip(bases, designs):
+        check_design(b, d)
     require("corner_margin", corner_margin, lambda v: np.isfinite(v) & (v >= 0), ">= 0 m")
     require("first_seed", first_seed, lambda v: (v >= 0) & (v == np.round(v)), "an integer >= 0")
     changes.setdefault("functionals", _functionals(statistic))
     settings = (settings if settings is not None else SteadySettings()).replace(**changes)
-    bearings = [with_design(bearing, d.end_radius, d.layback_angle, d.axial_clearance) for d in designs]
+    bearings = [
+        with_design(b, d.end_radius, d.layback_angle, d.axial_clearance) for b, d in zip(bases, designs)
+    ]
     pert = dataclasses.replace(perturbation, seed=int(first_seed))
     results = simulate_steady_points(
         bearings, ops, settings, initial_states=initial_states, perturbation=pert
@@ -202,28 +207,23 @@ def _tail_per_seed(result, run) -> float:
 
 
 def _metrics(
-    result, design: DesignVariables, margins, corner_margin: float, functionals, statistic: str = "mean"
+    result,
+    design: DesignVariables,
+    margins,
+    corner_margin: float,
+    functionals,
+    statistic: Statistic | str = Statistic.MEAN,
 ) -> SteadyDesignMetrics:
     """The design metrics of one operating point's settled run (module docstring)."""
-    s = summarise_steady(result)
-    none = {"value": None, "ci95_low": None, "ci95_high": None, "n": 0}
-    pv = s.get("flange_pv_contact_time_Pa_m_s", {})
-    widest = s.get("contact_radius_m", {}).get("max_in_contact", none)
-    rho_lim = s.get("limited_circle_radius_m")
+    stats = result.statistics()
+    s = summarise_steady(result, statistics=stats)
+    nothing = Estimate(np.nan, np.nan, np.nan, 0)
+    rho_lim = np.nan if stats is None else stats.limited_circle_radius_m
+    top = rho_lim - corner_margin
 
-    def shifted(est):  # rho_lim - margin - est (the interval flips)
-        if est.get("value") is None or rho_lim is None:
-            return dict(none)
-        top = rho_lim - corner_margin
-        lo, hi = est.get("ci95_low"), est.get("ci95_high")
-        return {
-            "value": top - est["value"],
-            "ci95_low": None if hi is None else top - hi,
-            "ci95_high": None if lo is None else top - lo,
-            "n": est.get("n", 0),
-        }
+    def shifted(est: Estimate) -> Estimate:  # rho_lim - margin - est (the interval flips)
+        return Estimate(top - est.value, top - est.ci95_high, top - est.ci95_low, est.n)
 
-    bound = float(s.get("max_contact_radius_bound", {}).get("value", np.nan))  # NaN stays NaN
     objectives = {
         name: [float(v) for v in _objective_per_seed(result, name, functionals)]
         for name, fn in STATISTICS.items()
@@ -238,25 +238,35 @@ def _metrics(
             "layback_angle_rad": float(design.layback_angle),
             "axial_clearance_m": float(design.axial_clearance),
         },
-        objective=student_t_interval(per_seed).as_dict(),
+        objective=student_t_interval(per_seed),
         objective_per_seed=[float(v) for v in per_seed],
-        mean_pv=pv.get("mean", dict(none)),
-        p95_pv=pv.get("p95", dict(none)),
-        corner_contact_share=s.get("corner_contact_share", {}).get("time", dict(none)),
-        corner_margin=shifted(widest),
+        mean_pv=nothing if stats is None else stats.flange_pv_contact_time_Pa_m_s.mean,
+        p95_pv=nothing if stats is None else stats.flange_pv_contact_time_Pa_m_s.p95,
+        corner_contact_share=nothing if stats is None else stats.corner_contact_share.time,
+        corner_margin=nothing if stats is None else shifted(stats.contact_radius_m.max_in_contact),
         static_margins={name: float(m) for name, m in zip(MARGIN_NAMES, margins)},
-        settled=bool(s["settled"]),
-        seeds=list(s["seeds"]),
+        settled=bool(result.settled),
+        seeds=[r.seed for r in result.runs],
         summary=s,
+        statistics=stats,
+        simulated_ms=_simulated_ms(result),
         final_states=[r.final_state for r in result.runs],
         sample_states=[
             x for r in result.runs if r.status == "ok" for x in (r.window_start_state, r.final_state)
         ],
-        corner_margin_bound=float("nan") if rho_lim is None else rho_lim - corner_margin - bound,
+        corner_margin_bound=np.nan if stats is None else top - stats.max_contact_radius_bound.value,
         objectives_per_seed=objectives,
         contact_radius_maxima=steady_revolution_maxima(result).contact_radius_m,
-        limited_circle_radius_m=float("nan") if rho_lim is None else float(rho_lim),
+        limited_circle_radius_m=float(rho_lim),
     )
+
+
+def _simulated_ms(result) -> float:
+    """Simulated time of a settled ensemble [ms]: every seed's settling, and the mean measured
+    window once per seed."""
+    windows = [r.edges[-1] - r.edges[0] for r in result.runs if r.measured]
+    window_ms = float(np.mean(windows)) * 1e3 if windows else 0.0
+    return sum(r.settle_time * 1e3 for r in result.runs) + len(result.runs) * window_ms
 
 
 def _same_functionals(a, b) -> bool:
@@ -266,12 +276,12 @@ def _same_functionals(a, b) -> bool:
     return ta == tb and all(np.array_equal(np.asarray(x), np.asarray(y)) for x, y in zip(la, lb))
 
 
-def _objective_per_seed(result, statistic: str, functionals) -> list:
+def _objective_per_seed(result, statistic: Statistic | str, functionals) -> list:
     """Each seed's objective of `statistic` from the window of `result`'s runs (module
     docstring): the tail from the revolutions' tail means, the mean and the peak from the
     accumulated integrals of `functionals`, PV_ref (sum A / sum C)^(1/p); NaN where a seed has
     no measured window or contact."""
-    if statistic == "tail":
+    if statistic == Statistic.TAIL:
         return [_tail_per_seed(result, r) for r in result.runs]
     pv_ref, p = float(functionals.pv_reference), float(functionals.pv_exponent)
     return [

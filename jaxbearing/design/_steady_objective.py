@@ -39,6 +39,7 @@ inside it, every sample of the worst 5 % carries the signal.
 from __future__ import annotations
 
 import dataclasses
+import enum
 
 import numpy as np
 
@@ -57,13 +58,24 @@ STEADY_FUNCTIONALS = Functionals(pv_exponent=1.0, contact_load=CONTACT_LOAD)
 #: p of the peak statistic: the p-mean of PV over contact time, PV_ref (sum A_p / sum C)^(1/p),
 #: which weights the tail (p = 8: a sample at twice the mean counts 256 times as much)
 PEAK_EXPONENT = 8.0
-#: the steady objective's statistics and the accumulators their runs integrate: "mean" (p = 1),
-#: "peak" (p = `PEAK_EXPONENT`) and "tail" (the tail mean of PV over contact time, the mean of its
-#: worst 1 - `TAIL_LEVEL` = 5 %, taken from the saved samples: the module docstring's tail statistic)
+
+
+class Statistic(enum.StrEnum):
+    """The statistic of flange PV a steady objective measures (module docstring): `MEAN` over
+    contact time (p = 1), `PEAK` (the p-mean, p = `PEAK_EXPONENT`) or `TAIL` (the tail mean of
+    PV over contact time, the mean of its worst 1 - `TAIL_LEVEL` = 5 %, from the saved
+    samples). Its value is the name the command line and the TOML files use."""
+
+    MEAN = "mean"
+    PEAK = "peak"
+    TAIL = "tail"
+
+
+#: the accumulators each statistic's runs integrate
 STATISTICS = {
-    "mean": STEADY_FUNCTIONALS,
-    "peak": Functionals(pv_exponent=PEAK_EXPONENT, contact_load=CONTACT_LOAD),
-    "tail": STEADY_FUNCTIONALS,
+    Statistic.MEAN: STEADY_FUNCTIONALS,
+    Statistic.PEAK: Functionals(pv_exponent=PEAK_EXPONENT, contact_load=CONTACT_LOAD),
+    Statistic.TAIL: STEADY_FUNCTIONALS,
 }
 #: default window of the short-window sensitivities [s] (docs/validation.md)
 GRADIENT_WINDOW = 1.0e-3
@@ -181,11 +193,20 @@ def _combine(outs, window, exponent: float = 1.0, tail_threshold: float | None =
     )
 
 
-def _functionals(statistic: str) -> Functionals:
+def statistic_of(value: Statistic | str) -> Statistic:
+    """`value` as a `Statistic` (the command line's and the TOML files' name maps here), or a
+    one-line error naming the valid ones."""
+    try:
+        return Statistic(value)
+    except ValueError:
+        raise UserInputError(
+            f"statistic = {value!r}: must be one of {', '.join(repr(s.value) for s in Statistic)}"
+        ) from None
+
+
+def _functionals(statistic: Statistic | str) -> Functionals:
     """The accumulators of the steady objective's `statistic` (`STATISTICS`), or a one-line error."""
-    if statistic not in STATISTICS:
-        raise UserInputError(f"statistic = {statistic!r}: must be one of {', '.join(map(repr, STATISTICS))}")
-    return STATISTICS[statistic]
+    return STATISTICS[statistic_of(statistic)]
 
 
 def _failed_integrals() -> tuple[np.ndarray, np.ndarray]:

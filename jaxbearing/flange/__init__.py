@@ -9,6 +9,10 @@
   Lambda), `FlangeFilm`, `flange_friction_coefficient` (dry or mixed, `FLANGE_LUBRICATION_MODES`);
 - the static design zone of an aligned roller: `design_zone`, `design_zone_grid`, `DesignZone`,
   `zone_margins`, `MARGIN_NAMES`;
+- general end and rib faces (a toroidal end of offset e, a rib meridian arc of curvature
+  1/R_rib; docs/model.md 5.4), as pure geometry not yet used by the dynamics: `Faces`,
+  `faces_of`, `check_faces`, `face_contact`, `FaceContact`, `face_contact_stiffness`,
+  `face_design_zone`, `FaceZone`, `face_limited_circle`, `face_protrusion`, `rib_distance`;
 - the design variables R_end, theta_f, Delta_bf: `DesignVariables`, `with_design`, and the one
   range check every design entry point uses, `check_design`.
 
@@ -27,6 +31,9 @@ from ._contact import (
     without_absent_flanges,
 )
 from ._design import DesignVariables, with_design
+from ._face_contact import FaceContact, face_contact, face_contact_stiffness
+from ._face_zone import FaceZone, face_design_zone
+from ._faces import Faces, check_faces, face_limited_circle, face_protrusion, faces_of, rib_distance
 from ._geometry import FlangeGeometry, flange_effective_modulus, flange_geometry
 from ._lubrication import (
     FLANGE_LUBRICATION_MODES,
@@ -44,18 +51,29 @@ __all__ = [
     "MARGIN_NAMES",
     "DesignVariables",
     "DesignZone",
+    "FaceContact",
+    "FaceZone",
+    "Faces",
     "FlangeContact",
     "FlangeFilm",
     "FlangeGeometry",
     "all_flange_contacts",
     "check_design",
+    "check_faces",
     "contact_point_velocity",
     "design_zone",
     "design_zone_grid",
+    "face_contact",
+    "face_contact_stiffness",
+    "face_design_zone",
+    "face_limited_circle",
+    "face_protrusion",
+    "faces_of",
     "flange_effective_modulus",
     "flange_film",
     "flange_friction_coefficient",
     "flange_geometry",
+    "rib_distance",
     "roller_flange_contact",
     "with_design",
     "without_absent_flanges",

@@ -36,6 +36,17 @@ def is_concrete(*values) -> bool:
     return not any(isinstance(v, jax.core.Tracer) for v in jax.tree_util.tree_leaves(values))
 
 
+def per_point(name: str, value, single: type, num_points: int) -> list:
+    """`value` given once (an instance of `single`) or once per operating point, as a list of
+    `num_points`; one line naming `name` when the count is neither."""
+    values = [value] * num_points if isinstance(value, single) else list(value)
+    if len(values) != num_points:
+        raise UserInputError(
+            f"{name}: {len(values)} given, expected one, or one per operating point ({num_points})"
+        )
+    return values
+
+
 def require(name: str, value, ok: Callable[[np.ndarray], np.ndarray], valid: str) -> None:
     """Raise `UserInputError("{name} = {value}: must be {valid}")` when a concrete `value` (any
     shape) has an element for which `ok` is False or that is NaN; traced values pass."""

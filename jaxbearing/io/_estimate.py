@@ -11,7 +11,9 @@ sensitivity study can read how well it is known:
   through the ring section; Harris & Kotzalas, Essential Concepts of Bearing Technology, 5th ed.,
   ch. 2; the usual default of bearing programs, e.g. the MESYS manual); the roller diameter
   D ~ 0.25 (D_o - d) (approximate: catalogue cylindrical roller bearings of the 02 and 03
-  series lie near it, Harris & Kotzalas ch. 2); the roller length from the ring width,
+  series lie near it, Harris & Kotzalas ch. 2; against the raceway diameters of SKF's catalogue,
+  (E - F)/2 = 11, 14, 19 mm for the 210, 212, 312 ECP sizes, it is 8-11 % low, within its
+  stated +/- 15 %); the roller length from the ring width,
   L ~ 0.6 B (the width less two ribs of about 0.2 B; L ~ D for the 02 and 03 series, longer
   for the 22 series); the roller count from the pitch circle and the cage bars,
   Z = floor(pi d_m / (D (1 + g))), with the reference bearing's bar width g = 0.37 D;
@@ -132,7 +134,8 @@ def _table() -> dict[str, dict[float, tuple[float, float]]]:
 
 def dimension_series(series: str, bore_mm: float) -> BoundaryDimensions:
     """The ISO 15 boundary dimensions of dimension series `series` ("10", "02", "22" or "03")
-    with bore `bore_mm`, from the table shipped with the package (bores 20 to 200 mm). Raises
+    with bore `bore_mm`, from the table shipped with the package (bores 20 to 200 mm; every
+    row checked against the Schaeffler and SKF catalogue tables its header names). Raises
     ConfigError (field "series" or "bore_mm") naming the valid series or bores."""
     table = _table()
     if series not in table:

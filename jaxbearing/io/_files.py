@@ -100,6 +100,14 @@ def _nonfinite_text(v: float) -> str:
     return "nan" if math.isnan(v) else ("inf" if v > 0 else "-inf")
 
 
+def finite_or_none(x) -> float | None:
+    """`x` as a float, or None where it is missing or not finite (JSON has no NaN)."""
+    if x is None:
+        return None
+    v = float(x)
+    return v if math.isfinite(v) else None
+
+
 def to_strict_json(doc: Any, reason: str | None = None) -> tuple[Any, dict[str, str]]:
     """(a copy of `doc` with every non-finite float replaced by None, {dotted path: reason}).
 

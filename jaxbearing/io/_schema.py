@@ -59,7 +59,7 @@ Schema (ranges; "(" open, "[" closed; symbols as in docs/model.md and the source
 | operating.radial_load_N | F_r | [0, 1e8] |
 | operating.gravity | g | true / false (9.81 m/s^2 along +Z) |
 | operating.misalignment_mrad | psi_m | [-10, 10] (inner-ring tilt about +Y) |
-| operating.axial_load_N | F_a | [-1e8, 1e8] (along +X); 0 unless inner_ring_axial_freedom and a flange path (bearing.type) |
+| operating.axial_load_N | F_a | [-1e8, 1e8] (along +X); flanges carry it (axial freedom on) or, without a flange path, the locating bearing (freedom off) |
 | operating.inner_ring_axial_freedom, inner_ring_tilt_freedom | | true / false |
 | simulation.end | | "arc", "corner" or "both" |
 | simulation.duration_ms | | (0, 10000] |
@@ -148,10 +148,14 @@ def _traction_bounded(v) -> str | None:
 
 
 def _axial_load_held(v) -> str | None:
-    """An axial load needs the inner ring's axial freedom: a ring held axially carries it to
-    ground itself, so the load would silently do nothing."""
+    """An axial load that the flanges carry (`_axial_load_carried`) needs the inner ring's axial
+    freedom: a ring held axially carries it to ground itself, so the load would silently do
+    nothing. (A load without a flange path goes to the shaft's locating bearing instead, which
+    holds the ring: `_axial_load_carried`.)"""
     f = v["operating.axial_load_N"]
     if f == 0.0 or v["operating.inner_ring_axial_freedom"]:
+        return None
+    if not carries_axial_load(flange_presence(v["bearing.type"]), f):
         return None
     return (
         f"{format_value(f)} N needs operating.inner_ring_axial_freedom = true (the ring is held "
@@ -174,13 +178,16 @@ def _rollers_located(v) -> str | None:
 
 
 def _axial_load_carried(v) -> str | None:
-    """An axial load on the inner ring needs a flange path to the outer ring: along +X the
-    inner -X and the outer +X flange, along -X the inner +X and the outer -X flange
-    (`geometry.carries_axial_load`). A floating bearing (NU, N; NJ along -X) carries none: in a
-    machine the shaft's locating bearing does, and the ring would slide away here."""
+    """Where an axial load on the inner ring goes. With a flange path to the outer ring (along +X
+    the inner -X and the outer +X flange, along -X the inner +X and the outer -X flange,
+    `geometry.carries_axial_load`) the flanges carry it, the ring free axially. Without one (a
+    floating bearing: NU, N; NJ along -X) the shaft's locating bearing carries it, as in a
+    machine, and holds the inner ring axially: the axial freedom must then be off. A ring free
+    axially would be pushed off the rollers, nothing in the bearing balancing the load
+    (docs/model.md 5.3)."""
     f, t = v["operating.axial_load_N"], v["bearing.type"]
     presence = flange_presence(t)
-    if f == 0.0 or carries_axial_load(presence, f):
+    if f == 0.0 or carries_axial_load(presence, f) or not v["operating.inner_ring_axial_freedom"]:
         return None
     need = '"inner-X" and "outer+X"' if f > 0 else '"inner+X" and "outer-X"'
     valid = {(True, False): ">= 0", (False, True): "<= 0"}.get(
@@ -188,8 +195,9 @@ def _axial_load_carried(v) -> str | None:
     )
     return (
         f"{format_value(f)} N has no flange path in bearing.type = {format_value(t)} (along "
-        f"{'+X' if f > 0 else '-X'} it needs the flanges {need}): must be {valid} N (in a "
-        "machine the shaft's locating bearing carries it)"
+        f"{'+X' if f > 0 else '-X'} it needs the flanges {need}), so the shaft's locating bearing "
+        f"carries it and holds the inner ring: with operating.inner_ring_axial_freedom = true it "
+        f"must be {valid} N (set the freedom false to apply it)"
     )
 
 
@@ -781,14 +789,16 @@ KEYS: tuple[Key, ...] = (
         attr="op.axial_load",
         extras=(
             Extra(
-                ("operating.inner_ring_axial_freedom",),
+                ("operating.inner_ring_axial_freedom", "bearing.type"),
                 _axial_load_held,
-                "non-zero only with inner_ring_axial_freedom = true",
+                "carried by the flanges (bearing.type: +X needs inner-X and outer+X, -X inner+X "
+                "and outer-X) with inner_ring_axial_freedom = true",
             ),
             Extra(
-                ("bearing.type",),
+                ("bearing.type", "operating.inner_ring_axial_freedom"),
                 _axial_load_carried,
-                "and a flange path (bearing.type): +X needs inner-X and outer+X, -X inner+X and outer-X",
+                "or, without that flange path (NU, N), by the shaft's locating bearing with "
+                "inner_ring_axial_freedom = false",
             ),
         ),
     ),

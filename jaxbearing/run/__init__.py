@@ -9,7 +9,9 @@
   inside a solve) and `HostProgress` (the same from the calling process: cacheable programs);
 - statistics: `contact_events`, `summarise`, `film_statistics` (film over contact time,
   `FILM_KEYS`; a sample is contact above `CONTACT_THRESHOLD`); of settled running with 95 %
-  confidence intervals: `steady_statistics`, `revolution_statistics`, `confidence_intervals`,
+  confidence intervals as a typed object, `SettledStatistics` (fields of `Estimate`s, groups
+  `PerEvent`, `ContactRadius`, `ContactTimePV`, `CornerShare`; `SteadyResult.statistics()`,
+  `settled_statistics`; its summary block `steady_statistics`), `revolution_statistics`, `confidence_intervals`,
   `batch_means`, `student_t_interval`, `Estimate`, `tail_mean` (the mean above the
   `TAIL_LEVEL` quantile); how often the contact reached the corner,
   with upper bounds: `corner_contact_bound`, `upper_probability_bound`; the prediction bound
@@ -27,7 +29,8 @@
   `summarise_steady`; the steady-running engine under it, `settle_members` (many
   `Member`s, each a case and a seed, with one `SteadySettings`: one after another, one process per
   core, or vmapped on accelerators, `STRATEGIES`, `choose_strategy`, `stack_trees`; an
-  `EngineRun`) and `window_statistics`
+  `EngineRun`; the members' starts resolved in one step, `resolve_starts`; the one member
+  dispatcher, `map_members`, which the gradient estimators use too) and `window_statistics`
   (`revolution_statistic_keys`); `solve_from` / `prepare_from` (continue from any state),
   `scaled_diffeqsolve` (diffrax's integration of the scaled state that `solve` and `solve_from`
   run, for callers that build their own programs around it); `SteadySettings`, the one
@@ -109,12 +112,24 @@ from ._settle import (
     summarise,
     summarise_steady,
 )
+from ._settled_statistics import (
+    ContactRadius,
+    ContactTimePV,
+    CornerShare,
+    PerEvent,
+    SettledStatistics,
+    settled_statistics,
+    steady_statistics,
+)
 from ._simulate import SolveArgs, flange_functionals, scaled_diffeqsolve, scaled_field, solve
 from ._solve_from import prepare_from, solve_from
 from ._start_cache import start_cache_dir
+from ._starts import map_members, resolve_starts
 from ._statistics import (
     TAIL_LEVEL,
+    CornerCount,
     Estimate,
+    PredictionBound,
     batch_means,
     confidence_intervals,
     corner_contact_bound,
@@ -123,7 +138,6 @@ from ._statistics import (
     revolution_statistics,
     steady_corner_risk,
     steady_revolution_maxima,
-    steady_statistics,
     student_t_interval,
     tail_mean,
     upper_probability_bound,
@@ -202,6 +216,16 @@ __all__ = [
     "solve",
     "solve_from",
     "steady_statistics",
+    "map_members",
+    "resolve_starts",
+    "settled_statistics",
+    "SettledStatistics",
+    "PerEvent",
+    "ContactRadius",
+    "ContactTimePV",
+    "CornerShare",
+    "CornerCount",
+    "PredictionBound",
     "student_t_interval",
     "tail_mean",
     "TAIL_LEVEL",

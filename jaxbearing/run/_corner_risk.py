@@ -77,7 +77,7 @@ import numpy as np
 from scipy import stats as _sp_stats
 
 from .._errors import UserInputError
-from ..io import require
+from ..io import finite_or_none, require
 from ._normal_tail import NormalTail, normal_tail, normal_tail_bounds
 from ._proportions import CORNER_RISK_CONFIDENCE, clopper_pearson, cluster_design_effect
 from ._tail_fit import MIN_TAIL_EXCEEDANCES, MIN_TAIL_REVOLUTIONS, TailFit, tail_fit_bounds
@@ -131,9 +131,7 @@ class CornerRisk:
     def as_dict(self) -> dict:
         """Plain JSON-able values (None for non-finite numbers)."""
 
-        def num(v):
-            return float(v) if math.isfinite(v) else None
-
+        num = finite_or_none
         out = {
             f.name: getattr(self, f.name)
             for f in dataclasses.fields(self)

@@ -1,30 +1,31 @@
 """The one dispatcher of the steady-running engine: every member (`Member`: a case and a seed)
 of a settled run, settled and measured by one of the drivers of `_engine` (docs/model.md 16).
 
-`settle_members` resolves what the members' starts need first (the static skid equilibria: one
-vmapped program for a vmapped batch; one per case for members that continue from given states,
-whose verdict needs only the case's time constant), then runs the member programs
-(`member_steps`) by the settings' strategy: one after another in this process ("sequential"),
-one process per core ("processes", `parallel_map`), or all members as one vmapped program per
-round ("vmap", `drive_batched`); "auto" picks by the machine (`choose_strategy`). Every strategy
-takes the same decisions for a member.
+`settle_members` resolves what the members' starts need first, in one step for every strategy
+(`_starts.resolve_starts`: the static skid equilibria, each solved once, read from or stored in
+the start cache), then runs the member programs (`member_steps`) by the settings' strategy
+through the one member dispatcher (`_starts.map_members`, which the gradient estimators use
+too): one after another in this process ("sequential"), one process per core ("processes",
+`parallel_map`, one pool for both steps), or all members as one vmapped program per round
+("vmap", `drive_batched`); "auto" picks by the machine (`choose_strategy`). Every strategy takes
+the same decisions for a member.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import time
+from contextlib import nullcontext
 
 import jax
-import numpy as np
 
 from ._engine import BatchTimes, choose_strategy, drive, drive_batched
-from ._ensemble import parallel_map
-from ._initial import _static_skid_start, static_skid_starts
+from ._ensemble import shared_workers
 from ._member import Member, SeedRun, member_steps
 from ._member_progress import active_progress
-from ._settings import SettleAuto, SteadySettings
+from ._settings import SteadySettings
 from ._solve_from import _integrator, solve_from
+from ._starts import map_members, resolve_starts
 
 
 def _reporting(program):
@@ -53,52 +54,6 @@ def _run_one(member: Member, settings: SteadySettings, reduce=None, static=None)
     )
     run = drive(_reporting(member_steps(member, settings, reduce, static, stored_start=True)), integrate)
     return run, sum(compiled)
-
-
-def _continuing_cases(members, settings: SteadySettings) -> dict:
-    """{member index: index of its case's first member} for the members that continue from a
-    given state and settle with the verdict: they share the static skid equilibrium of that
-    first member's seed (a case: one bearing and operating point). The verdict needs only its
-    time constant, which the seeds' scatters move by 3e-6 (reference bearing, 31 slices, seeds
-    0-2); solved per seed, the equilibria took a quarter of a continuing design-search
-    evaluation on the 2-core CPU."""
-    if not isinstance(settings.settle, SettleAuto) or settings.continuation_settle_revs is not None:
-        return {}
-    first, out = {}, {}
-    for i, m in enumerate(members):
-        if m.initial_state is not None:
-            leaves, tree = jax.tree_util.tree_flatten((m.bearing, m.operating))
-            key = (str(tree), tuple(np.asarray(x).tobytes() for x in leaves))
-            out[i] = first.setdefault(key, i)
-    return out
-
-
-def _shared_time_constants(members, settings: SteadySettings) -> dict:
-    """{member index: static skid equilibrium} of `_continuing_cases`, one solve per case."""
-    cases = _continuing_cases(members, settings)
-    solved = {
-        j: _static_skid_start(members[j].bearing, members[j].operating, members[j].perturbation)
-        for j in set(cases.values())
-    }
-    return {i: solved[j] for i, j in cases.items()}
-
-
-def _batched_statics(members, idx: list, settings: SteadySettings) -> dict:
-    """{member index: static skid equilibrium} of the members `idx` of one vmapped group that need
-    one, solved as one vmapped program: for the skid start, and for the verdict's time constant
-    of continuing members (solved one by one on the host they took most of a search iteration on
-    a GPU)."""
-    cases = _continuing_cases([members[i] for i in idx], settings)
-    auto = isinstance(settings.settle, SettleAuto)
-    needs = [
-        i
-        for k, i in enumerate(idx)
-        if (members[i].initial_state is None and (settings.start == "skid" or auto)) or cases.get(k) == k
-    ]
-    cases_needed = [(members[i].bearing, members[i].operating, members[i].perturbation) for i in needs]
-    statics = dict(zip(needs, static_skid_starts(cases_needed) if needs else []))
-    statics.update({idx[k]: statics[idx[j]] for k, j in cases.items()})
-    return statics
 
 
 @dataclasses.dataclass(frozen=True)
@@ -140,38 +95,43 @@ def settle_members(
     progress = active_progress()
     if progress is not None:
         progress.started(len(members))
-    if chosen == "vmap":
-        return _settle_vmapped(members, settings, devices, reduce, wall0)
-    statics = _shared_time_constants(members, settings)
-    if chosen == "processes" and len(members) > 1:
-        items = [(m, statics.get(i)) for i, m in enumerate(members)]
-        done = None if progress is None else progress.finished
-        outs = parallel_map(
-            _MemberJob(settings, reduce), items, workers=min(settings.workers, len(members)), on_done=done
+    pool = shared_workers(min(settings.workers, len(members))) if chosen == "processes" else nullcontext()
+    with pool:
+        h0 = time.perf_counter()
+        statics = resolve_starts(members, settings, chosen)
+        if chosen == "vmap":
+            return _settle_vmapped(
+                members, settings, devices, reduce, wall0, statics, time.perf_counter() - h0
+            )
+        outs = map_members(
+            [(m, statics.get(i)) for i, m in enumerate(members)],
+            chosen,
+            settings.workers,
+            _MemberJob(settings, reduce),
+            on_done=None if progress is None else progress.finished,
         )
+    if chosen == "processes" and len(members) > 1:
         compile_time = max(c for _, c in outs)
         # the pool's wall time less its longest compilation (the workers compile side by side)
-        return EngineRun(
-            [r for r, _ in outs], chosen, time.perf_counter() - wall0 - compile_time, compile_time
-        )
-    outs = [_run_one(m, settings, reduce, statics.get(i)) for i, m in enumerate(members)]
-    compile_time = sum(c for _, c in outs)
+    else:
+        compile_time = sum(c for _, c in outs)
     return EngineRun([r for r, _ in outs], chosen, time.perf_counter() - wall0 - compile_time, compile_time)
 
 
-def _settle_vmapped(members, settings: SteadySettings, devices, reduce, wall0: float) -> EngineRun:
+def _settle_vmapped(
+    members, settings: SteadySettings, devices, reduce, wall0: float, statics: dict, host_s: float
+) -> EngineRun:
     """`settle_members` by the "vmap" strategy: one batch per parameter structure, each the
-    members' programs driven together (`drive_batched`)."""
+    members' programs driven together (`drive_batched`); `statics`: the resolved starts, solved
+    in `host_s` seconds."""
     times = BatchTimes()
+    times.host_s += host_s
     groups: dict = {}
     for i, m in enumerate(members):
         groups.setdefault(jax.tree_util.tree_structure(settings.params(m)), []).append(i)
     runs: list = [None] * len(members)
     quiet = dataclasses.replace(settings, progress=False)
     for idx in groups.values():
-        h0 = time.perf_counter()
-        statics = _batched_statics(members, idx, settings)
-        times.host_s += time.perf_counter() - h0
         outs = drive_batched(
             [_reporting(member_steps(members[i], quiet, reduce, statics.get(i))) for i in idx],
             [settings.params(members[i]) for i in idx],

@@ -18,12 +18,13 @@ import numpy as np
 
 from .._errors import UserInputError
 from ..geometry import Bearing, OperatingPoint, kinematic_cage_speed, rad_s_to_rpm
+from ..io import finite_or_none
 from ._dispatch import settle_members
 from ._initial import Perturbation
 from ._member import Member
 from ._settings import SteadySettings
+from ._settled_statistics import SettledStatistics, settled_statistics
 from ._simulate import simulate as _simulate_fixed
-from ._statistics import steady_statistics
 from ._summary import CONTACT_THRESHOLD, FAILED_LABEL, SETTLED_LABEL, UNSETTLED_LABEL
 from ._summary import summarise as _summarise_fixed
 
@@ -60,6 +61,22 @@ class SteadyResult:
     def histories(self) -> dict:
         """The first seed's window (for plots and the histories file)."""
         return self.runs[0].window
+
+    def statistics(self, threshold: float = CONTACT_THRESHOLD) -> SettledStatistics | None:
+        """The statistics of the measured members' windows (`SettledStatistics`; a sample is
+        contact above `threshold` [N]); None when no member was measured."""
+        ok = [r for r in self.runs if r.measured]
+        if not ok:
+            return None
+        fresh = [r for r in ok if r.per_revolution is None]
+        return settled_statistics(
+            [r.window for r in fresh],
+            [r.edges for r in fresh],
+            self.bearing,
+            self.operating,
+            threshold,
+            per_revolution=[r.per_revolution for r in ok if r.per_revolution is not None],
+        )
 
 
 def simulate_steady(
@@ -101,15 +118,11 @@ def simulate_steady_points(
     one `SteadyResult` per point, in order. `bearing`: one bearing, or one per point (several
     designs, each at its operating points). `initial_states`: None, or per point None or one
     state per seed. The wall and compilation times of each result are those of the whole call."""
-    from ..io import validate_bearing
+    from ..io import per_point, validate_bearing
 
     settings = (settings if settings is not None else SteadySettings()).replace(**changes)
     ops = list(ops)
-    bearings = [bearing] * len(ops) if isinstance(bearing, Bearing) else list(bearing)
-    if len(bearings) != len(ops):
-        raise UserInputError(
-            f"bearing: {len(bearings)} given, expected one, or one per operating point ({len(ops)})"
-        )
+    bearings = per_point("bearing", bearing, Bearing, len(ops))
     for b, op in zip(bearings, ops):
         validate_bearing(b, op)
     given = _given_states(initial_states, len(ops), settings.seeds)
@@ -164,9 +177,12 @@ def _settle_mode(settings: SteadySettings, continuing: bool) -> str:
     return settings.settle.mode
 
 
-def summarise_steady(result: SteadyResult, threshold: float = CONTACT_THRESHOLD) -> dict:
+def summarise_steady(
+    result: SteadyResult, threshold: float = CONTACT_THRESHOLD, statistics: SettledStatistics | None = None
+) -> dict:
     """The summary.json block of a settled run: how it settled, and every statistic of the
-    window as {"value", "ci95_low", "ci95_high", "n"} (`_statistics`)."""
+    window as {"value", "ci95_low", "ci95_high", "n"} (`SettledStatistics.as_dict`;
+    `statistics`: the run's, when already computed)."""
     runs = result.runs
     ok = [r for r in runs if r.measured]
     block = {
@@ -204,18 +220,9 @@ def summarise_steady(result: SteadyResult, threshold: float = CONTACT_THRESHOLD)
         "wall_time_s": result.wall_time_s,
         "compile_time_s": result.compile_time_s,
     }
-    if ok:
-        given = [r for r in ok if r.per_revolution is not None]  # the reducer's threshold
-        block.update(
-            steady_statistics(
-                [r.window for r in ok if r.per_revolution is None],
-                [r.edges for r in ok if r.per_revolution is None],
-                result.bearing,
-                result.operating,
-                threshold,
-                per_revolution=[r.per_revolution for r in given],
-            )
-        )
+    stats = statistics if statistics is not None else result.statistics(threshold)
+    if stats is not None:
+        block.update(stats.as_dict())
     return block
 
 
@@ -234,9 +241,7 @@ def _verdict_block(verdict) -> dict:
     if verdict is None:
         return {}
 
-    def num(x):
-        return float(x) if math.isfinite(x) else None
-
+    num = finite_or_none
     return {
         "residual_drift_rpm": num(verdict.residual_drift_rpm),
         "residual_drift_bound_rpm": num(verdict.bound_rpm),

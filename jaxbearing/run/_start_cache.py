@@ -22,8 +22,9 @@ would return, bit for bit:
 - the backend and device kind, 64-bit mode and `XLA_FLAGS` as this process started with them:
   XLA's options may change the last digits of a compiled program's results.
 
-Only the one-at-a-time path reads and writes starts (`_initial._static_skid_start`, and the
-pre-start of a member run in this process or one worker process, `_dispatch._run_one`); the
+Only the one-at-a-time path reads and writes starts (`_initial._static_skid_start`, which
+`_starts.resolve_starts` calls for the sequential and process strategies, and the pre-start of
+a member run in this process or one worker process, `_dispatch._run_one`); the
 vmapped members' starts (`static_skid_starts`, the batched pre-start) come from other programs,
 whose roundings differ in the last digits, and are never mixed with these.
 

@@ -39,6 +39,7 @@ from scipy import stats as _sp_stats
 
 from .._errors import UserInputError
 from ..geometry import kinematic_cage_speed, limited_circle_radius, rad_s_to_rpm
+from ..io import finite_or_none
 from ._corner_risk import (
     CORNER_RISK_CONFIDENCE,
     CornerRisk,
@@ -73,15 +74,44 @@ class Estimate:
         return 0.5 * (self.ci95_high - self.ci95_low)
 
     def as_dict(self) -> dict:
-        def num(x):
-            return float(x) if np.isfinite(x) else None
-
+        num = finite_or_none
         return {
             "value": num(self.value),
             "ci95_low": num(self.ci95_low),
             "ci95_high": num(self.ci95_high),
             "n": int(self.n),
         }
+
+
+@dataclasses.dataclass(frozen=True)
+class CornerCount:
+    """How often the contact reached the corner over every measured revolution of every seed,
+    with the upper 95 % bounds of its probability per revolution and per seed
+    (`corner_contact_bound`)."""
+
+    revolutions: int
+    revolutions_with_corner_contact: int
+    per_revolution_upper95: float
+    seeds: int
+    seeds_with_corner_contact: int
+    per_seed_upper95: float
+
+    def as_dict(self) -> dict:
+        return dataclasses.asdict(self)
+
+
+@dataclasses.dataclass(frozen=True)
+class PredictionBound:
+    """The one-sided upper prediction bound of one further revolution's largest contact radius
+    [m] at `confidence` over `revolutions` measured ones (`max_contact_radius_bound`); NaN with
+    fewer than two."""
+
+    value: float
+    revolutions: int
+    confidence: float
+
+    def as_dict(self) -> dict:
+        return dataclasses.asdict(self)
 
 
 def student_t_interval(samples, confidence: float = CONFIDENCE) -> Estimate:
@@ -206,18 +236,6 @@ def revolution_statistics(
     return out
 
 
-def _nest(flat: dict[str, Estimate]) -> dict:
-    """{"a.b": est, "c": est} -> {"a": {"b": {...}}, "c": {...}}."""
-    out: dict = {}
-    for key, est in flat.items():
-        group, _, red = key.partition(".")
-        if red:
-            out.setdefault(group, {})[red] = est.as_dict()
-        else:
-            out[group] = est.as_dict()
-    return out
-
-
 def confidence_intervals(per_revolution: list[dict[str, np.ndarray]]) -> tuple[dict[str, Estimate], str]:
     """95 % intervals of every statistic: batch means over the revolutions of one seed, or the
     Student-t interval over seeds of each seed's batch-means value (module docstring)."""
@@ -245,7 +263,7 @@ def upper_probability_bound(count: int, trials: int, confidence: float = CONFIDE
     return float(_sp_stats.beta.ppf(confidence, count + 1, trials - count))
 
 
-def corner_contact_bound(per_revolution: list[dict[str, np.ndarray]], rho_lim: float) -> dict:
+def corner_contact_bound(per_revolution: list[dict[str, np.ndarray]], rho_lim: float) -> CornerCount:
     """How often the contact reached the corner (a revolution whose largest contact radius in
     contact lies beyond the limited circle `rho_lim`), over every measured revolution of every
     seed, with the upper 95 % bounds on its probability (`upper_probability_bound`): per
@@ -259,19 +277,19 @@ def corner_contact_bound(per_revolution: list[dict[str, np.ndarray]], rho_lim: f
         revs, revs_hit = revs + int(measured.sum()), revs_hit + int(hit.sum())
         if measured.any():
             seeds, seeds_hit = seeds + 1, seeds_hit + int(hit.any())
-    return {
-        "revolutions": revs,
-        "revolutions_with_corner_contact": revs_hit,
-        "per_revolution_upper95": upper_probability_bound(revs_hit, revs),
-        "seeds": seeds,
-        "seeds_with_corner_contact": seeds_hit,
-        "per_seed_upper95": upper_probability_bound(seeds_hit, seeds),
-    }
+    return CornerCount(
+        revolutions=revs,
+        revolutions_with_corner_contact=revs_hit,
+        per_revolution_upper95=upper_probability_bound(revs_hit, revs),
+        seeds=seeds,
+        seeds_with_corner_contact=seeds_hit,
+        per_seed_upper95=upper_probability_bound(seeds_hit, seeds),
+    )
 
 
 def max_contact_radius_bound(
     per_revolution: list[dict[str, np.ndarray]], confidence: float = CONFIDENCE
-) -> dict:
+) -> PredictionBound:
     """The one-sided upper prediction bound of the largest contact radius in contact of one
     further cage revolution: over the N measured revolutions of every seed (taken as
     independent: the rollers' axial memory is 3-4 ms against a 7 ms revolution, docs/model.md
@@ -293,7 +311,7 @@ def max_contact_radius_bound(
     if n >= 2:
         t = float(_sp_stats.t.ppf(confidence, n - 1))
         bound = float(np.mean(values) + t * np.std(values, ddof=1) * np.sqrt(1.0 + 1.0 / n))
-    return {"value": bound, "revolutions": n, "confidence": float(confidence)}
+    return PredictionBound(value=bound, revolutions=n, confidence=float(confidence))
 
 
 def window_statistics(
@@ -304,28 +322,6 @@ def window_statistics(
     rho_lim = float(limited_circle_radius(bearing.roller))
     kin = float(kinematic_cage_speed(bearing, op))
     return revolution_statistics(window, edges, rho_lim, kin, threshold)
-
-
-def steady_statistics(
-    windows: list[dict], edges: list, bearing, op, threshold: float = CONTACT_THRESHOLD, per_revolution=None
-) -> dict:
-    """The statistics block of a settled run: `windows` are the measurement-window histories of
-    each seed, `edges` their revolution boundaries [s]; or, instead, `per_revolution`: each
-    seed's `window_statistics`, computed as the seed finished."""
-    rho_lim = float(limited_circle_radius(bearing.roller))
-    kin = float(kinematic_cage_speed(bearing, op))
-    per_rev = list(per_revolution) if per_revolution is not None else []
-    per_rev += [revolution_statistics(h, e, rho_lim, kin, threshold) for h, e in zip(windows, edges)]
-    est, method = confidence_intervals(per_rev)
-    block = _nest(est)
-    block["ci_method"] = method
-    block["corner_contact_bound"] = corner_contact_bound(per_rev, rho_lim)
-    block["max_contact_radius_bound"] = max_contact_radius_bound(per_rev)
-    risk = corner_risk_of_revolutions(per_rev, rho_lim)
-    block["corner_risk"] = risk.as_dict() if risk is not None else None
-    block["limited_circle_radius_m"] = rho_lim
-    block["kinematic_cage_speed_rpm"] = float(rad_s_to_rpm(kin))
-    return block
 
 
 def _measured_revolutions(result) -> list:

@@ -297,7 +297,7 @@ def settle_batch(spec: SweepSpec, cases: Sequence[int], devices: Sequence | None
 
 
 def _settled_row(spec: SweepSpec, runs, member) -> dict:
-    from ..run import SteadyResult, revolution_statistic_keys, summarise_steady
+    from ..run import Estimate, SteadyResult, revolution_statistic_keys, summarise_steady
 
     steady = spec.steady
     result = SteadyResult(
@@ -310,7 +310,10 @@ def _settled_row(spec: SweepSpec, runs, member) -> dict:
         bearing=member.bearing,
         operating=member.operating,
     )
-    block = summarise_steady(result, threshold=CONTACT_THRESHOLD)
+    stats = result.statistics(CONTACT_THRESHOLD)
+    block = summarise_steady(result, threshold=CONTACT_THRESHOLD, statistics=stats)
+    estimates = {} if stats is None else stats.estimates()
+    nothing = Estimate(np.nan, np.nan, np.nan, 0)
 
     def num(v):
         return np.float64(np.nan if v is None else v)
@@ -326,14 +329,13 @@ def _settled_row(spec: SweepSpec, runs, member) -> dict:
         "num_steps": np.float64(block["num_steps"]),
     }
     for key in revolution_statistic_keys():
-        group, _, red = key.partition(".")
-        est = (block.get(group, {}).get(red) if red else block.get(group)) or {}
+        est = estimates.get(key, nothing)
         name = key.replace(".", "_")
-        row[name] = num(est.get("value"))
-        row[name + "_ci95_low"] = num(est.get("ci95_low"))
-        row[name + "_ci95_high"] = num(est.get("ci95_high"))
-    row["status"] = np.asarray(block["status"])
-    row["result_code"] = np.int32(0 if block["status"] == "ok" else 1)
+        row[name] = np.float64(est.value)
+        row[name + "_ci95_low"] = np.float64(est.ci95_low)
+        row[name + "_ci95_high"] = np.float64(est.ci95_high)
+    row["status"] = np.asarray(result.status)
+    row["result_code"] = np.int32(0 if result.ok else 1)
     pos = np.concatenate([r.extras.get("positions", np.zeros((0, 2))) for r in runs])
     row.update(_position_columns(_evenly(pos, spec.max_positions), spec))
     return row
