@@ -242,15 +242,19 @@ def test_one_thread_workers_add_only_the_flags_their_parent_lacks():
 @pytest.mark.skipif(not hasattr(os, "sched_getaffinity"), reason="CPU affinity is Linux-only")
 def test_parallel_map_pins_each_worker_to_one_cpu():
     """Every worker of a pool runs on one CPU of this process's set (its XLA threads with it),
-    the workers in turn on the set's CPUs."""
+    the workers in turn on the set's CPUs. (Both maps in one pool, `shared_workers`: a pool is two
+    spawned processes that import JAX, a few seconds.)"""
+    from jaxbearing.run import shared_workers
     from jaxbearing.run._ensemble import _pin_to_one_cpu
 
     mine = os.sched_getaffinity(0)
-    seen = parallel_map(os.sched_getaffinity, [0] * 6, workers=2)
-    assert all(len(cpus) == 1 and cpus <= mine for cpus in seen)
     cpus = sorted(mine)
     expected = [{cpus[i % len(cpus)]} for i in range(3)]
-    assert parallel_map(_affinity_after_pin, [(i, cpus) for i in range(3)], workers=2) == expected
+    with shared_workers(2):
+        seen = parallel_map(os.sched_getaffinity, [0] * 6, workers=2)
+        pinned = parallel_map(_affinity_after_pin, [(i, cpus) for i in range(3)], workers=2)
+    assert all(len(cpus) == 1 and cpus <= mine for cpus in seen)
+    assert pinned == expected
     _pin_to_one_cpu(0, [])  # no CPUs given: nothing to do
     assert os.sched_getaffinity(0) == mine
 

@@ -10,6 +10,7 @@ asserts the same of it in the default suite). The bias of the estimators against
 derivative of the settled mean is measured in benchmarks/results/bench_steady_gradient.json."""
 
 import dataclasses
+import functools
 
 import equinox as eqx
 import jax
@@ -258,9 +259,24 @@ def frozen_window(settled):
     saved, code = _frozen_window_states(b, op, base.sample_states[0])
     assert int(code) == 0
     params = Params(bearing=b, operating=op, functionals=STEADY_FUNCTIONALS)
-    q0 = jax.jit(jax.vmap(lambda s: contact_loads(s, params).flange.normal_force))(saved)
-    fl = jax.vmap(lambda s: contact_loads(s, params).flange)(saved)
-    return saved, q0, fl.pv / STEADY_FUNCTIONALS.pv_reference
+    # one compiled program for both (a second evaluation of the loads compiled again, ~5 s)
+    fl = jax.jit(jax.vmap(lambda s: contact_loads(s, params).flange))(saved)
+    return saved, fl.normal_force, fl.pv / STEADY_FUNCTIONALS.pv_reference
+
+
+@eqx.filter_jit
+def _frozen_sums(b, op, saved, q0, exponent, v):
+    """The frozen functional's sums over the saved states (`frozen_load_integrands`) at design v;
+    the exponent an argument, so that the mean and the peak share one compiled program."""
+    from jaxbearing.design._frozen_load import frozen_load_integrands
+
+    per = jax.vmap(lambda s, q: frozen_load_integrands(b, op, v, s, q, exponent))(saved, q0)
+    return jnp.sum(per, axis=0)
+
+
+@eqx.filter_jit
+def _frozen_sums_jacobian(b, op, saved, q0, exponent, v):
+    return jax.jacfwd(lambda w: _frozen_sums(b, op, saved, q0, exponent, w))(v)
 
 
 @pytest.mark.parametrize("statistic", ["mean", "peak", "tail"])
@@ -271,7 +287,7 @@ def test_frozen_load_derivative_matches_central_differences(settled, frozen_wind
     estimator's own 1 ms window from a settled state; for the mean (p = 1), the peak
     statistic's p-mean (p = 8) and the tail statistic (every touching sample's frozen PV,
     `frozen_tail_samples`, whose Jacobian `tail_integrals` sums over the worst 5 %)."""
-    from jaxbearing.design._frozen_load import frozen_load_integrands, frozen_pv, frozen_tail_samples
+    from jaxbearing.design._frozen_load import frozen_pv, frozen_tail_samples
 
     b, op, _, _ = settled
     x = jnp.asarray(DesignVariables.of(b).as_array())
@@ -294,13 +310,8 @@ def test_frozen_load_derivative_matches_central_differences(settled, frozen_wind
         direct = jnp.stack([jnp.sum(jnp.where(worst, ratio, 0.0)), jnp.sum(q0 > 1.0)])
     else:
         exponent = {"mean": 1.0, "peak": 8.0}[statistic]
-
-        @jax.jit
-        def frozen(v):
-            per = jax.vmap(lambda s, q: frozen_load_integrands(b, op, v, s, q, exponent))(saved, q0)
-            return jnp.sum(per, axis=0)
-
-        value, jac = frozen(x), jax.jacfwd(frozen)(x)
+        frozen = functools.partial(_frozen_sums, b, op, saved, q0, jnp.asarray(exponent))
+        value, jac = frozen(x), _frozen_sums_jacobian(b, op, saved, q0, jnp.asarray(exponent), x)
         w = q0 / (q0 + STEADY_FUNCTIONALS.contact_load)
         direct = jnp.stack([jnp.sum(w * ratio**exponent), jnp.sum(w)])
     for i in range(3):
@@ -360,8 +371,21 @@ def _crn_ensembles(settled, crn_runs, statistic):
     return runs
 
 
+@pytest.fixture(scope="module")
+def frozen_estimates(settled):
+    """The frozen-load estimates of every statistic from the settled states, their trajectories
+    integrated once (`frozen_load_statistics`)."""
+    from jaxbearing.design import frozen_load_statistics
+
+    b, op, x, base = settled
+    case = (b, op, DesignVariables.from_array(x), base.sample_states)
+    return frozen_load_statistics([case], statistics=("mean", "peak", "tail"), workers=1)[0]
+
+
 @pytest.mark.parametrize("statistic", ["mean", "peak", "tail"])
-def test_frozen_load_estimator_agrees_with_crn_differences_on_settled_running(settled, crn_runs, statistic):
+def test_frozen_load_estimator_agrees_with_crn_differences_on_settled_running(
+    settled, crn_runs, frozen_estimates, statistic
+):
     """The acceptance check of the gradient study (benchmarks/results/bench_steady_gradient.json) at reduced size (11 slices,
     3 seeds, theta_f at the reference design), in the default suite: running from the skid start
     (which lands on the plateau, tests/test_skid.py), then a common-random-number central
@@ -391,18 +415,14 @@ def test_frozen_load_estimator_agrees_with_crn_differences_on_settled_running(se
     with them the chaotic runs; 2026-11-26, `pytest -rP tests/test_steady_gradient.py -k crn`
     with conftest's flags, one process): mean -8.84e10 +- 1.1e10 against -9.99e10 (13 %
     apart), peak -1.59e11 +- 1.6e10 against -1.61e11 (1 %), tail -2.10e11 +- 3.3e10 against
-    -2.20e11 (5 %). The mean and the tail share their ensembles (`_crn_ensembles`)."""
-    from jaxbearing.design import frozen_load_gradient
-
-    b, op, x, base = settled
+    -2.20e11 (5 %). The mean and the tail share their ensembles (`_crn_ensembles`), and the three
+    frozen-load estimates their trajectories (`frozen_estimates`)."""
     h = CRN_STEP
     ensembles = _crn_ensembles(settled, crn_runs, statistic)
     per_seed = [np.asarray(m.objectives_per_seed[statistic]) for m in ensembles]
     d = (per_seed[0] - per_seed[1]) / (2 * h)
     fd, se = float(np.mean(d)), float(np.std(d, ddof=1) / np.sqrt(d.size))
-    g = frozen_load_gradient(
-        b, op, DesignVariables.from_array(x), base.sample_states, workers=1, statistic=statistic
-    )
+    g = frozen_estimates[statistic]
     print(
         f"dJ/dtheta_f: CRN FD {fd:.3e} +- {se:.1e}, frozen load {g.gradient[1]:.3e} +- {g.gradient_stderr[1]:.1e}"
     )
@@ -411,20 +431,20 @@ def test_frozen_load_estimator_agrees_with_crn_differences_on_settled_running(se
     assert abs(g.gradient[1] - fd) <= 0.3 * abs(fd)
 
 
-@pytest.mark.parametrize("statistic", ["mean", "tail"])
-def test_frozen_load_gradients_batched_equal_one_at_a_time(settled, statistic):
-    """`frozen_load_gradients` on two cases (two designs, two and three settled states): every
-    trajectory a member of one vmapped program gives each case's estimate and gradient as the
-    cases run one trajectory at a time do, each case only from its own states. Not bitwise: the
-    vmapped solve is another program, its roundings flip a step's acceptance now and then, and
-    over the 1 ms window the impacting dynamics grow such a difference (module docstring of
-    `_steady_gradient`), by an amount that depends on the CPU and the batch's size. The two are
-    then two estimates of the same expectation, each with its own standard error, so they must
-    agree within three standard errors of their difference, sqrt(SE_1^2 + SE_b^2) (a false alarm
-    at most 0.3 % of the time for normal errors; one standard error of one of them failed on a
-    fresh machine). The tail statistic too: its vmapped program returns every sample's frozen PV
-    and Jacobian, the accelerator's path (`frozen_tail_members`)."""
-    from jaxbearing.design import frozen_load_gradients
+def test_frozen_load_statistics_batched_equal_one_at_a_time(settled):
+    """`frozen_load_statistics` of every statistic on two cases (two designs, two and three
+    settled states): every trajectory a member of one vmapped program gives each case's estimates
+    and gradients as the cases run one trajectory at a time do, each case only from its own
+    states. Not bitwise: the vmapped solve is another program, its roundings flip a step's
+    acceptance now and then, and over the 1 ms window the impacting dynamics grow such a
+    difference (module docstring of `_steady_gradient`), by an amount that depends on the CPU and
+    the batch's size. The two are then two estimates of the same expectation, each with its own
+    standard error, so they must agree within three standard errors of their difference,
+    sqrt(SE_1^2 + SE_b^2) (a false alarm at most 0.3 % of the time for normal errors; one
+    standard error of one of them failed on a fresh machine). One program for the three
+    statistics: the mean's and the peak's Jacobians at their exponents, and every sample's frozen
+    PV and Jacobian for the tail."""
+    from jaxbearing.design import frozen_load_statistics
 
     b, op, x, base = settled
     x2 = x.copy()
@@ -433,19 +453,54 @@ def test_frozen_load_gradients_batched_equal_one_at_a_time(settled, statistic):
         (b, op, DesignVariables.from_array(x), base.sample_states[:2]),
         (b, op, DesignVariables.from_array(x2), base.sample_states[:3]),
     ]
-    one = frozen_load_gradients(cases, strategy="sequential", statistic=statistic)
-    batched = frozen_load_gradients(cases, strategy="vmap", statistic=statistic)
-    for a, v in zip(one, batched):
-        assert a.num_samples == v.num_samples and np.isfinite(a.value)
-        print(
-            f"value {a.value:.6e} / {v.value:.6e}, gradient {a.gradient} / {v.gradient} +- {a.gradient_stderr}"
-        )
-        assert abs(v.value - a.value) <= 3.0 * np.hypot(a.value_stderr, v.value_stderr)
-        # Delta_bf's component is round-off (~1e-11 of the others: the estimator cannot see it)
-        floor = 1e-9 * np.max(np.abs(a.gradient))
-        spread = 3.0 * np.hypot(a.gradient_stderr, v.gradient_stderr)
-        assert np.all(np.abs(v.gradient - a.gradient) <= spread + floor)
-    assert [g.num_samples for g in batched] == [2, 3] and one[0].value != one[1].value
+    every = ("mean", "peak", "tail")
+    one = frozen_load_statistics(cases, statistics=every, strategy="sequential")
+    batched = frozen_load_statistics(cases, statistics=every, strategy="vmap")
+    for statistic in every:
+        for a, v in zip((o[statistic] for o in one), (o[statistic] for o in batched)):
+            assert a.num_samples == v.num_samples and np.isfinite(a.value)
+            print(
+                f"{statistic}: value {a.value:.6e} / {v.value:.6e}, "
+                f"gradient {a.gradient} / {v.gradient} +- {a.gradient_stderr}"
+            )
+            assert abs(v.value - a.value) <= 3.0 * np.hypot(a.value_stderr, v.value_stderr)
+            # Delta_bf's component is round-off (~1e-11 of the others: the estimator cannot see it)
+            floor = 1e-9 * np.max(np.abs(a.gradient))
+            spread = 3.0 * np.hypot(a.gradient_stderr, v.gradient_stderr)
+            assert np.all(np.abs(v.gradient - a.gradient) <= spread + floor)
+        assert [o[statistic].num_samples for o in batched] == [2, 3]
+        assert one[0][statistic].value != one[1][statistic].value
+
+
+def test_frozen_load_statistics_equal_one_statistic_at_a_time(settled):
+    """The statistics of one call of `frozen_load_statistics` (each trajectory integrated once)
+    are exactly those of `frozen_load_gradients` run for each statistic on its own: the same
+    programs from the same states, summed differently."""
+    from jaxbearing.design import frozen_load_gradients, frozen_load_statistics
+
+    b, op, x, base = settled
+    cases = [(b, op, DesignVariables.from_array(x), base.sample_states[:2])]
+    together = frozen_load_statistics(cases, statistics=("tail", "peak"), strategy="sequential")[0]
+    assert list(together) == ["tail", "peak"]
+    for statistic, found in together.items():
+        alone = frozen_load_gradients(cases, statistic=statistic, strategy="sequential")[0]
+        assert found.value == alone.value and found.num_samples == alone.num_samples == 2
+        assert np.array_equal(found.gradient, alone.gradient)
+        assert np.array_equal(found.integral_jacobians, alone.integral_jacobians)
+
+
+@pytest.mark.parametrize(
+    "statistics, words",
+    [
+        ((), "statistics = (): must name at least one of"),
+        (("mean", "p99"), "statistic = 'p99': must be one of"),
+    ],
+)
+def test_bad_frozen_load_statistics_are_one_line(statistics, words):
+    from jaxbearing.design import frozen_load_statistics
+
+    with pytest.raises(jb.UserInputError, match=r"^" + __import__("re").escape(words)):
+        frozen_load_statistics([], statistics=statistics)
 
 
 def test_frozen_load_trajectories_run_with_the_design(settled):

@@ -145,7 +145,9 @@ def test_validate_writes_the_comparison(two_points, capsys):
 
 def test_an_interrupted_validation_keeps_its_finished_points(two_points, capsys, monkeypatch):
     """The second point is interrupted (Ctrl-C): exit 130, and validation.csv holds the first
-    point, finished before it."""
+    point, finished before it. The points in the other order (20,000 rpm first: its
+    revolutions take half the time of 10,000 rpm's, and `test_validate_writes_the_comparison`
+    stored the skid start of its seed 0)."""
     from jaxbearing.run import _measured
 
     real = _measured.simulate_steady
@@ -160,9 +162,13 @@ def test_an_interrupted_validation_keeps_its_finished_points(two_points, capsys,
     monkeypatch.setattr(_measured, "simulate_steady", interrupted_second)
     d = two_points
     out = d / "killed"
+    lines = (d / "two.csv").read_text().splitlines()
+    (d / "swapped.csv").write_text("\n".join([*lines[:-2], lines[-1], lines[-2]]) + "\n")
     one_seed = [*ARGS[:5], "1", *ARGS[6:]]  # one seed: the first point's run is all this needs
-    code = main(["validate", str(d / "two.csv"), "--config", str(d / "c.toml"), *one_seed, "--out", str(out)])
+    code = main(
+        ["validate", str(d / "swapped.csv"), "--config", str(d / "c.toml"), *one_seed, "--out", str(out)]
+    )
     assert code == 130
     rows = list(csv.DictReader((out / "validation.csv").open()))
-    assert [float(r["shaft_speed_rpm"]) for r in rows] == [10000.0]
+    assert [float(r["shaft_speed_rpm"]) for r in rows] == [20000.0]
     assert not (out / "validation.json").exists()  # the record is written once every point is done

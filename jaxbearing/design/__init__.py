@@ -12,7 +12,7 @@
   95 % intervals over seeds; continuation from given states), `SteadyDesignMetrics`,
   `CORNER_MARGIN`;
 - its gradient: `steady_gradient` (an ensemble of short-window forward-mode sensitivities from
-  settled states, `GRADIENT_WINDOW`), `frozen_load_gradient` (`frozen_load_gradients`: many cases, one call), `ratio_gradient`, `paired_central_difference` (common-random-number differences),
+  settled states, `GRADIENT_WINDOW`), `frozen_load_gradient` (`frozen_load_gradients`: many cases, one call; `frozen_load_statistics`: several statistics from the same trajectories), `ratio_gradient`, `paired_central_difference` (common-random-number differences),
   `SteadyGradient`, `tangent_growth` (finite-time growth of the tangents) and the smooth
   accumulators they differentiate, `STEADY_FUNCTIONALS` (`STATISTICS`, by `Statistic`: the mean, and the
   peak statistic's p-mean with p = `PEAK_EXPONENT`).
@@ -45,7 +45,7 @@ from ._design import (
     forward_jacobian,
     seated_perturbation,
 )
-from ._frozen_load import frozen_load_gradient, frozen_load_gradients
+from ._frozen_load import frozen_load_gradient, frozen_load_gradients, frozen_load_statistics
 from ._robustness import (
     ROBUSTNESS_CONSTANTS,
     Robustness,
@@ -114,6 +114,7 @@ __all__ = [
     "forward_jacobian",
     "frozen_load_gradient",
     "frozen_load_gradients",
+    "frozen_load_statistics",
     "paired_central_difference",
     "parse_sensitivity_statistics",
     "ratio_gradient",

@@ -135,7 +135,10 @@ def tail_integrals(samples) -> tuple[list, float]:
 
 @dataclasses.dataclass(frozen=True)
 class _FrozenSample:
-    """Picklable frozen-load integrals and Jacobians along one trajectory (`parallel_map`)."""
+    """Picklable frozen-load samples along one trajectory (`parallel_map`): the trajectory
+    integrated once, then per statistic of `statistics` its integrals and Jacobian (the mean and
+    the peak: `_frozen_jacobian`, at the statistic's exponent) or its samples (the tail:
+    `frozen_tail_samples`)."""
 
     bearing: Bearing
     op: OperatingPoint
@@ -143,10 +146,9 @@ class _FrozenSample:
     duration: float
     num_saves: int
     rtol: float
-    exponent: float = 1.0
-    tail: bool = False  # the tail statistic's samples (`frozen_tail_samples`) instead of sums
+    statistics: tuple = ("mean",)
 
-    def __call__(self, state):
+    def __call__(self, state) -> dict:
         x = jnp.asarray(self.x)
         state = jax.tree_util.tree_map(jnp.asarray, state)
         num_saves = self.num_saves
@@ -154,15 +156,28 @@ class _FrozenSample:
         trajectory = lambda b, o, s, d, r: trajectory_states(b, o, s, d, num_saves, rtol=r)
         states, code = compiled_program("trajectory_states", trajectory, args, num_saves)(*args)
         if int(code) != 0:  # a failed trajectory: no samples (tail), NaN integrals (sums)
-            return None if self.tail else _failed_integrals()
-        if self.tail:
-            args = (self.bearing, self.op, x, states)
-            return tuple(
-                map(np.asarray, compiled_program("frozen_tail_samples", frozen_tail_samples, args)(*args))
-            )
-        args = (self.bearing, self.op, x, states, np.float64(self.exponent))
-        val, jac = compiled_program("frozen_load_jacobian", _frozen_jacobian, args)(*args)
-        return np.asarray(val), np.asarray(jac)
+            return {s: _failed_sample(s) for s in self.statistics}
+        out = {}
+        for statistic in self.statistics:
+            if statistic == "tail":
+                args = (self.bearing, self.op, x, states)
+                program = compiled_program("frozen_tail_samples", frozen_tail_samples, args)
+                out[statistic] = tuple(map(np.asarray, program(*args)))
+            else:
+                args = (self.bearing, self.op, x, states, _exponent(statistic))
+                val, jac = compiled_program("frozen_load_jacobian", _frozen_jacobian, args)(*args)
+                out[statistic] = (np.asarray(val), np.asarray(jac))
+        return out
+
+
+def _exponent(statistic: str) -> np.float64:
+    """The PV exponent p of a statistic's frozen-load integrand (`STATISTICS`)."""
+    return np.float64(_functionals(statistic).pv_exponent)
+
+
+def _failed_sample(statistic: str):
+    """A failed trajectory's sample: no tail samples (None), NaN integrals otherwise."""
+    return None if statistic == "tail" else _failed_integrals()
 
 
 def _frozen_jacobian(bearing, op, x, states, exponent=1.0):
@@ -186,26 +201,40 @@ def frozen_load_gradient(
 
 
 def frozen_load_gradients(
+    cases, *, statistic: Statistic | str = Statistic.MEAN, **options
+) -> list[SteadyGradient]:
+    """The frozen-load estimate (module docstring) of the steady objective and its gradient for
+    every case (bearing, op, design, states), e.g. every start and operating point of one
+    iteration of the design search; one `SteadyGradient` per case, in order. `statistic`:
+    "mean" (PV over contact time), "peak" (its p-mean) or "tail" (the mean of its worst 5 %);
+    the other `options` and how the trajectories run: `frozen_load_statistics`, of this one
+    statistic."""
+    key = statistic_of(statistic)
+    return [found[key] for found in frozen_load_statistics(cases, statistics=(key,), **options)]
+
+
+def frozen_load_statistics(
     cases,
     *,
+    statistics=("mean", "peak", "tail"),
     window: float = 1.0e-3,
     saves_per_ms: int = 200,
     rtol: float = 1e-3,
     workers: int = 1,
     strategy: str = "auto",
-    statistic: Statistic | str = Statistic.MEAN,
-) -> list[SteadyGradient]:
-    """The frozen-load estimate (module docstring) of the steady objective and its gradient for
-    every case (bearing, op, design, states), e.g. every start and operating point of one
-    iteration of the design search; one `SteadyGradient` per case, in order. From each of a
-    case's `states` (states of settled running of that design), a plain solve with `design`
-    applied to `bearing` (its other parameters kept) over `window` seconds saves the state every
-    1 / `saves_per_ms` ms; at every saved state the flange PV is differentiated in the design at
-    the loads the dynamics gave (`frozen_load_integrands`), summed, and combined through the
-    ratio estimator; jackknife over the trajectories. `statistic`: "mean" (PV over contact
-    time), "peak" (its p-mean) or "tail" (the mean of its worst 5 %, at the 95th percentile of the
-    trajectories' own touching samples: `tail_integrals`; `STATISTICS`). Every trajectory of
-    every case is one member of one call (`strategy`, as the steady-running engine's
+) -> list[dict[str, SteadyGradient]]:
+    """The frozen-load estimates (module docstring) of the steady objective and its gradient for
+    every case (bearing, op, design, states) and every statistic of `statistics`: one
+    {statistic: `SteadyGradient`} per case, in order. From each of a case's `states` (states of
+    settled running of that design), a plain solve with `design` applied to `bearing` (its other
+    parameters kept) over `window` seconds saves the state every 1 / `saves_per_ms` ms; at every
+    saved state the flange PV is differentiated in the design at the loads the dynamics gave
+    (`frozen_load_integrands`), summed, and combined through the ratio estimator; jackknife over
+    the trajectories. Each trajectory is integrated once for all the statistics: they differ
+    only in what is summed over its saved states. Statistics (`STATISTICS`): "mean" (PV over
+    contact time), "peak" (its p-mean) or "tail" (the mean of its worst 5 %, at the 95th
+    percentile of the trajectories' own touching samples: `tail_integrals`). Every trajectory
+    of every case is one member of one call (`strategy`, as the steady-running engine's
     `choose_strategy`): "vmap" (the default on an accelerator) integrates and differentiates
     them all in one vmapped program; on a CPU they run `workers` processes at a time
     ("processes"), or one after another ("sequential")."""
@@ -213,8 +242,11 @@ def frozen_load_gradients(
     require("saves_per_ms", saves_per_ms, lambda v: (v >= 1) & (v == np.round(v)), "an integer >= 1")
     if strategy not in STRATEGIES:
         raise UserInputError(f"strategy = {strategy!r}: must be one of {', '.join(map(repr, STRATEGIES))}")
-    exponent = float(_functionals(statistic).pv_exponent)
-    tail = statistic_of(statistic) is Statistic.TAIL
+    statistics = tuple(
+        dict.fromkeys(statistic_of(s) for s in ([statistics] if isinstance(statistics, str) else statistics))
+    )
+    if not statistics:
+        raise UserInputError("statistics = (): must name at least one of 'mean', 'peak', 'tail'")
     cases = list(cases)
     n = max(1, int(round(window * 1e3 * saves_per_ms)))
     jobs, owner = [], []
@@ -222,18 +254,21 @@ def frozen_load_gradients(
         x = np.asarray(design.as_array(), dtype=float)
         # the trajectories run with the design, as the settled states did: a bearing of another
         # design would start every window off its contacts (micrometres against a changed end arc)
-        job = _FrozenSample(design.apply(bearing), op, x, float(window), n, float(rtol), exponent, tail)
+        job = _FrozenSample(design.apply(bearing), op, x, float(window), n, float(rtol), statistics)
         jobs += [(job, s) for s in states]
         owner += [k] * len(states)
     outs = _run_frozen(jobs, strategy, workers)
     per_case = [[o for o, j in zip(outs, owner) if j == k] for k in range(len(cases))]
-    if not tail:
-        return [_combine(o, window, exponent) for o in per_case]
-    found = []
-    for o in per_case:
-        integrals, q = tail_integrals(o)
-        found.append(_combine(integrals, window, tail_threshold=q * STEADY_FUNCTIONALS.pv_reference))
-    return found
+    return [{s: _combine_statistic(s, [o[s] for o in per], window) for s in statistics} for per in per_case]
+
+
+def _combine_statistic(statistic: str, samples: list, window: float) -> SteadyGradient:
+    """One statistic's estimate from its per-trajectory samples (`_FrozenSample`): the ratio
+    estimator at its exponent (mean, peak), or at the tail threshold of its samples (tail)."""
+    if statistic != "tail":
+        return _combine(samples, window, float(_exponent(statistic)))
+    integrals, q = tail_integrals(samples)
+    return _combine(integrals, window, tail_threshold=q * STEADY_FUNCTIONALS.pv_reference)
 
 
 def _run_frozen(jobs, strategy: str, workers: int) -> list:
@@ -253,14 +288,16 @@ def _frozen_job(item):
 
 def _frozen_samples_batched(jobs) -> list:
     """Every (`_FrozenSample`, state) of `jobs` as one member of one vmapped program: its
-    trajectory and the frozen-load integrals and Jacobian along it."""
-    num_saves, tail = jobs[0][0].num_saves, jobs[0][0].tail
+    trajectory, integrated once, and per statistic the frozen-load integrals and Jacobian (mean,
+    peak: their exponents a traced argument, so one program serves either) or the tail's samples."""
+    num_saves, statistics = jobs[0][0].num_saves, jobs[0][0].statistics
+    sums = [s for s in statistics if s != "tail"]
+    tail = "tail" in statistics
 
     def one(b, o, x, s, d, r, p):
         states, code = trajectory_states(b, o, s, d, num_saves, rtol=r)
-        if tail:
-            return frozen_tail_samples(b, o, x, states), code
-        return _frozen_jacobian(b, o, x, states, p), code
+        out = [_frozen_jacobian(b, o, x, states, p[i]) for i in range(len(sums))]
+        return (out, frozen_tail_samples(b, o, x, states) if tail else None), code
 
     args = stack_trees(
         [
@@ -271,14 +308,18 @@ def _frozen_samples_batched(jobs) -> list:
                 state,
                 np.float64(job.duration),
                 np.float64(job.rtol),
-                np.float64(job.exponent),
+                np.array([_exponent(s) for s in sums], dtype=np.float64),
             )
             for job, state in jobs
         ]
     )
-    name = "frozen_tail_members" if tail else "frozen_load_members"
-    outs, codes = jax.device_get(compiled_program(name, jax.vmap(one), args, num_saves)(*args))
-    if tail:
-        return [tuple(a[i] for a in outs) if int(codes[i]) == 0 else None for i in range(len(jobs))]
-    vals, jacs = outs
-    return [(vals[i], jacs[i]) if int(codes[i]) == 0 else _failed_integrals() for i in range(len(jobs))]
+    program = compiled_program("frozen_members", jax.vmap(one), args, (num_saves, len(sums), tail))
+    (sum_outs, tail_outs), codes = jax.device_get(program(*args))
+    found = []
+    for i in range(len(jobs)):
+        ok = int(codes[i]) == 0
+        one_member = {s: (sum_outs[j][0][i], sum_outs[j][1][i]) for j, s in enumerate(sums)}
+        if tail:
+            one_member["tail"] = tuple(a[i] for a in tail_outs)
+        found.append({s: one_member[s] if ok else _failed_sample(s) for s in statistics})
+    return found
