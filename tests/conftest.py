@@ -62,6 +62,7 @@ FILE_SECONDS = {
     "test_steady_design.py": 17,
     "test_flange_arrangement.py": 13,
     "test_config_new.py": 13,
+    "test_faces.py": 15,
 }
 
 #: files that compile the same programs, run by one process in this order (`make test`, the

@@ -428,6 +428,9 @@ def test_rib_distance_is_the_distance_to_the_meridian_circle():
 # skew alone): the depth along the corner circle has two maxima, and Newton's method from the
 # circle's radial direction alone stops between them (checked: it fails this example)
 @example(0.834, 0.677, 0.221, -1.49e-4, 4.36e-3, 0.0, 1.0, -1.0)
+# an end offset e of 1e-126 of R_ce: the arc's centre circle shrinks to a point, the depth is
+# flat in the angle and F'/F'' is 0/0 (the reported step is bounded by pi times the radius)
+@example(1.2913027781919056e-126, 0.5, 0.0, 0.0, 0.0, 0.0, 1.0, 1.0)
 def test_newton_converges_to_the_deepest_point(
     offset, conformity, height, tilt, skew, axial, ring_sign, side
 ):

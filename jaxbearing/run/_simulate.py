@@ -155,6 +155,29 @@ def _save(t, y_scaled, args: SolveArgs):
     )
 
 
+#: the keyword arguments of `solve` and `simulate` that `_check_solve` checks
+_CHECKED_OPTIONS = (
+    "num_saves",
+    "rtol",
+    "atol",
+    "max_steps",
+    "progress",
+    "perturbation",
+    "functionals",
+    "adjoint",
+    "solver",
+    "error_norm",
+    "raceway_loosen",
+    "rotation_loosen",
+)
+
+
+def _checked_options(arguments: dict) -> dict:
+    """The options among a caller's `arguments` (its `locals()` on entry) that `_check_solve`
+    checks: one list for `solve` and `simulate`, not a copy of their keywords in each."""
+    return {k: arguments[k] for k in _CHECKED_OPTIONS if k in arguments}
+
+
 def _check_solve(
     bearing, op, duration, *, adjoint=None, solver=DEFAULT_SOLVER, error_norm=None, **kwargs
 ) -> None:
@@ -258,23 +281,7 @@ def solve(
     one-line `UserInputError`/`ConfigError`); under jit/vmap/grad traced values cannot be
     checked and pass (`simulate` and the sweep check them concretely first).
     """
-    _check_solve(
-        bearing,
-        op,
-        duration,
-        num_saves=num_saves,
-        rtol=rtol,
-        atol=atol,
-        max_steps=max_steps,
-        progress=progress,
-        perturbation=perturbation,
-        functionals=functionals,
-        adjoint=adjoint,
-        solver=solver,
-        error_norm=error_norm,
-        raceway_loosen=raceway_loosen,
-        rotation_loosen=rotation_loosen,
-    )
+    _check_solve(bearing, op, duration, **_checked_options(locals()))
     args, y0_scaled = _transient_start(bearing, op, perturbation, functionals)
     saveat = _transient_saveat(duration, num_saves)
     controller = _transient_controller(y0_scaled, rtol, atol, error_norm, raceway_loosen, rotation_loosen)
@@ -399,20 +406,7 @@ def simulate(
 
     Compiles once per bearing structure (cached) and reports compile and run time separately.
     """
-    _check_solve(
-        bearing,
-        op,
-        duration,
-        num_saves=num_saves,
-        rtol=rtol,
-        atol=atol,
-        max_steps=max_steps,
-        progress=progress,
-        perturbation=perturbation,
-        functionals=functionals,
-        solver=solver,
-        rules={"num_saves": SIMULATE_NUM_SAVES},
-    )
+    _check_solve(bearing, op, duration, **_checked_options(locals()), rules={"num_saves": SIMULATE_NUM_SAVES})
     dyn = (bearing, op, jnp.asarray(duration, float), jnp.asarray(rtol, float), jnp.asarray(atol, float))
     static = (int(num_saves), int(max_steps), bool(progress), perturbation, functionals, solver)
     start = time.perf_counter()
