@@ -7,13 +7,11 @@ coefficient), ranges as `jaxbearing.design.sensitivity_inputs` states them, and 
 its verification). Writes benchmarks/results/study_robust_design.json.
 
     taskset -c 1 python benchmarks/studies/study_robust_design.py [--slices 11] [--seeds 3] [--window-revs 4]
-    taskset -c 1 python benchmarks/studies/study_robust_design.py --time-members   # the size's cost
 
 Options: --slices (default 31), --seeds (4), --window-revs (4), --first-seed (5000), --out (the
-results file). The size run for the docs is in the results file (`command`). `--time-members`
-times one settled member (the reference design at 30,000 rpm, one seed, a 4-revolution window,
-compilation included: the first member of a fresh process) at 11 and at 31 slices and adds the
-times to the results file (`size_choice`): what chose the size.
+results file). The size run for the docs is in the results file (`command`). What chose the
+size, one settled member timed at 11 and at 31 slices, is in `study_robust_design.json`
+(`size_choice`; measured by an earlier version of this script, in git history).
 """
 
 from __future__ import annotations
@@ -51,9 +49,6 @@ def parse(argv):
         default=DESIGN_FILE,
         help="a search's result.json whose design is checked (default the 3-speed default run's)",
     )
-    p.add_argument(
-        "--time-members", action="store_true", help="time one member at 11 and 31 slices (default off)"
-    )
     return p.parse_args(argv)
 
 
@@ -85,42 +80,8 @@ def commit() -> str:
         return "unknown"
 
 
-def time_members(out: Path) -> dict:
-    """Wall time of one settled member at 11 and at 31 slices, each in a fresh process (module
-    docstring), added to `out` as `size_choice`."""
-    import json
-
-    code = (
-        "import sys, time, dataclasses as dc, jaxbearing as jb;"
-        "from jaxbearing.design import steady_design_metrics_points as m;"
-        "from jaxbearing.flange import DesignVariables as D;"
-        "from jaxbearing.run import SteadySettings as S;"
-        "b = dc.replace(jb.reference_bearing(), num_slices=int(sys.argv[1]));"
-        "op = dc.replace(jb.reference_operating_point(), inner_speed=jb.rpm_to_rad_s(30000.0));"
-        "t = time.perf_counter(); m(b, [op], D.of(b), S(seeds=1, window_revs=4), first_seed=5000);"
-        "print(time.perf_counter() - t)"
-    )
-    times = {}
-    for n in (11, 31):
-        run = subprocess.run([sys.executable, "-c", code, str(n)], capture_output=True, text=True, check=True)
-        times[f"{n}_slices_s"] = float(run.stdout.strip().splitlines()[-1])
-    block = {
-        "member": "reference design, 30,000 rpm, 1 seed, settled (auto) then a 4-revolution window, "
-        "compilation included, one core",
-        **times,
-        "ratio_31_to_11": times["31_slices_s"] / times["11_slices_s"],
-        "command": "taskset -c 1 python benchmarks/studies/study_robust_design.py --time-members",
-    }
-    doc = json.loads(out.read_text()) if out.is_file() else {}
-    out.write_text(json.dumps(doc | {"size_choice": block}, indent=1, allow_nan=False) + "\n")
-    return block
-
-
 def main(argv=None) -> int:
     args = parse(sys.argv[1:] if argv is None else argv)
-    if args.time_members:
-        print(time_members(args.out))
-        return 0
     cfg = reference_config().replace({"bearing.num_slices": args.slices})
     settings = SteadySettings(seeds=args.seeds, window_revs=args.window_revs, progress=True)
     started_at = commit()

@@ -67,11 +67,11 @@ from ..run import (
     Perturbation,
     SettledStatistics,
     SteadySettings,
+    settled_statistics,
     simulate_steady_points,
     steady_revolution_maxima,
     student_t_interval,
     summarise_steady,
-    window_statistics,
 )
 from ._steady_objective import STATISTICS, Statistic, _functionals
 
@@ -194,16 +194,16 @@ def steady_design_metrics_points(
 
 def _tail_per_seed(result, run) -> float:
     """One seed's tail statistic: the mean over its window's revolutions of the tail mean of PV
-    over contact time (`run.tail_mean` of the touching samples, per revolution); NaN without a
+    over contact time (`run.tail_mean` of the touching samples, per revolution: the
+    `flange_pv_contact_time_Pa_m_s.tail95` field of that seed's own statistics); NaN without a
     measured window or contact."""
     if not run.measured:
         return float("nan")
-    per_rev = run.per_revolution
-    if per_rev is None:
-        per_rev = window_statistics(run.window, run.edges, result.bearing, result.operating)
-    values = np.asarray(per_rev["flange_pv_contact_time_Pa_m_s.tail95"], dtype=float)
-    values = values[np.isfinite(values)]
-    return float(np.mean(values)) if values.size else float("nan")
+    windows, edges, given = (
+        ([run.window], [run.edges], None) if run.per_revolution is None else ([], [], [run.per_revolution])
+    )
+    own = settled_statistics(windows, edges, result.bearing, result.operating, per_revolution=given)
+    return float(own.flange_pv_contact_time_Pa_m_s.tail95.value)
 
 
 def _metrics(
