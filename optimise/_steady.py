@@ -181,7 +181,7 @@ def steady_search(
     settings: SteadySettings = SteadySettings(),
     *,
     num_starts: int = 2,
-    num_iterations: int = 6,
+    num_iterations: int = 4,
     learning_rate: float = 0.08,
     rho: float = 10.0,
     starts: np.ndarray | None = None,
