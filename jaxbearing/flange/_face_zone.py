@@ -35,6 +35,7 @@ from ._checks import DEFAULT_FLANGE_LOAD
 from ._face_contact import face_contact
 from ._faces import Faces, check_faces, face_limited_circle, face_protrusion
 from ._geometry import flange_effective_modulus
+from ._zone import zone_margin_fields
 
 
 class FaceZone(eqx.Module):
@@ -84,11 +85,6 @@ def face_design_zone(
         jnp.asarray(flange_load, dtype=float), 1.0 / a11, 1.0 / a22, flange_effective_modulus(bearing)
     )
     rho_lim = face_limited_circle(roller, faces)
-    fl = bearing.flange
-    relief = c.contact_height - half_width - fl.relief_height
-    height = fl.contact_height_limit - c.contact_height
-    limited = rho_lim - c.contact_radius
-    clear = clearance - min_clearance
     return FaceZone(
         contact_radius=c.contact_radius,
         corner_contact_radius=c.corner_contact_radius,
@@ -100,10 +96,8 @@ def face_design_zone(
         ellipse_half_width=half_width,
         curvature_sums=jnp.stack([a11, a22]),
         on_arc=c.on_arc,
-        relief_margin=relief,
-        height_margin=height,
-        limited_circle_margin=limited,
-        clearance_margin=clear,
         flange_height_margin=faces.flange_height - c.contact_height,
-        feasible=(relief > 0) & (height > 0) & (limited > 0) & (clear > 0),
+        **zone_margin_fields(
+            bearing.flange, c.contact_height, half_width, rho_lim, c.contact_radius, clearance, min_clearance
+        ),
     )

@@ -92,11 +92,6 @@ def design_zone(
         flange_effective_modulus(bearing),
     )
     rho_lim = limited_circle_radius(roller)
-    fl = bearing.flange
-    relief = geo.contact_height - half_width - fl.relief_height
-    height = fl.contact_height_limit - geo.contact_height
-    limited = rho_lim - geo.contact_radius
-    clear = clearance - min_clearance
     return DesignZone(
         contact_radius=geo.contact_radius,
         corner_contact_radius=corner.contact_radius,
@@ -107,6 +102,30 @@ def design_zone(
         seated_gap=-2 * geo.interference,
         ellipse_half_width=half_width,
         on_arc=geo.on_arc,
+        **zone_margin_fields(
+            bearing.flange,
+            geo.contact_height,
+            half_width,
+            rho_lim,
+            geo.contact_radius,
+            clearance,
+            min_clearance,
+        ),
+    )
+
+
+def zone_margin_fields(
+    flange, contact_height, half_width, rho_lim, contact_radius, clearance, min_clearance
+) -> dict:
+    """The four design-zone margins [m], positive when satisfied, and their conjunction
+    `feasible`: the contact ellipse above the relief (h_c - a - relief height), the contact
+    height below its limit, the contact radius inside the limited circle (rho_lim - rho) and the
+    actual axial clearance above `min_clearance`; the fields of `DesignZone` and `FaceZone`."""
+    relief = contact_height - half_width - flange.relief_height
+    height = flange.contact_height_limit - contact_height
+    limited = rho_lim - contact_radius
+    clear = clearance - min_clearance
+    return dict(
         relief_margin=relief,
         height_margin=height,
         limited_circle_margin=limited,
