@@ -9,7 +9,7 @@
   inside a solve) and `HostProgress` (the same from the calling process: cacheable programs);
 - statistics: `contact_events`, `summarise`, `film_statistics` (film over contact time,
   `FILM_KEYS`; a sample is contact above `CONTACT_THRESHOLD`); of settled running with 95 %
-  confidence intervals as a typed object, `SettledStatistics` (fields of `Estimate`s, groups
+  confidence intervals as a typed object, `SettledStatistics` (fields of `Estimate`s, groups of `Reductions`:
   `PerEvent`, `ContactRadius`, `ContactTimePV`, `CornerShare`; `SteadyResult.statistics()`,
   `settled_statistics`; its summary block `steady_statistics`), `revolution_statistics`, `confidence_intervals`,
   `batch_means`, `student_t_interval`, `Estimate`, `tail_mean` (the mean above the
@@ -117,6 +117,7 @@ from ._settled_statistics import (
     ContactTimePV,
     CornerShare,
     PerEvent,
+    Reductions,
     SettledStatistics,
     settled_statistics,
     steady_statistics,
@@ -221,6 +222,7 @@ __all__ = [
     "settled_statistics",
     "SettledStatistics",
     "PerEvent",
+    "Reductions",
     "ContactRadius",
     "ContactTimePV",
     "CornerShare",

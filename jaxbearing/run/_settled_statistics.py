@@ -10,6 +10,7 @@ written from the object (`as_dict`), the one place where the statistics get thei
 from __future__ import annotations
 
 import dataclasses
+import typing
 from typing import Any
 
 from ..geometry import kinematic_cage_speed, limited_circle_radius, rad_s_to_rpm
@@ -40,7 +41,13 @@ def _nested(group) -> dict:
 
 
 @dataclasses.dataclass(frozen=True)
-class PerEvent:
+class Reductions:
+    """A group of one quantity's statistics per cage revolution, each field an `Estimate`: nested
+    under the quantity's name in the summary block, "quantity.reduction" in `estimates`."""
+
+
+@dataclasses.dataclass(frozen=True)
+class PerEvent(Reductions):
     """One flange-contact quantity over the contact events of a cage revolution: the largest,
     the mean, the median and the 95th percentile of the events' values, each the expectation
     per revolution with its interval."""
@@ -62,7 +69,7 @@ class ContactRadius(PerEvent):
 
 
 @dataclasses.dataclass(frozen=True)
-class ContactTimePV:
+class ContactTimePV(Reductions):
     """Flange PV over contact time [Pa m/s] (every touching sample, equally spaced in time), per
     revolution: the mean, the 95th percentile and the tail mean above it (`tail_mean`)."""
 
@@ -72,7 +79,7 @@ class ContactTimePV:
 
 
 @dataclasses.dataclass(frozen=True)
-class RollerSkew:
+class RollerSkew(Reductions):
     """The roller skew angle's magnitude [rad] per revolution: mean and largest."""
 
     mean_abs: Estimate
@@ -80,7 +87,7 @@ class RollerSkew:
 
 
 @dataclasses.dataclass(frozen=True)
-class CornerShare:
+class CornerShare(Reductions):
     """The share of contact beyond the limited circle: of contact time and of contact events."""
 
     time: Estimate
@@ -88,7 +95,7 @@ class CornerShare:
 
 
 @dataclasses.dataclass(frozen=True)
-class MinimumFilm:
+class MinimumFilm(Reductions):
     """The minimum film thickness at the flange over contact time [m]."""
 
     min: Estimate
@@ -97,7 +104,7 @@ class MinimumFilm:
 
 
 @dataclasses.dataclass(frozen=True)
-class CentralFilm:
+class CentralFilm(Reductions):
     """The central film thickness at the flange over contact time [m]."""
 
     min: Estimate
@@ -105,40 +112,13 @@ class CentralFilm:
 
 
 @dataclasses.dataclass(frozen=True)
-class FilmParameter:
+class FilmParameter(Reductions):
     """The film parameter Lambda (film over composite roughness) over contact time."""
 
     mean: Estimate
     median: Estimate
     p05: Estimate
     min: Estimate
-
-
-#: the reductions written at the top level of the summary block, in its order
-_GROUPS = {
-    "flange_force_N": PerEvent,
-    "flange_pressure_Pa": PerEvent,
-    "flange_sliding_velocity_m_s": PerEvent,
-    "flange_roller_surface_speed_m_s": PerEvent,
-    "flange_pv_Pa_m_s": PerEvent,
-    "contact_height_m": PerEvent,
-    "contact_radius_m": ContactRadius,
-    "roller_skew_rad": RollerSkew,
-    "corner_contact_share": CornerShare,
-    "flange_pv_contact_time_Pa_m_s": ContactTimePV,
-    "flange_min_film_m": MinimumFilm,
-    "flange_central_film_m": CentralFilm,
-    "film_parameter": FilmParameter,
-}
-#: the single estimates of the summary block
-_SINGLES = (
-    "cage_speed_rpm",
-    "cage_slip",
-    "flange_contact_events_per_rev",
-    "lambda_below_one_share",
-    "top_edge_contact_share",
-    "flange_face_error_max_m",
-)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -187,7 +167,7 @@ class SettledStatistics:
         out: dict[str, Estimate] = {}
         for f in dataclasses.fields(self):
             v = getattr(self, f.name)
-            if f.name in _GROUPS:
+            if isinstance(v, Reductions):
                 out.update({f"{f.name}.{g.name}": getattr(v, g.name) for g in dataclasses.fields(v)})
             elif isinstance(v, Estimate):
                 out[f.name] = v
@@ -199,7 +179,7 @@ class SettledStatistics:
         out: dict = {}
         for f in dataclasses.fields(self):
             v = getattr(self, f.name)
-            if f.name in _GROUPS:
+            if isinstance(v, Reductions):
                 out[f.name] = _nested(v)
             elif isinstance(v, Estimate):
                 out[f.name] = v.as_dict()
@@ -208,6 +188,13 @@ class SettledStatistics:
             else:
                 out[f.name] = v
         return out
+
+
+#: the fields of `SettledStatistics` that are groups of reductions, and those that are single
+#: estimates (read from its annotations: the class is the one list of its statistics)
+_HINTS = typing.get_type_hints(SettledStatistics)
+_GROUPS = {n: t for n, t in _HINTS.items() if isinstance(t, type) and issubclass(t, Reductions)}
+_SINGLES = tuple(n for n, t in _HINTS.items() if t is Estimate)
 
 
 def settled_statistics(
