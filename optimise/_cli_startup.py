@@ -8,6 +8,14 @@ import sys
 
 from ._cli_output import EXIT_INFEASIBLE, _design_text, _engineering, _margin_text, _progress, _write_results
 
+#: why the start-up search found no design, by its status: the line it prints
+_INFEASIBLE = {
+    "no_feasible_design_in_bounds": "no feasible design exists within the bounds (every design-zone margin "
+    "cannot be satisfied at once); widen the bounds or relax --min-clearance-mm",
+    "no_feasible_iterate": "no iterate reached the feasible design zone (it exists within the bounds);"
+    " try more --iterations or --starts",
+}
+
 
 def run_startup(args, problem, options, out, meta) -> int:
     """The start-up search (`_search.search`) with progress, result.json and the plot."""
@@ -43,20 +51,8 @@ def run_startup(args, problem, options, out, meta) -> int:
 
     print(f"start design: {_design_text(res.start_design)}")
     print(f"  margins: {_margin_text(res.start_margins)}")
-    if res.status == "no_feasible_design_in_bounds":
-        print(
-            "optimise: no feasible design exists within the bounds (every design-zone margin "
-            "cannot be satisfied at once); widen the bounds or relax --min-clearance-mm",
-            file=sys.stderr,
-        )
-        print(f"wrote {out / 'result.json'} and {plot_path}")
-        return EXIT_INFEASIBLE
-    if res.status == "no_feasible_iterate":
-        print(
-            "optimise: no iterate reached the feasible design zone (it exists within the bounds);"
-            " try more --iterations or --starts",
-            file=sys.stderr,
-        )
+    if res.status in _INFEASIBLE:
+        print(f"optimise: {_INFEASIBLE[res.status]}", file=sys.stderr)
         print(f"wrote {out / 'result.json'} and {plot_path}")
         return EXIT_INFEASIBLE
     print(
