@@ -41,7 +41,7 @@ import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array, Float
 
-from jaxbearing import Bearing, OperatingPoint, Perturbation, UserInputError, rpm_to_rad_s
+from jaxbearing import Bearing, OperatingPoint, Perturbation, UserInputError, rad_s_to_rpm, rpm_to_rad_s
 from jaxbearing.design import design_metrics, seated_perturbation
 from jaxbearing.flange import (
     DEFAULT_FLANGE_LOAD,
@@ -257,7 +257,7 @@ class DesignProblem(eqx.Module):
 
     def point_label(self, k: int) -> str:
         """Operating point k in words: "10000 rpm, 1000 N", with its corner of the constants."""
-        rpm = float(np.asarray(self.operating.inner_speed)[k]) * 60 / (2 * math.pi)
+        rpm = float(rad_s_to_rpm(np.asarray(self.operating.inner_speed)[k]))
         text = f"{rpm:.0f} rpm, {float(np.asarray(self.operating.radial_load)[k]):.0f} N"
         return text if self.point_constants is None else f"{text}, {self.point_constants[k]}"
 
