@@ -16,6 +16,7 @@ import jaxbearing  # noqa: F401  (enables 64-bit floats)
 from jaxbearing.design import Statistic
 from jaxbearing.flange import MARGIN_NAMES
 
+from ._gradient_free import GradientFreeResult, gradient_free_search
 from ._grid import steady_grid
 from ._plot import plot_search
 from ._problem import (
@@ -41,6 +42,7 @@ __all__ = [
     "Estimator",
     "Statistic",
     "DesignProblem",
+    "GradientFreeResult",
     "NearOptimal",
     "SearchResult",
     "SteadySearchResult",
@@ -48,6 +50,7 @@ __all__ = [
     "any_feasible",
     "bounds_from_engineering",
     "feasibility_map",
+    "gradient_free_search",
     "grid_search",
     "load_optimise_toml",
     "make_problem",
