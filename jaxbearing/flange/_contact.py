@@ -196,7 +196,6 @@ def roller_flange_contact(
     Top edge: `top_edge` = 1 where the exact radial height of C above the raceway,
     g(|C - c_r|_YZ - R_r), exceeds the flange height H_rf: the contact is then computed on the
     plane continued beyond a flange that is not there (reported, not corrected).
-
     Forces: on the roller F = -Q n + F_t, moment (C - p) x F; on the ring -F, moment (C - c_r) x (-F).
 
     Arguments: `raceway_radius` R_r of the ring; `side` s = -1 or +1 (flange at -X or +X);
