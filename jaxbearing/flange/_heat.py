@@ -23,7 +23,7 @@ Between them f lies within 2.3 % of a quadrature of the exact moving-source solu
 
 The contact: the Hertz ellipse (a, b) as the circle of equal area, radius a_e = sqrt(a b), with
 the uniform flux q = P_f / (pi a_e^2) (a semi-ellipsoidal flux mu p(r) |u| of the same power has
-a maximum 16-18 % higher over all Pe, by the same quadrature). The source moves over the roller
+a maximum 16-18 % higher at Pe = 0-100, by the same quadrature). The source moves over the roller
 end at V_1 = |u_e + u/2| and over the rib at V_2 = |u_e - u/2| (the surfaces' velocities
 relative to the contact point, from the entrainment velocity u_e and the sliding velocity u),
 each body with its own Pe_i = V_i a_e / (2 kappa_i). Blok's postulate (1937) partitions the heat
