@@ -19,7 +19,8 @@ with the two exact limits it joins (Carslaw & Jaeger, Conduction of Heat in Soli
 a fast source, the one-dimensional surface temperature 2 q sqrt(kappa t / pi) / k after the
 time t = 2 a / V the centre line spends under it (Jaeger 1942), i.e. f -> 2 / sqrt(pi Pe).
 Between them f lies within 2.3 % of a quadrature of the exact moving-source solution
-(tests/test_flange_heat.py).
+(tests/test_flange_heat.py); the form and its constant are verified against these, the paper's
+equation number is not quoted.
 
 The contact: the Hertz ellipse (a, b) as the circle of equal area, radius a_e = sqrt(a b), with
 the uniform flux q = P_f / (pi a_e^2) (a semi-ellipsoidal flux mu p(r) |u| of the same power has
