@@ -73,10 +73,21 @@ def test_both_ends_write_summary_histories_plots(both_run, capsys):
         assert block["flange_min_film_m"]["min"] > 0 and block["film_parameter"]["p05"] > 0
         for key in ("lambda_below_one_share", "top_edge_contact_share"):
             assert 0.0 <= block[key] <= 1.0
+        # friction power per flange and in total, flash temperature at the rib (docs/model.md 5.5)
+        power = block["flange_friction_power_W"]
+        assert set(power) == {"inner_neg_x", "inner_pos_x", "outer_neg_x", "outer_pos_x", "total"}
+        np.testing.assert_allclose(sum(v for k, v in power.items() if k != "total"), power["total"])
+        assert power["total"] > 0 and block["flange_flash_temperature_K"]["max"] > 0
         h = np.load(out / f"histories_{end}.npz")
         assert h["flange_force"].shape[1:] == (26, 4)
         for key in ("flange_min_film", "flange_central_film", "flange_film_parameter", "flange_top_edge"):
             assert h[key].shape == h["flange_force"].shape
+        mu_q_u = h["flange_friction_coefficient"] * h["flange_force"] * h["flange_sliding_speed"]
+        np.testing.assert_allclose(h["flange_friction_power"], mu_q_u, rtol=1e-12, atol=1e-300)
+        touching = h["flange_force"] > 1.0
+        assert np.all(h["flange_flash_temperature"][touching] > 0)
+        assert np.all(h["flange_flash_temperature"] >= 0)
+    assert printed.count("flash temperature") == 1 and printed.count("friction power (mean)") == 2
     for png in ("flange_boxplots.png", "contact_positions.png", "cage_speed.png"):
         assert_png_drawn(out / png)
     # arc ends press less on the flange than corners (the paper's headline result)

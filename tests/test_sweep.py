@@ -218,6 +218,14 @@ def test_reference_dataset(reference):
 
     assert all("units" in ds[v].attrs for v in [*ds.data_vars, "speed_rpm", "end"])
     assert ds["flange_pv_Pa_m_s_max"].attrs["units"] == "Pa m/s" and ds["cage_slip"].attrs["units"] == "1"
+    # friction power per flange and in total, flash temperature at the rib (docs/model.md 5.5)
+    assert ds["flange_friction_power_W_total"].attrs["units"] == "W"
+    assert ds["flange_flash_temperature_K_max"].attrs["units"] == "K"
+    parts = sum(
+        ds[f"flange_friction_power_W_{f}"]
+        for f in ("inner_neg_x", "inner_pos_x", "outer_neg_x", "outer_pos_x")
+    )
+    np.testing.assert_allclose(parts.values, ds["flange_friction_power_W_total"].values, rtol=1e-12)
     assert ds.attrs["jaxbearing_version"] == jaxbearing.__version__
     assert json.loads(ds.attrs["seeds"]) == [0] and isinstance(json.loads(ds.attrs["command"]), list)
     assert json.loads(ds.attrs["config"])["roller"]["end_radius_mm"] == 80.0

@@ -14,6 +14,7 @@ _TABLE_ROWS = (
     ("flange_pressure_Pa", "peak pressure", "GPa", 1e-9),
     ("flange_sliding_velocity_m_s", "sliding velocity", "m/s", 1.0),
     ("flange_pv_Pa_m_s", "PV", "GPa m/s", 1e-9),
+    ("flange_flash_temperature_K", "flash temperature", "K", 1.0),
     ("contact_height_m", "contact height", "mm", 1e3),
     ("contact_radius_m", "contact radius", "mm", 1e3),
 )
@@ -222,17 +223,20 @@ def format_table(summaries: dict) -> str:
 
 
 def _film_line(end: str, s: dict) -> str:
-    """One line of film statistics over contact time (`jaxbearing.run.film_statistics`)."""
+    """One line of film statistics over contact time (`jaxbearing.run.film_statistics`) and the
+    time-mean friction power of all flanges (`jaxbearing.run.friction_power_statistics`)."""
 
     def num(v, k=1.0, fmt=".3g"):
         return "-" if v is None or not math.isfinite(v) else format(v * k, fmt)
 
     film, lam = s.get("flange_min_film_m", {}), s.get("film_parameter", {})
+    power = s.get("flange_friction_power_W", {})
     return (
         f"[{end}] flange film: h_min min {num(film.get('min'), 1e6)} um; Lambda median "
         f"{num(lam.get('median'))}, p05 {num(lam.get('p05'))}; Lambda < 1 "
         f"{num(s.get('lambda_below_one_share'), 100, '.1f')} % of contact time; top-edge contact "
-        f"{num(s.get('top_edge_contact_share'), 100, '.1f')} %"
+        f"{num(s.get('top_edge_contact_share'), 100, '.1f')} %; friction power (mean) "
+        f"{num(power.get('total'))} W"
     )
 
 

@@ -23,6 +23,7 @@ _ROWS = (
     ("flange_sliding_velocity_m_s", "sliding velocity", "m/s", 1.0),
     ("flange_roller_surface_speed_m_s", "surface speed (paper)", "m/s", 1.0),
     ("flange_pv_Pa_m_s", "PV", "GPa m/s", 1e-9),
+    ("flange_flash_temperature_K", "flash temperature rise", "K", 1.0),
     ("contact_height_m", "contact height", "mm", 1e3),
     ("contact_radius_m", "contact radius", "mm", 1e3),
 )
@@ -179,6 +180,7 @@ def _statistics_table(summaries: dict) -> str:
         ("film parameter Lambda, median", "", lambda s: s.get("film_parameter", {}).get("median"), 1.0),
         ("film parameter Lambda, p05", "", lambda s: s.get("film_parameter", {}).get("p05"), 1.0),
         ("Lambda < 1 share, time", "%", lambda s: s.get("lambda_below_one_share"), 100.0),
+        *_friction_power_rows(),
         ("top-edge contact share, time", "%", lambda s: s.get("top_edge_contact_share"), 100.0),
         ("cage speed", "rpm", lambda s: s.get("cage_speed_rpm"), 1.0),
         ("cage slip", "%", lambda s: s.get("cage_slip"), 100.0),
@@ -219,6 +221,24 @@ def _statistics_table(summaries: dict) -> str:
                 "(fix a settling time with --settle MS)"
             )
     return "\n".join(lines)
+
+
+#: the friction-power rows of the settled table: (label, summary key of the flange or the total)
+_FRICTION_POWER_ROWS = (
+    ("friction power, total", "total"),
+    ("friction power, inner -X", "inner_neg_x"),
+    ("friction power, inner +X", "inner_pos_x"),
+    ("friction power, outer -X", "outer_neg_x"),
+    ("friction power, outer +X", "outer_pos_x"),
+)
+
+
+def _friction_power_rows() -> tuple:
+    """(label, unit, getter, scale) of the time-mean friction power per flange and in total [W]."""
+    return tuple(
+        (label, "W", lambda s, n=name: s.get("flange_friction_power_W", {}).get(n), 1.0)
+        for label, name in _FRICTION_POWER_ROWS
+    )
 
 
 def exit_code(summaries: dict) -> int:

@@ -7,6 +7,9 @@
   nothing, `without_absent_flanges`), `FlangeContact`;
 - its lubrication: `contact_point_velocity`, `flange_film` (entrainment, Hamrock-Dowson film,
   Lambda), `FlangeFilm`, `flange_friction_coefficient` (dry or mixed, `FLANGE_LUBRICATION_MODES`);
+- its heat (docs/model.md 5.5): `friction_power`, `flange_friction_power` (per flange),
+  `flange_flash_temperature` (Tian & Kennedy's moving source, Blok's partition),
+  `blok_flash_temperature`, `flash_temperature_factor`, `flange_heat_source_speeds`;
 - the static design zone of an aligned roller: `design_zone`, `design_zone_grid`, `DesignZone`,
   `zone_margins`, `MARGIN_NAMES`;
 - general end and rib faces (a toroidal end of offset e, a rib meridian arc of curvature
@@ -35,6 +38,14 @@ from ._face_contact import FaceContact, face_contact, face_contact_stiffness
 from ._face_zone import FaceZone, face_design_zone
 from ._faces import Faces, check_faces, face_limited_circle, face_protrusion, faces_of, rib_distance
 from ._geometry import FlangeGeometry, flange_effective_modulus, flange_geometry
+from ._heat import (
+    blok_flash_temperature,
+    flange_flash_temperature,
+    flange_friction_power,
+    flange_heat_source_speeds,
+    flash_temperature_factor,
+    friction_power,
+)
 from ._lubrication import (
     FLANGE_LUBRICATION_MODES,
     FlangeFilm,
@@ -45,6 +56,12 @@ from ._lubrication import (
 from ._zone import MARGIN_NAMES, DesignZone, design_zone, design_zone_grid, zone_margins
 
 __all__ = [
+    "friction_power",
+    "flash_temperature_factor",
+    "flange_heat_source_speeds",
+    "flange_friction_power",
+    "flange_flash_temperature",
+    "blok_flash_temperature",
     "DEFAULT_FLANGE_LOAD",
     "FLANGE_LUBRICATION_MODES",
     "FLANGE_ORDER",

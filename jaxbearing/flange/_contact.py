@@ -96,6 +96,8 @@ class FlangeContact(eqx.Module):
     moment_on_ring: Float[Array, "*batch 3"]  # (C - c_r) x (-F)
     ellipse_semi_axes: Float[Array, "*batch 2"]  # (along t / the end meridian, along the parallel)
     entrainment_speed: Float[Array, "*batch"]  # |u_e|, mean surface speed relative to C
+    # u_e, tangential: the surfaces move at u_e +/- u/2 relative to C (`flange_heat_source_speeds`)
+    entrainment_velocity: Float[Array, "*batch 3"]
     min_film: Float[Array, "*batch"]  # h_min, Hamrock-Dowson minimum film [m]
     central_film: Float[Array, "*batch"]  # h_c, Hamrock-Dowson central film [m]
     film_parameter: Float[Array, "*batch"]  # Lambda = h_min / sigma
@@ -194,7 +196,6 @@ def roller_flange_contact(
     Top edge: `top_edge` = 1 where the exact radial height of C above the raceway,
     g(|C - c_r|_YZ - R_r), exceeds the flange height H_rf: the contact is then computed on the
     plane continued beyond a flange that is not there (reported, not corrected).
-
     Forces: on the roller F = -Q n + F_t, moment (C - p) x F; on the ring -F, moment (C - c_r) x (-F).
 
     Arguments: `raceway_radius` R_r of the ring; `side` s = -1 or +1 (flange at -X or +X);
@@ -240,6 +241,7 @@ def roller_flange_contact(
         moment_on_ring=jnp.cross(c - c_r, -force),
         ellipse_semi_axes=semi,
         entrainment_speed=film.entrainment_speed,
+        entrainment_velocity=film.entrainment_velocity,
         min_film=film.min_film,
         central_film=film.central_film,
         film_parameter=film.film_parameter,

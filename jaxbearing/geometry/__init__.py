@@ -1,6 +1,7 @@
 """Bearing geometry: parameter pytrees, derived mass properties, the roller end body.
 
-Owns: `Bearing` and its parts (`Roller`, `Flange`, `Cage`, `Material`, `Lubricant`), the
+Owns: `Bearing` and its parts (`Roller`, `Flange`, `Cage`, `Material` with the bearing-steel
+thermal defaults `BEARING_STEEL_CONDUCTIVITY`, `BEARING_STEEL_SPECIFIC_HEAT`, `Lubricant`), the
 flange arrangement of the bearing types (`FLANGES`, `BEARING_TYPES`, `flange_presence`), the
 `OperatingPoint`, the reference bearing (docs/model.md 1), unit conversions, the mass properties
 derived from geometry, the inner ring's tilted axis (`ring_axis`), and the shape of the roller end (corner torus and spherical cap, docs/model.md
@@ -22,6 +23,8 @@ from ._arrangement import (
 )
 from ._inertia import cage_mass_properties, inner_ring_inertia, roller_mass_properties
 from ._params import (
+    BEARING_STEEL_CONDUCTIVITY,
+    BEARING_STEEL_SPECIFIC_HEAT,
     Bearing,
     Cage,
     Flange,
@@ -48,6 +51,8 @@ from ._roller_end import (
 )
 
 __all__ = [
+    "BEARING_STEEL_CONDUCTIVITY",
+    "BEARING_STEEL_SPECIFIC_HEAT",
     "BEARING_TYPES",
     "FLANGES",
     "LIMITED_CIRCLE_BAND",

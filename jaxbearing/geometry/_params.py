@@ -93,12 +93,30 @@ class Cage(eqx.Module):
     land_width: Scalar = _field()  # b_l, per land (two lands)
 
 
+#: thermal conductivity [W/(m K)] and specific heat [J/(kg K)] of through-hardened bearing steel,
+#: SAE-AISI 52100 (100Cr6): MakeItFrom.com, "SAE-AISI 52100 (G52986) Chromium Steel" (47 W/m-K,
+#: 470 J/kg-K); the defaults of `Material` (docs/model.md 5.5)
+BEARING_STEEL_CONDUCTIVITY = 47.0
+BEARING_STEEL_SPECIFIC_HEAT = 470.0
+
+
 class Material(eqx.Module):
-    """Isotropic linear-elastic material."""
+    """Isotropic linear-elastic material with the thermal constants of the flash temperature.
+
+    `thermal_conductivity` k and `specific_heat` c default to bearing steel (AISI 52100,
+    `BEARING_STEEL_CONDUCTIVITY`); the thermal diffusivity is derived, kappa = k / (rho c).
+    """
 
     elastic_modulus: Scalar = _field()  # E [Pa]
     poisson_ratio: Scalar = _field()  # nu
     density: Scalar = _field()  # rho [kg/m^3]
+    thermal_conductivity: Scalar = eqx.field(converter=_f, default=BEARING_STEEL_CONDUCTIVITY)  # k [W/(m K)]
+    specific_heat: Scalar = eqx.field(converter=_f, default=BEARING_STEEL_SPECIFIC_HEAT)  # c [J/(kg K)]
+
+    @property
+    def thermal_diffusivity(self) -> Array:
+        """kappa = k / (rho c) [m^2/s]."""
+        return self.thermal_conductivity / (self.density * self.specific_heat)
 
 
 class Lubricant(eqx.Module):

@@ -8,7 +8,8 @@ its meaning, symbol and valid range. The schema and the ranges are `jaxbearing.i
     [roller]             diameter_mm, length_mm, ..., end_radius_mm (inf = flat end)
     [flange]             height_mm, relief_height_mm, contact_height_limit_mm, ...
     [cage]               inner_diameter_mm, outer_diameter_mm, width_mm, ...
-    [materials.ring]     elastic_modulus_GPa, poisson_ratio, density_kg_m3
+    [materials.ring]     elastic_modulus_GPa, poisson_ratio, density_kg_m3, thermal_conductivity_W_mK,
+                         specific_heat_J_kgK
     [materials.roller]   (same)
     [materials.cage]     (same)
     [lubricant]          viscosity_Pa_s, ..., traction_a, traction_b_s_m, traction_c_s_m, traction_d

@@ -44,6 +44,7 @@ from collections.abc import Mapping
 from typing import Any, NamedTuple
 
 from .._errors import ConfigError
+from ..geometry import BEARING_STEEL_CONDUCTIVITY, BEARING_STEEL_SPECIFIC_HEAT
 from ._config import Config
 from ._keys import format_derived, format_value
 from ._schema import KEY_BY_PATH, REFERENCE_VALUES
@@ -393,6 +394,9 @@ def _material_lubricant_estimates() -> dict:
         out[f"{s}.elastic_modulus_GPa"] = _est(208.0, 5.0, f"{steel} (201-210 GPa in handbooks)")
         out[f"{s}.poisson_ratio"] = _est(0.3, 0.01, steel)
         out[f"{s}.density_kg_m3"] = _est(_STEEL_DENSITY, 30.0, steel)
+        # the flash temperature's constants (docs/model.md 5.5): MakeItFrom.com's 52100 values
+        out[f"{s}.thermal_conductivity_W_mK"] = _est(BEARING_STEEL_CONDUCTIVITY, 4.7, f"{steel}; +/- 10 %")
+        out[f"{s}.specific_heat_J_kgK"] = _est(BEARING_STEEL_SPECIFIC_HEAT, 23.5, f"{steel}; +/- 5 %")
     cage = " (steel; a catalogue cage may be brass, E ~ 100 GPa, rho ~ 8500 kg/m^3, or polyamide)"
     out["materials.cage.elastic_modulus_GPa"] = _representative(
         "materials.cage.elastic_modulus_GPa", 100.0, cage

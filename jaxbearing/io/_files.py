@@ -254,6 +254,8 @@ _UNIT_SUFFIXES = (
     ("_deg", "deg"),
     ("_mrad", "mrad"),
     ("_kg", "kg"),
+    ("_W", "W"),
+    ("_K", "K"),
 )
 
 

@@ -46,6 +46,8 @@ Schema (ranges; "(" open, "[" closed; symbols as in docs/model.md and the source
 | materials.*.elastic_modulus_GPa | E | (0, 1500] |
 | materials.*.poisson_ratio | nu | (-1, 0.5) |
 | materials.*.density_kg_m3 | rho | (0, 25000] |
+| materials.*.thermal_conductivity_W_mK | k | (0, 500] |
+| materials.*.specific_heat_J_kgK | c | (0, 5000] |
 | lubricant.viscosity_Pa_s | eta_0 | (0, 100] |
 | lubricant.pressure_viscosity_1_Pa | alpha_p | [0, 1e-6] |
 | lubricant.temperature_viscosity_1_C | beta_T | [0, 1] |
@@ -208,7 +210,11 @@ _H, _HREL = "flange.height_mm", "flange.relief_height_mm"
 _CP, _CG = "cage.pocket_clearance_mm", "cage.guiding_clearance_mm"
 
 
-def _material(part: str, attr: str, e: float, nu: float, rho: float, what: str) -> list[Key]:
+def _material(
+    part: str, attr: str, e: float, nu: float, rho: float, what: str, k: float, c: float
+) -> list[Key]:
+    """The keys of one material: elastic constants, density, and the thermal conductivity and
+    specific heat of the flash temperature (docs/model.md 5.5)."""
     s = f"materials.{part}"
     return [
         make_key(
@@ -243,6 +249,28 @@ def _material(part: str, attr: str, e: float, nu: float, rho: float, what: str) 
             constant_bound(0, False),
             constant_bound(25000, True),
             attr=f"{attr}.density",
+        ),
+        make_key(
+            f"{s}.thermal_conductivity_W_mK",
+            float,
+            k,
+            "W/(m K)",
+            "k",
+            f"thermal conductivity of the {what}",
+            constant_bound(0, False),
+            constant_bound(500, True),
+            attr=f"{attr}.thermal_conductivity",
+        ),
+        make_key(
+            f"{s}.specific_heat_J_kgK",
+            float,
+            c,
+            "J/(kg K)",
+            "c",
+            f"specific heat of the {what}",
+            constant_bound(0, False),
+            constant_bound(5000, True),
+            attr=f"{attr}.specific_heat",
         ),
     ]
 
@@ -581,9 +609,10 @@ KEYS: tuple[Key, ...] = (
         attr="cage.land_width",
     ),
     # [materials.*]
-    *_material("ring", "ring_material", 203.0, 0.28, 7830.0, "rings (AISI M50)"),
-    *_material("roller", "roller_material", 203.0, 0.28, 7830.0, "rollers (AISI M50)"),
-    *_material("cage", "cage_material", 205.0, 0.29, 7850.0, "cage (AISI 4340)"),
+    # thermal constants: MakeItFrom.com, SAE-AISI M50 (35 W/m-K, 470 J/kg-K) and 4340 (44, 470)
+    *_material("ring", "ring_material", 203.0, 0.28, 7830.0, "rings (AISI M50)", 35.0, 470.0),
+    *_material("roller", "roller_material", 203.0, 0.28, 7830.0, "rollers (AISI M50)", 35.0, 470.0),
+    *_material("cage", "cage_material", 205.0, 0.29, 7850.0, "cage (AISI 4340)", 44.0, 470.0),
     # [lubricant]
     make_key(
         "lubricant.viscosity_Pa_s",

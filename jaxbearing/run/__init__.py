@@ -8,9 +8,10 @@
   `RESULT_NAMES` (the outcome code of a solve), `SolveProgress` (the text progress meter
   inside a solve) and `HostProgress` (the same from the calling process: cacheable programs);
 - statistics: `contact_events`, `summarise`, `film_statistics` (film over contact time,
-  `FILM_KEYS`; a sample is contact above `CONTACT_THRESHOLD`); of settled running with 95 %
+  `FILM_KEYS`; a sample is contact above `CONTACT_THRESHOLD`), `friction_power_statistics`
+  (time-mean friction power per flange and in total, `FRICTION_POWER_KEYS`); of settled running with 95 %
   confidence intervals as a typed object, `SettledStatistics` (fields of `Estimate`s, groups of `Reductions`:
-  `PerEvent`, `ContactRadius`, `ContactTimePV`, `CornerShare`; `SteadyResult.statistics()`,
+  `PerEvent`, `ContactRadius`, `ContactTimePV`, `CornerShare`, `FrictionPower`; `SteadyResult.statistics()`,
   `settled_statistics`; its summary block `steady_statistics`), `revolution_statistics`, `confidence_intervals`,
   `batch_means`, `student_t_interval`, `Estimate`, `tail_mean` (the mean above the
   `TAIL_LEVEL` quantile); how often the contact reached the corner,
@@ -116,6 +117,7 @@ from ._settled_statistics import (
     ContactRadius,
     ContactTimePV,
     CornerShare,
+    FrictionPower,
     PerEvent,
     Reductions,
     SettledStatistics,
@@ -155,7 +157,14 @@ from ._step_control import (
     RacewayNormalNorm,
     raceway_normal_norm,
 )
-from ._summary import CONTACT_THRESHOLD, FILM_KEYS, contact_events, film_statistics
+from ._summary import (
+    CONTACT_THRESHOLD,
+    FILM_KEYS,
+    FRICTION_POWER_KEYS,
+    contact_events,
+    film_statistics,
+    friction_power_statistics,
+)
 from ._tail_fit import MIN_TAIL_REVOLUTIONS, TailFit
 
 __all__ = [
@@ -168,6 +177,7 @@ __all__ = [
     "STARTS",
     "SkidStart",
     "FILM_KEYS",
+    "FRICTION_POWER_KEYS",
     "RESULT_NAMES",
     "CACHE_ENV",
     "DEFAULT_ERROR_NORM",
@@ -200,6 +210,7 @@ __all__ = [
     "confidence_intervals",
     "contact_events",
     "film_statistics",
+    "friction_power_statistics",
     "flange_functionals",
     "initial_state",
     "skid_start",
@@ -226,6 +237,7 @@ __all__ = [
     "ContactRadius",
     "ContactTimePV",
     "CornerShare",
+    "FrictionPower",
     "CornerCount",
     "PredictionBound",
     "student_t_interval",

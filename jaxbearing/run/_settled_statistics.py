@@ -122,9 +122,24 @@ class FilmParameter(Reductions):
 
 
 @dataclasses.dataclass(frozen=True)
+class FrictionPower(Reductions):
+    """The time-mean friction power mu Q |u| [W] over each cage revolution, of each flange
+    (summed over the rollers; inner -X, inner +X, outer -X, outer +X) and in total
+    (docs/model.md 5.5). The field names are `_summary.FRICTION_POWER_NAMES`."""
+
+    inner_neg_x: Estimate
+    inner_pos_x: Estimate
+    outer_neg_x: Estimate
+    outer_pos_x: Estimate
+    total: Estimate
+
+
+@dataclasses.dataclass(frozen=True)
 class SettledStatistics:
     """Every statistic of a settled run's window (module docstring). Units in the field names;
-    `cage_slip` = (kinematic - measured)/kinematic cage speed; `ci_method`: how the intervals
+    `cage_slip` = (kinematic - measured)/kinematic cage speed; `flange_flash_temperature_K`: the
+    largest flash temperature rise at the rib of each contact event, `flange_friction_power_W`:
+    the time-mean friction power (docs/model.md 5.5); `ci_method`: how the intervals
     were formed (batch means of one seed, or the ensemble of seeds); `corner_risk`: the
     corner-contact risk per revolution (None without a measured revolution)."""
 
@@ -135,6 +150,8 @@ class SettledStatistics:
     flange_sliding_velocity_m_s: PerEvent
     flange_roller_surface_speed_m_s: PerEvent
     flange_pv_Pa_m_s: PerEvent
+    flange_flash_temperature_K: PerEvent
+    flange_friction_power_W: FrictionPower
     contact_height_m: PerEvent
     contact_radius_m: ContactRadius
     roller_skew_rad: RollerSkew

@@ -47,6 +47,7 @@ from ..dynamics import (
     state_scales,
     tangential_unit,
 )
+from ..flange import flange_flash_temperature, friction_power
 from ..geometry import Bearing, OperatingPoint, kinematic_cage_speed
 from ..io import SIMULATE_NUM_SAVES, check_solve_inputs
 from ._compile_cache import checks_without_host_callbacks, compiled_program
@@ -119,8 +120,9 @@ def _histories(ts, saved, args: SolveArgs) -> dict:
 
 
 def _save(t, y_scaled, args: SolveArgs):
-    """The sampled outputs at time t of the scaled state `y_scaled` (flange contacts, cage,
-    inner ring, roller loads, axial positions and skew)."""
+    """The sampled outputs at time t of the scaled state `y_scaled` (flange contacts with their
+    friction power and flash temperature, docs/model.md 5.5; cage, inner ring, roller loads,
+    axial positions and skew)."""
     y = args.scaling.unscale(t, y_scaled)
     loads = contact_loads(y, args.params)
     fl = loads.flange
@@ -143,6 +145,8 @@ def _save(t, y_scaled, args: SolveArgs):
         flange_top_edge=fl.top_edge,
         flange_face_error=fl.face_error,
         flange_friction_coefficient=fl.friction_coefficient,
+        flange_friction_power=friction_power(fl),
+        flange_flash_temperature=flange_flash_temperature(args.params.bearing, fl),
         cage_speed=y.cage.speed,
         cage_centre=y.cage.centre,
         inner_ring_centre=y.inner_ring.centre,

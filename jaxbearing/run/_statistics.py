@@ -47,7 +47,15 @@ from ._corner_risk import (
     corner_risk_of_revolutions,
     revolution_maxima,
 )
-from ._summary import _EVENT_QUANTITIES, CONTACT_THRESHOLD, FILM_KEYS, contact_events, film_statistics
+from ._summary import (
+    _EVENT_QUANTITIES,
+    CONTACT_THRESHOLD,
+    FILM_KEYS,
+    FRICTION_POWER_KEYS,
+    contact_events,
+    film_statistics,
+    friction_power_statistics,
+)
 
 CONFIDENCE = 0.95
 
@@ -180,7 +188,7 @@ def tail_mean(values, level: float = TAIL_LEVEL) -> float:
 def revolution_statistic_keys() -> tuple[str, ...]:
     """The keys of `revolution_statistics`, in its order ("group.reduction" or "name")."""
     events = tuple(f"{key}.{red}" for key in _EVENT_QUANTITIES for red in EVENT_REDUCTIONS)
-    return events + _REVOLUTION_SCALARS + tuple(FILM_KEYS)
+    return events + _REVOLUTION_SCALARS + tuple(FILM_KEYS) + FRICTION_POWER_KEYS
 
 
 def revolution_statistics(
@@ -201,7 +209,7 @@ def revolution_statistics(
                 if v.size:
                     vals[i] = fn(v)
             out[f"{key}.{red}"] = vals
-    for name in (*_REVOLUTION_SCALARS, *FILM_KEYS):
+    for name in (*_REVOLUTION_SCALARS, *FILM_KEYS, *FRICTION_POWER_KEYS):
         out[name] = np.full(nrev, np.nan)
     kin_rpm = float(rad_s_to_rpm(kinematic_speed))
     for i in range(nrev):
@@ -227,7 +235,7 @@ def revolution_statistics(
             out["contact_radius_m.p99"][i] = np.percentile(rho, 99.0)
             # the largest contact radius of any touching sample: the corner is reached iff > rho_lim
             out["contact_radius_m.max_in_contact"][i] = np.max(rho)
-        for key, value in film_statistics(w, threshold).items():
+        for key, value in (*film_statistics(w, threshold).items(), *friction_power_statistics(w).items()):
             out[key][i] = value
         sel = rev_of_event == i
         out["flange_contact_events_per_rev"][i] = np.sum(sel)

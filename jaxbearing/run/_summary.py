@@ -13,6 +13,10 @@ with normal force above `threshold`: the minimum film h_min (min, p05, median), 
 of contact time with the contact point above the flange height: computed on a flange that is
 not there) and the largest tangent-plane error at a contact, `flange_face_error_max_m`
 (docs/model.md 5.2). Histories without these keys (older runs) give None.
+
+Friction power (`friction_power_statistics`) is a time-mean over every sample, per flange and in
+total; the flash temperature rise at the rib is an event quantity, each event's largest
+(docs/model.md 5.5).
 """
 
 from __future__ import annotations
@@ -35,12 +39,16 @@ _EVENT_QUANTITIES = {
     "flange_pv_Pa_m_s": ("flange_pv", "max"),
     "contact_height_m": ("contact_height", "at_peak"),
     "contact_radius_m": ("contact_radius", "at_peak"),
+    # the largest flash temperature rise at the rib during the event (docs/model.md 5.5)
+    "flange_flash_temperature_K": ("flange_flash_temperature", "max"),
 }
 
 
 def contact_events(histories: dict, threshold: float = CONTACT_THRESHOLD) -> dict[str, np.ndarray]:
-    """Per-event values of every quantity in `_EVENT_QUANTITIES` plus `on_arc`, `roller`, `flange`."""
+    """Per-event values of every quantity in `_EVENT_QUANTITIES` plus `on_arc`, `roller`, `flange`
+    (NaN for a quantity the histories lack: older runs)."""
     q = np.asarray(histories["flange_force"])  # (T, Z, 4)
+    nan = np.full(q.shape, np.nan)
     t_n, z, f = q.shape
     out: dict[str, list] = {k: [] for k in _EVENT_QUANTITIES}
     out.update(on_arc=[], roller=[], flange=[], time=[])
@@ -58,7 +66,7 @@ def contact_events(histories: dict, threshold: float = CONTACT_THRESHOLD) -> dic
                 seg = slice(s, e)
                 i_peak = s + int(np.argmax(q[seg, j, k]))
                 for key, (hk, how) in _EVENT_QUANTITIES.items():
-                    h = np.asarray(histories[hk])[:, j, k]
+                    h = np.asarray(histories.get(hk, nan))[:, j, k]
                     out[key].append(h[seg].max() if how == "max" else h[i_peak])
                 out["on_arc"].append(float(np.asarray(histories["on_arc"])[i_peak, j, k] > 0.5))
                 out["roller"].append(j)
@@ -114,11 +122,32 @@ def film_statistics(histories: dict, threshold: float = CONTACT_THRESHOLD) -> di
     return out
 
 
+#: the flanges' names in the friction-power statistics, in `flange.FLANGE_ORDER` (inner -X,
+#: inner +X, outer -X, outer +X), and their total
+FRICTION_POWER_NAMES = ("inner_neg_x", "inner_pos_x", "outer_neg_x", "outer_pos_x", "total")
+#: every key of `friction_power_statistics`
+FRICTION_POWER_KEYS = tuple(f"flange_friction_power_W.{n}" for n in FRICTION_POWER_NAMES)
+
+
+def friction_power_statistics(histories: dict) -> dict[str, float]:
+    """The time-mean friction power [W] over the samples of `histories` (equally spaced in
+    time), of each flange (summed over the rollers, `flange.flange_friction_power`) and in total:
+    "flange_friction_power_W.inner_neg_x", ..., ".total" (`FRICTION_POWER_KEYS`). NaN without
+    samples or without the quantity (older runs)."""
+    power = histories.get("flange_friction_power")
+    if power is None or not np.asarray(power).size:
+        return dict.fromkeys(FRICTION_POWER_KEYS, np.nan)
+    per_flange = np.mean(np.sum(np.asarray(power), axis=1), axis=0)  # (T, Z, 4) -> (4,)
+    return dict(zip(FRICTION_POWER_KEYS, (*map(float, per_flange), float(np.sum(per_flange)))))
+
+
 def _none_if_nan(x: float):
     return None if not np.isfinite(x) else float(x)
 
 
 def _stats(values: np.ndarray) -> dict:
+    """max / mean / median / min of the finite `values` (None without any)."""
+    values = values[np.isfinite(values)]
     if values.size == 0:
         return {"max": None, "mean": None, "median": None, "min": None}
     return {
@@ -169,4 +198,6 @@ def summarise(result, threshold: float = CONTACT_THRESHOLD) -> dict:
         block[name] = {r: _none_if_nan(film[f"{name}.{r}"]) for r in reds}
     for name in FILM_SCALARS:
         block[name] = _none_if_nan(film[name])
+    power = friction_power_statistics(h)
+    block["flange_friction_power_W"] = {k.partition(".")[2]: _none_if_nan(v) for k, v in power.items()}
     return block

@@ -19,8 +19,11 @@ _EVENT_STATS = (
     "flange_pv_Pa_m_s",
     "contact_height_m",
     "contact_radius_m",
+    "flange_flash_temperature_K",
 )
 _STATS = ("max", "mean", "median", "min")
+#: the time-mean friction power of each flange and in total (summary key, its parts)
+_POWER = "flange_friction_power_W"
 #: scalar summary quantities (summary.json keys) stored per case
 _SCALARS = (
     "cage_speed_rpm",
@@ -81,7 +84,10 @@ def variable_names(spec: SweepSpec | None = None) -> tuple[str, ...]:
     if spec is not None and spec.settled:
         stats = statistic_names()
         return SETTLED_SCALARS + stats + tuple(n + c for n in stats for c in CI_SUFFIXES)
-    return _SCALARS + tuple(f"{q}_{s}" for q in _EVENT_STATS for s in _STATS)
+    from ..run import FRICTION_POWER_KEYS
+
+    power = tuple(k.replace(".", "_") for k in FRICTION_POWER_KEYS)
+    return _SCALARS + tuple(f"{q}_{s}" for q in _EVENT_STATS for s in _STATS) + power
 
 
 # -- batched solve -------------------------------------------------------------------------------
@@ -203,6 +209,8 @@ def _summarise_case(spec: SweepSpec, sol, inputs) -> dict:
         for s in _STATS:
             v = summary[q][s]
             row[f"{q}_{s}"] = np.float64(np.nan if v is None else v)
+    for part, v in summary[_POWER].items():
+        row[f"{_POWER}_{part}"] = np.float64(np.nan if v is None else v)
     if not res.ok:
         for key in row:
             if key not in _KEPT_ON_FAILURE:
