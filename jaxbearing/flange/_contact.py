@@ -60,7 +60,8 @@ from ..contact import (
     smooth_direction,
 )
 from ..geometry import Bearing
-from ._geometry import flange_effective_modulus, flange_geometry
+from ._face_geometry import contact_geometry
+from ._geometry import flange_effective_modulus
 from ._lubrication import contact_point_velocity, flange_film, flange_friction_coefficient
 
 Scalar = Float[Array, ""]
@@ -186,7 +187,9 @@ def roller_flange_contact(
     """Contact of one roller end with one ring flange (docs/model.md 5; the caller vmaps).
 
     Interference delta = h(n) - (P0 - p) . n with h the support function of the end body
-    (`jaxbearing._roller_end.end_support`); contact point C = its extreme point. Sliding velocity
+    (`jaxbearing._roller_end.end_support`); contact point C = its extreme point. A bearing with
+    general faces (`Bearing.has_general_faces`: a toroidal end, a curved rib) takes them from
+    `face_contact` instead (`contact_geometry`, docs/model.md 5.4), into the same laws. Sliding velocity
     u and the roller's surface speed: `_flange_sliding`; normal load Q (Hertz point contact,
     Hunt-Crossley damping), peak pressure p_max and contact ellipse: `_flange_normal_load`; film,
     friction coefficient mu and friction force F_t: `_flange_friction`; PV = p_max |u|.
@@ -203,7 +206,7 @@ def roller_flange_contact(
     `ring_axis` a, the ring's unit axis (default X; a tilted inner ring: `geometry.ring_axis`),
     along which the flange faces sit (`flange_geometry`).
     """
-    g = flange_geometry(
+    g = contact_geometry(
         bearing, raceway_radius, side, ring_sign, roller_centre, roller_axis, ring_centre, ring_axis
     )
     n = g.normal

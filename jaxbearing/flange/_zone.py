@@ -71,8 +71,16 @@ def design_zone(
     height comes from the exact Hertz solution (`jaxbearing.contact`) with
     the principal radii at the contact point and the normal load `flange_load` (N).
     `min_clearance` (m) is the required actual axial clearance.
+
+    A bearing with general faces (`Bearing.has_general_faces`) gets `face_design_zone` of its
+    own faces (`faces_of`): the same fields and more (`FaceZone`).
     """
     check_design(bearing, flange_load=flange_load, min_clearance=min_clearance)
+    if bearing.has_general_faces:
+        from ._face_zone import face_design_zone  # imports this module's margins
+        from ._faces import faces_of
+
+        return face_design_zone(bearing, faces_of(bearing), flange_load, min_clearance)
     roller = bearing.roller
     theta = bearing.flange.layback_angle
     radius = bearing.inner_raceway_radius
