@@ -188,7 +188,8 @@ def validate_bearing(bearing, op=None, *, traced: str = "error") -> None:
     checked = [k.path for k in keys if not set(k.deps) & skipped]
     # counts and choices (static pytree fields) are one Python value for the whole batch
     arrays = {k.path: np.asarray(leaves[k.path]) for k in keys if k.kind not in (int, str)}
-    # converted keys (the flange presence of `bearing.type`) have one trailing axis of their own
+    # converted string keys (the flange presence of `bearing.type`) have one trailing axis of
+    # their own; a converted float key (`flange.rib_radius_mm`) is a scalar like the others
     vectors = {
         k.path: np.asarray(leaves[k.path], dtype=float)
         for k in keys
