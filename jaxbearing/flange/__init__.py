@@ -13,11 +13,16 @@
 - the static design zone of an aligned roller: `design_zone`, `design_zone_grid`, `DesignZone`,
   `zone_margins`, `MARGIN_NAMES`;
 - general end and rib faces (a toroidal end of offset e, a rib meridian arc of curvature
-  1/R_rib; docs/model.md 5.4), as pure geometry not yet used by the dynamics: `Faces`,
-  `faces_of`, `check_faces`, `face_contact`, `FaceContact`, `face_contact_stiffness`,
-  `face_design_zone`, `FaceZone`, `face_limited_circle`, `face_protrusion`, `rib_distance`;
+  1/R_rib; docs/model.md 5.4): `Faces`, `faces_of`, `check_faces`, `face_contact`,
+  `FaceContact`, `face_contact_stiffness`, `face_design_zone`, `FaceZone`,
+  `face_limited_circle`, `face_protrusion`, `rib_distance`; in the dynamics through
+  `contact_geometry` (today's `flange_geometry` for a bearing without general faces,
+  `face_flange_geometry` for one with them, `Bearing.has_general_faces`), set on a bearing with
+  `with_faces`;
 - the design variables R_end, theta_f, Delta_bf: `DesignVariables`, `with_design`, and the one
-  range check every design entry point uses, `check_design`.
+  range check every design entry point uses, `check_design`; the eight profile variables
+  (R_end, e, R_cor, 1/R_rib, h_t, theta_f, H_rf, Delta_bf): `ProfileVariables`,
+  `PROFILE_NAMES`, `check_profile`.
 
 The shape of the roller end itself (support function, limited circle) is in
 `jaxbearing.geometry`, because the roller's mass properties need it.
@@ -35,6 +40,7 @@ from ._contact import (
 )
 from ._design import DesignVariables, with_design
 from ._face_contact import FaceContact, face_contact, face_contact_stiffness
+from ._face_geometry import contact_geometry, face_flange_geometry
 from ._face_zone import FaceZone, face_design_zone
 from ._faces import Faces, check_faces, face_limited_circle, face_protrusion, faces_of, rib_distance
 from ._geometry import FlangeGeometry, flange_effective_modulus, flange_geometry
@@ -53,6 +59,7 @@ from ._lubrication import (
     flange_film,
     flange_friction_coefficient,
 )
+from ._profile import PROFILE_NAMES, ProfileVariables, check_profile, with_faces
 from ._zone import MARGIN_NAMES, DesignZone, design_zone, design_zone_grid, zone_margins
 
 __all__ = [
@@ -66,6 +73,7 @@ __all__ = [
     "FLANGE_LUBRICATION_MODES",
     "FLANGE_ORDER",
     "MARGIN_NAMES",
+    "PROFILE_NAMES",
     "DesignVariables",
     "DesignZone",
     "FaceContact",
@@ -74,15 +82,19 @@ __all__ = [
     "FlangeContact",
     "FlangeFilm",
     "FlangeGeometry",
+    "ProfileVariables",
     "all_flange_contacts",
     "check_design",
     "check_faces",
+    "check_profile",
+    "contact_geometry",
     "contact_point_velocity",
     "design_zone",
     "design_zone_grid",
     "face_contact",
     "face_contact_stiffness",
     "face_design_zone",
+    "face_flange_geometry",
     "face_limited_circle",
     "face_protrusion",
     "faces_of",
@@ -93,6 +105,7 @@ __all__ = [
     "rib_distance",
     "roller_flange_contact",
     "with_design",
+    "with_faces",
     "without_absent_flanges",
     "zone_margins",
 ]

@@ -60,7 +60,8 @@ from ..contact import (
     smooth_direction,
 )
 from ..geometry import Bearing
-from ._geometry import flange_effective_modulus, flange_geometry
+from ._face_geometry import contact_geometry
+from ._geometry import flange_effective_modulus
 from ._lubrication import contact_point_velocity, flange_film, flange_friction_coefficient
 
 Scalar = Float[Array, ""]
@@ -135,7 +136,8 @@ def _flange_normal_load(g, approach_rate, e_prime, damping):
     Hertz point contact of the end surface against the plane (exact elliptic solution, via
     `jaxbearing.contact`): principal radii R_end, R_end on the arc; R_cor across the corner and
     rho_c / sin(alpha) along it on the corner torus, blended C1 across the limited circle
-    (`end_principal_curvatures`). Q = K delta^1.5 (softplus of width PENETRATION_WIDTH),
+    (`end_principal_curvatures`); for general faces the principal relative radii of the end
+    and the rib (`face_flange_geometry`, docs/model.md 5.4). Q = K delta^1.5 (softplus of width PENETRATION_WIDTH),
     p_max = 3Q/(2 pi a b).
 
     Normal damping (Hunt & Crossley 1975, as on the raceways and pockets): the elastic load is
@@ -188,10 +190,13 @@ def roller_flange_contact(
     """Contact of one roller end with one ring flange (docs/model.md 5; the caller vmaps).
 
     Interference delta = h(n) - (P0 - p) . n with h the support function of the end body
-    (`jaxbearing._roller_end.end_support`); contact point C = its extreme point. Sliding velocity
-    u and the roller's surface speed: `_flange_sliding`; normal load Q (Hertz point contact,
-    Hunt-Crossley damping), peak pressure p_max and contact ellipse: `_flange_normal_load`; film,
-    friction coefficient mu and friction force F_t: `_flange_friction`; PV = p_max |u|.
+    (`jaxbearing._roller_end.end_support`); contact point C = its extreme point. A bearing with
+    general faces (`Bearing.has_general_faces`: a toroidal end, a curved rib) takes them from
+    `face_contact` instead (`contact_geometry`, docs/model.md 5.4), into the same laws.
+    Sliding velocity u and the roller's surface speed: `_flange_sliding`; normal load Q (Hertz
+    point contact, Hunt-Crossley damping), peak pressure p_max and contact ellipse:
+    `_flange_normal_load`; film, friction coefficient mu and friction force F_t:
+    `_flange_friction`; PV = p_max |u|.
 
     Top edge: `top_edge` = 1 where the exact radial height of C above the raceway,
     g(|C - c_r|_YZ - R_r), exceeds the flange height H_rf: the contact is then computed on the
@@ -204,7 +209,7 @@ def roller_flange_contact(
     `ring_axis` a, the ring's unit axis (default X; a tilted inner ring: `geometry.ring_axis`),
     along which the flange faces sit (`flange_geometry`).
     """
-    g = flange_geometry(
+    g = contact_geometry(
         bearing, raceway_radius, side, ring_sign, roller_centre, roller_axis, ring_centre, ring_axis
     )
     n = g.normal

@@ -79,7 +79,6 @@ _X = np.array([1.0, 0.0, 0.0])
 
 #: start angles of the maximisation over a centre circle (Newton's method runs from each)
 START_ANGLES = 16
-_STARTS = 2 * np.pi * np.arange(START_ANGLES) / START_ANGLES
 
 
 class FaceContact(eqx.Module):
@@ -164,7 +163,7 @@ def _tangent_solve(g, y):
     return y / jnp.where(slope != 0, slope, 1.0)
 
 
-def _circle_max(frame: _Frame, faces: Faces, centre: Vec3, radius) -> tuple[Vec3, Array]:
+def _circle_max(frame: _Frame, faces: Faces, centre: Vec3, radius, starts: int) -> tuple[Vec3, Array]:
     """(Q*, its error): the point of the circle (centre, axis x_end, radius) deepest in the rib,
     and radius min(|F'/F''|, pi) at it, how far one more Newton step would move it [m].
 
@@ -187,7 +186,8 @@ def _circle_max(frame: _Frame, faces: Faces, centre: Vec3, radius) -> tuple[Vec3
         return jnp.dot(n, dq), curv * jnp.dot(m, dq) ** 2 - jnp.dot(n, point(phi) - centre)
 
     newton = _newton(derivatives)
-    roots = jax.vmap(lambda t: newton(None, t))(jnp.asarray(_STARTS))
+    angles = 2 * np.pi * np.arange(starts) / starts
+    roots = jax.vmap(lambda t: newton(None, t))(jnp.asarray(angles))
     depths = jax.vmap(lambda phi: _rib(frame, faces, point(phi))[0])(roots)
     start = jax.lax.stop_gradient(roots[jnp.argmax(depths)])
     phi = jax.lax.custom_root(lambda t: derivatives(t)[0], start, newton, _tangent_solve)
@@ -198,9 +198,9 @@ def _circle_max(frame: _Frame, faces: Faces, centre: Vec3, radius) -> tuple[Vec3
     return point(phi), jax.lax.stop_gradient(radius * angle)
 
 
-def _branch(frame, faces, centre, radius, ball):
+def _branch(frame, faces, centre, radius, ball, starts):
     """(delta, C, n, last Newton step) of the balls of radius `ball` centred on a circle."""
-    q, step = _circle_max(frame, faces, centre, radius)
+    q, step = _circle_max(frame, faces, centre, radius, starts)
     d, n, _, _ = _rib(frame, faces, q)
     return ball + d, q + ball * n, n, step
 
@@ -254,6 +254,8 @@ def face_contact(
     roller_axis: Vec3,
     ring_centre: Vec3,
     ring_axis: Vec3 | None = None,
+    *,
+    starts: int = START_ANGLES,
 ) -> FaceContact:
     """Contact geometry of one general roller end with one general rib face (docs/model.md 5.4).
 
@@ -271,10 +273,10 @@ def face_contact(
     k_safe = jnp.where(k > 0, k, 1.0)
     r_end = 1.0 / k_safe
     arc_centre = p + (roller.length / 2 + face_protrusion(roller, faces) - r_end) * fr.x_end
-    arc = _branch(fr, faces, arc_centre, e, r_end)
+    arc = _branch(fr, faces, arc_centre, e, r_end, starts)
     corner_centre = p + corner_centre_offset(roller, faces) * fr.x_end
     r_ce = corner_centre_radius(roller, faces)
-    corner = _branch(fr, faces, corner_centre, r_ce, faces.corner_radius)
+    corner = _branch(fr, faces, corner_centre, r_ce, faces.corner_radius, starts)
     sin_arc = safe_norm(arc[2] - jnp.dot(arc[2], fr.x_end) * fr.x_end)
     sin_corner = safe_norm(corner[2] - jnp.dot(corner[2], fr.x_end) * fr.x_end)
     on_arc = sin_arc < k * (face_limited_circle(roller, faces) - e)

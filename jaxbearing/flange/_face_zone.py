@@ -35,7 +35,7 @@ from ._checks import DEFAULT_FLANGE_LOAD
 from ._face_contact import face_contact
 from ._faces import Faces, check_faces, face_limited_circle, face_protrusion
 from ._geometry import flange_effective_modulus
-from ._zone import zone_margin_fields
+from ._margins import zone_margin_fields
 
 
 class FaceZone(eqx.Module):

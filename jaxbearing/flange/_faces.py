@@ -93,20 +93,25 @@ class Faces(eqx.Module):
 
 def faces_of(
     bearing: Bearing,
-    end_offset: ArrayLike = 0.0,
-    rib_curvature: ArrayLike = 0.0,
-    rib_tangent_height: ArrayLike = 0.0,
+    end_offset: ArrayLike | None = None,
+    rib_curvature: ArrayLike | None = None,
+    rib_tangent_height: ArrayLike | None = None,
 ) -> Faces:
     """The faces of `bearing` (its R_end, R_cor, theta_f, H_rf, Delta_bf) with the end offset e
-    [m], the rib curvature 1/R_rib [1/m] and the rib's tangent height h_t [m] given (defaults:
-    today's sphere or flat end against today's cone)."""
+    [m], the rib curvature 1/R_rib [1/m] and the rib's tangent height h_t [m] given; each one
+    not given is the bearing's own (`Roller.end_offset`, `Flange.rib_curvature`,
+    `Flange.rib_tangent_height`), 0 where the bearing has none (today's sphere or flat end
+    against today's cone)."""
+    own = (bearing.roller.end_offset, bearing.flange.rib_curvature, bearing.flange.rib_tangent_height)
+    given = (end_offset, rib_curvature, rib_tangent_height)
+    e, k_rib, h_t = (g if g is not None else (o if o is not None else 0.0) for g, o in zip(given, own))
     return Faces(
         end_curvature=1.0 / bearing.roller.end_radius,
-        end_offset=end_offset,
+        end_offset=e,
         corner_radius=bearing.roller.corner_radius,
         layback_angle=bearing.flange.layback_angle,
-        rib_curvature=rib_curvature,
-        rib_tangent_height=rib_tangent_height,
+        rib_curvature=k_rib,
+        rib_tangent_height=h_t,
         flange_height=bearing.flange.height,
         axial_clearance=bearing.flange.axial_clearance,
     )

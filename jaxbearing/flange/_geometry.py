@@ -102,7 +102,13 @@ def flange_geometry(
     axis), P0 = c_r + s (W_r/2) a + R_r e_rad, n = s cos(theta_f) a - g sin(theta_f) e_rad
     (module docstring of `_contact` with X -> a). With a = X these are exactly the aligned
     formulas.
+
+    Today's faces only (a sphere or flat end against the cone): a bearing with general faces
+    (`Bearing.has_general_faces`) is refused with a ValueError; its geometry is
+    `face_flange_geometry`.
     """
+    if bearing.has_general_faces:
+        raise ValueError("flange_geometry: the bearing has general faces; use face_flange_geometry")
     roller = bearing.roller
     theta = bearing.flange.layback_angle
     p = jnp.asarray(roller_centre)

@@ -34,7 +34,10 @@ from ..contact import point_contact_ellipse
 from ..geometry import Bearing, end_support, limited_circle_radius
 from ._checks import DEFAULT_FLANGE_LOAD, check_design
 from ._design import DesignVariables, with_design
+from ._face_zone import face_design_zone
+from ._faces import faces_of
 from ._geometry import flange_effective_modulus, flange_geometry
+from ._margins import zone_margin_fields
 
 
 class DesignZone(eqx.Module):
@@ -71,8 +74,13 @@ def design_zone(
     height comes from the exact Hertz solution (`jaxbearing.contact`) with
     the principal radii at the contact point and the normal load `flange_load` (N).
     `min_clearance` (m) is the required actual axial clearance.
+
+    A bearing with general faces (`Bearing.has_general_faces`) gets `face_design_zone` of its
+    own faces (`faces_of`): the same fields and more (`FaceZone`).
     """
     check_design(bearing, flange_load=flange_load, min_clearance=min_clearance)
+    if bearing.has_general_faces:
+        return face_design_zone(bearing, faces_of(bearing), flange_load, min_clearance)
     roller = bearing.roller
     theta = bearing.flange.layback_angle
     radius = bearing.inner_raceway_radius
@@ -111,26 +119,6 @@ def design_zone(
             clearance,
             min_clearance,
         ),
-    )
-
-
-def zone_margin_fields(
-    flange, contact_height, half_width, rho_lim, contact_radius, clearance, min_clearance
-) -> dict:
-    """The four design-zone margins [m], positive when satisfied, and their conjunction
-    `feasible`: the contact ellipse above the relief (h_c - a - relief height), the contact
-    height below its limit, the contact radius inside the limited circle (rho_lim - rho) and the
-    actual axial clearance above `min_clearance`; the fields of `DesignZone` and `FaceZone`."""
-    relief = contact_height - half_width - flange.relief_height
-    height = flange.contact_height_limit - contact_height
-    limited = rho_lim - contact_radius
-    clear = clearance - min_clearance
-    return dict(
-        relief_margin=relief,
-        height_margin=height,
-        limited_circle_margin=limited,
-        clearance_margin=clear,
-        feasible=(relief > 0) & (height > 0) & (limited > 0) & (clear > 0),
     )
 
 

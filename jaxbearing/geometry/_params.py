@@ -31,12 +31,26 @@ def _field():
     return eqx.field(converter=_f)
 
 
+def _optional(x) -> Array | None:
+    """Converter of the general-face parameters: None stays None (today's faces, a structural
+    switch: the contact code traced for them is today's), anything else a 64-bit JAX array."""
+    return None if x is None else _f(x)
+
+
+def _optional_field():
+    return eqx.field(converter=_optional, default=None)
+
+
 class Roller(eqx.Module):
     """Cylindrical roller with a crowned generatrix and corner-rounded or arc (spherical) ends.
 
     The end body is the convex hull of a corner torus (tube radius `corner_radius` R_cor, centre
     circle of radius R_ce = D/2 - R_cor at x_cor = L_b1/2 - R_cor from the roller centre) and,
     for an arc end, a spherical cap of radius `end_radius` R_end. A flat end is R_end = inf.
+
+    `end_offset` e (None by default: e = 0, today's sphere, traced as today) makes the arc end a
+    torus: the arc's centre lies a distance e off the roller axis (docs/model.md 5.4); the mass
+    properties and the limited circle follow it (`jaxbearing.geometry.limited_circle_radius`).
     """
 
     diameter: Scalar = _field()  # D
@@ -45,6 +59,7 @@ class Roller(eqx.Module):
     crown_drop: Scalar = _field()  # c_crown at the ends of the effective length
     corner_radius: Scalar = _field()  # R_cor
     end_radius: Scalar = _field()  # R_end (inf: flat end with corners only)
+    end_offset: Scalar | None = _optional_field()  # e [m]; None: today's sphere (e = 0)
 
     @property
     def corner_centre_radius(self) -> Array:
@@ -71,6 +86,10 @@ class Flange(eqx.Module):
 
     The flange face is a cone of revolution about the ring axis starting at the raceway edge
     x = +/-(L_b1 + Delta_bf)/2 and opening away from the roller by the layback angle theta_f.
+
+    `rib_curvature` 1/R_rib and `rib_tangent_height` h_t (None by default: today's cone, traced
+    as today) make the face a surface of revolution whose meridian is an arc of curvature
+    1/R_rib (positive concave) tangent to that cone at the height h_t (docs/model.md 5.4).
     """
 
     height: Scalar = _field()  # H_rf, above the raceway surface
@@ -80,6 +99,8 @@ class Flange(eqx.Module):
     axial_clearance: Scalar = _field()  # Delta_bf = flange spacing - L_b1
     # sigma = sqrt(s_end^2 + s_flange^2), composite rms roughness of roller end and flange [m]
     roughness: Scalar = eqx.field(converter=_f, default=0.2e-6)
+    rib_curvature: Scalar | None = _optional_field()  # kappa_rib = 1/R_rib [1/m]; None: cone
+    rib_tangent_height: Scalar | None = _optional_field()  # h_t [m]; None: 0
 
 
 class Cage(eqx.Module):
@@ -220,6 +241,14 @@ class Bearing(eqx.Module):
         from ._inertia import inner_ring_inertia
 
         return jnp.stack(inner_ring_inertia(self))
+
+    @property
+    def has_general_faces(self) -> bool:
+        """Whether the roller end or the rib carries a general-face parameter (a torus end, a
+        curved rib; docs/model.md 5.4): static, from the pytree's structure, so the reference
+        bearing (all None) traces today's contact code unchanged."""
+        r, f = self.roller, self.flange
+        return any(x is not None for x in (r.end_offset, f.rib_curvature, f.rib_tangent_height))
 
     def with_flat_ends(self) -> Bearing:
         """The same bearing with flat-end (corner) rollers."""

@@ -33,9 +33,14 @@ def _offset_curvature(roller: Roller) -> Array:
 
 
 def limited_circle_radius(roller: Roller) -> Array:
-    """rho_lim = R_ce R_end / (R_end - R_cor): where the arc end meets the corner torus."""
+    """rho_lim = R_ce R_end / (R_end - R_cor): where the arc end meets the corner torus; for a
+    toroidal end of offset e (`Roller.end_offset` not None) e + (R_ce - e) R_end / (R_end - R_cor)
+    (docs/model.md 5.4: R_ce replaced by R_ce - e, rho shifted by e)."""
     k = end_curvature(roller)
-    return roller.corner_centre_radius / (1.0 - k * roller.corner_radius)
+    if roller.end_offset is None:
+        return roller.corner_centre_radius / (1.0 - k * roller.corner_radius)
+    e = roller.end_offset
+    return e + (roller.corner_centre_radius - e) / (1.0 - k * roller.corner_radius)
 
 
 def arc_protrusion(roller: Roller) -> Array:
@@ -43,8 +48,12 @@ def arc_protrusion(roller: Roller) -> Array:
     beyond the flat end plane x = L_b1/2 (0 for a flat end).
 
     Written as kappa' R_ce^2 / (1 + sqrt(1 - kappa'^2 R_ce^2)) to avoid cancellation.
+    For a toroidal end (`Roller.end_offset` e not None) the apex is the circle rho = e and the
+    protrusion sag(R_ce - e, kappa') (docs/model.md 5.4).
     """
     kp = _offset_curvature(roller)
+    if roller.end_offset is not None:
+        return sag(roller.corner_centre_radius - roller.end_offset, kp)
     rce = roller.corner_centre_radius
     return kp * rce**2 / (1.0 + jnp.sqrt(1.0 - (kp * rce) ** 2))
 
@@ -56,7 +65,12 @@ def sag(radius: ArrayLike, curvature: ArrayLike) -> Array:
 
 def arc_half_length(roller: Roller, rho: ArrayLike) -> Array:
     """Axial position x(rho) of the spherical end at distance rho from the roller axis
-    (rho <= rho_lim): L_b1/2 + e - sag(rho, 1/R_end). For a flat end: L_b1/2."""
+    (rho <= rho_lim): L_b1/2 + e - sag(rho, 1/R_end). For a flat end: L_b1/2. For a toroidal
+    end of offset e_o (`Roller.end_offset`) the arc is centred at rho = e_o: L_b1/2 + e -
+    sag(rho - e_o, 1/R_end), which inside the centre circle (rho < e_o) is the arc continued to
+    the axis (a central dimple of depth sag(e_o, 1/R_end))."""
+    if roller.end_offset is not None:
+        rho = rho - roller.end_offset
     return roller.length / 2 + arc_protrusion(roller) - sag(rho, end_curvature(roller))
 
 

@@ -261,7 +261,8 @@ class Config:
 
     # -- model inputs ---------------------------------------------------------------------------
     def bearing(self) -> Bearing:
-        """The `Bearing` pytree in SI units."""
+        """The `Bearing` pytree in SI units; with general faces only where the face keys differ
+        from today's faces (`jaxbearing.io._schema` docstring)."""
         parts: dict[str, dict[str, Any]] = {}
         top: dict[str, Any] = {}
         for key in KEYS:
@@ -280,6 +281,10 @@ class Config:
             "roller_material": Material,
             "cage_material": Material,
         }
+        if parts["roller"]["end_offset"] == 0.0 and parts["flange"]["rib_curvature"] == 0.0:
+            # today's faces: none of the general-face fields (today's contact code, schema doc)
+            del parts["roller"]["end_offset"]
+            del parts["flange"]["rib_curvature"], parts["flange"]["rib_tangent_height"]
         return Bearing(**top, **{g: classes[g](**kw) for g, kw in parts.items()})
 
     def operating_point(self) -> OperatingPoint:

@@ -32,12 +32,15 @@ Schema (ranges; "(" open, "[" closed; symbols as in docs/model.md and the source
 | roller.central_length_mm | L_b2 | [0, length_mm - 2 corner_radius_mm] |
 | roller.crown_drop_um | c_crown | [0, diameter_mm/10] |
 | roller.end_radius_mm | R_end | (diameter_mm/2, inf], inf = flat end |
+| roller.end_offset_mm | e (end arc centre off the roller axis) | [0, diameter_mm/2 - corner_radius_mm), 0 = sphere |
 | flange.height_mm | H_rf | (0, diameter_mm) |
 | flange.relief_height_mm | h_rel | [0, height_mm) |
 | flange.contact_height_limit_mm | h_up | (relief_height_mm, height_mm] |
 | flange.layback_angle_deg | theta_f | (0, 10] |
 | flange.axial_clearance_mm | Delta_bf | [0, length_mm) |
 | flange.roughness_um | sigma (composite rms, end and flange) | [0, 10] |
+| flange.rib_radius_mm | R_rib (rib meridian arc, concave) | (end_radius_mm, inf], inf = cone; (corner_radius_mm, inf] for a flat end |
+| flange.rib_tangent_height_mm | h_t (where the rib arc touches the cone) | [0, height_mm] |
 | cage.inner_diameter_mm | | (inner raceway diameter, pitch_diameter_mm) |
 | cage.outer_diameter_mm | | (pitch_diameter_mm, outer raceway diameter - guiding_clearance_mm] |
 | cage.width_mm | | (length_mm + pocket_clearance_mm, 3 length_mm] |
@@ -71,7 +74,11 @@ Schema (ranges; "(" open, "[" closed; symbols as in docs/model.md and the source
 | simulation.solver | | "tsit5" (default) or "ros34pw2" |
 
 The inner and outer raceway diameters are d_m -/+ (D + P_d/2) (`Bearing.inner_raceway_radius`).
-Non-finite values are rejected everywhere except `roller.end_radius_mm = inf`.
+Non-finite values are rejected everywhere except `roller.end_radius_mm = inf` and
+`flange.rib_radius_mm = inf`. The three face keys (`roller.end_offset_mm`,
+`flange.rib_radius_mm`, `flange.rib_tangent_height_mm`; docs/model.md 5.4) give a bearing with
+general faces only where they differ from today's faces (e > 0 or a finite R_rib); otherwise the
+bearing carries none (`Bearing.has_general_faces` False) and runs today's contact code.
 """
 
 from __future__ import annotations
@@ -203,7 +210,32 @@ def _axial_load_carried(v) -> str | None:
     )
 
 
+def _rib_beyond_end_radius(v) -> str | None:
+    """A concave rib conforms with the end only while R_rib > R_end (the meridian curvature sum
+    1/R_end - 1/R_rib stays positive; docs/model.md 5.4); against a flat end (R_end = inf, its
+    corner carrying the contact) while R_rib > R_cor."""
+    r_rib, r, r_cor = v["flange.rib_radius_mm"], v[_REND], v[_RC]
+    bound, name = (r, "end_radius_mm") if math.isfinite(r) else (r_cor, "corner_radius_mm (flat end)")
+    if math.isinf(r_rib) or r_rib > bound:
+        return None
+    return (
+        f"{format_value(r_rib)} mm must be > {name} = {format_derived(bound)} mm "
+        "(a concave rib less curved than the end; inf = the cone)"
+    )
+
+
+def _rib_curvature(radius_mm: float) -> float:
+    """flange.rib_radius_mm -> Flange.rib_curvature 1/R_rib [1/m] (inf: 0, the cone)."""
+    return 0.0 if math.isinf(radius_mm) else 1e3 / radius_mm
+
+
+def _rib_radius_mm(curvature) -> float:
+    """Flange.rib_curvature [1/m] -> flange.rib_radius_mm (0: inf, the cone)."""
+    return math.inf if curvature == 0 else 1e3 / float(curvature)
+
+
 # -- the schema --------------------------------------------------------------------------------
+_REND = "roller.end_radius_mm"
 _DM, _PD = "bearing.pitch_diameter_mm", "bearing.radial_clearance_um"
 _D, _L, _RC = "roller.diameter_mm", "roller.length_mm", "roller.corner_radius_mm"
 _H, _HREL = "flange.height_mm", "flange.relief_height_mm"
@@ -466,6 +498,18 @@ KEYS: tuple[Key, ...] = (
         allow_inf=True,
         note="inf = flat end with corner radii only",
     ),
+    make_key(
+        "roller.end_offset_mm",
+        float,
+        0.0,
+        "mm",
+        "e",
+        "offset of the end arc's centre from the roller axis (toroidal end)",
+        constant_bound(0, True),
+        relative_bound("diameter_mm/2 - corner_radius_mm", (_D, _RC), lambda d, rc: d / 2 - rc, False),
+        attr="roller.end_offset",
+        note="0 = today's spherical end (below end_radius_mm too, since end_radius_mm > diameter_mm/2)",
+    ),
     # [flange]
     make_key(
         _H,
@@ -533,6 +577,36 @@ KEYS: tuple[Key, ...] = (
         constant_bound(10, True),
         attr="flange.roughness",
         note="sigma = sqrt(s_end^2 + s_flange^2); 0.2 um: ground end and flange",
+    ),
+    # a concave rib conforms with the end only while R_rib > R_end (the meridian curvature sum
+    # 1/R_end - 1/R_rib stays positive; docs/model.md 5.4); a convex rib is not modelled
+    make_key(
+        "flange.rib_radius_mm",
+        float,
+        math.inf,
+        "mm",
+        "R_rib",
+        "radius of the rib face's meridian arc (concave)",
+        constant_bound(0, False),
+        None,
+        attr="flange.rib_curvature",
+        allow_inf=True,
+        convert=Convert(_rib_curvature, _rib_radius_mm),
+        note="inf = today's cone",
+        extras=(
+            Extra(("flange.rib_radius_mm", _REND), _rib_beyond_end_radius, "finite only above end_radius_mm"),
+        ),
+    ),
+    make_key(
+        "flange.rib_tangent_height_mm",
+        float,
+        0.0,
+        "mm",
+        "h_t",
+        "height above the raceway where the rib arc touches the cone",
+        constant_bound(0, True),
+        relative_bound("height_mm", (_H,), lambda h: h, True),
+        attr="flange.rib_tangent_height",
     ),
     # [cage]
     make_key(

@@ -178,6 +178,8 @@ def validate_bearing(bearing, op=None, *, traced: str = "error") -> None:
         raise ValueError(f"traced = {traced!r}: must be 'error' or 'skip'")
     keys = [k for k in KEYS if k.attr is not None and (op is not None or not k.attr.startswith("op."))]
     leaves = {k.path: _leaf(bearing, op, k.attr) for k in keys}
+    # a general-face field left None is today's face: the key's reference value
+    leaves = {p: KEY_BY_PATH[p].to_si(KEY_BY_PATH[p].default) if v is None else v for p, v in leaves.items()}
     skipped = {p for p, v in leaves.items() if _traced(v)}
     if skipped and traced == "error":
         raise TypeError("validate_bearing needs concrete values: call it outside jax.jit/grad/vmap")
@@ -186,8 +188,13 @@ def validate_bearing(bearing, op=None, *, traced: str = "error") -> None:
     checked = [k.path for k in keys if not set(k.deps) & skipped]
     # counts and choices (static pytree fields) are one Python value for the whole batch
     arrays = {k.path: np.asarray(leaves[k.path]) for k in keys if k.kind not in (int, str)}
-    # converted keys (the flange presence of `bearing.type`) have one trailing axis of their own
-    vectors = {k.path: np.asarray(leaves[k.path], dtype=float) for k in keys if k.convert is not None}
+    # converted string keys (the flange presence of `bearing.type`) have one trailing axis of
+    # their own; a converted float key (`flange.rib_radius_mm`) is a scalar like the others
+    vectors = {
+        k.path: np.asarray(leaves[k.path], dtype=float)
+        for k in keys
+        if k.convert is not None and k.kind is str
+    }
     shape = np.broadcast_shapes(
         *(a.shape for a in arrays.values()), *(a.shape[:-1] for a in vectors.values())
     )
@@ -202,7 +209,7 @@ def validate_bearing(bearing, op=None, *, traced: str = "error") -> None:
     for idx in np.ndindex(shape):
         values = dict(REFERENCE_VALUES)
         for k in keys:
-            if k.convert is not None:
+            if k.path in vectors:
                 values[k.path] = k.from_si(vectors[k.path][idx])
             elif k.kind in (int, str):
                 values[k.path] = coerce(k, leaves[k.path])
