@@ -370,13 +370,17 @@ def test_steady_corner_risk_of_a_settled_result():
         steady_corner_risk(types.SimpleNamespace(runs=runs[2:], bearing=b, operating=op))
 
 
-@pytest.mark.parametrize("name", ["corner_risk_validation_105mm", "corner_risk_validation_31slices"])
+@pytest.mark.parametrize(
+    "name",
+    ["corner_risk_validation_105mm", "corner_risk_validation_105mm_31slices", "corner_risk_validation_31slices"],
+)
 def test_normal_method_covers_the_brute_force_rate_on_the_dynamics(name):
     """The normal model on the settled dynamics where the corner rate is observable: 105 mm /
     1.6 deg at 20,000 rpm (11 slices, 8 members x 16 revolutions, 7 of 128 at the corner;
     benchmarks/results/corner_risk_validation_105mm.json) and, at full size, 106.9 mm / 1.616 deg
     at 20,000 rpm (31 slices, 32 members x 16 revolutions, 228 of 512 at the corner;
-    corner_risk_validation_31slices.json). From 4 members x 4 revolutions (the verification's
+    corner_risk_validation_31slices.json) and 105 mm / 1.6 deg (31 slices, 16 x 16, 20 of 256;
+    corner_risk_validation_105mm_31slices.json). From 4 members x 4 revolutions (the verification's
     size) and 4 x 2 (the search's), the upper bound lies below the pooled rate in at most 5 % of
     300 random subsets (binomial 0.999 tolerance: 26), also at lower limits (the 90 % and 95 %
     quantiles of the maxima)."""

@@ -225,8 +225,11 @@ def _rib_beyond_end_radius(v) -> str | None:
 
 
 def _rib_curvature(radius_mm: float) -> float:
-    """flange.rib_radius_mm -> Flange.rib_curvature 1/R_rib [1/m] (inf: 0, the cone)."""
-    return 0.0 if math.isinf(radius_mm) else 1e3 / radius_mm
+    """flange.rib_radius_mm -> Flange.rib_curvature 1/R_rib [1/m] (+inf: 0, the cone; -inf, which
+    is no radius, NaN, so that the pytree's range check rejects it as the file's does)."""
+    if math.isinf(radius_mm):
+        return 0.0 if radius_mm > 0 else math.nan
+    return math.inf if radius_mm == 0 else 1e3 / radius_mm
 
 
 def _rib_radius_mm(curvature) -> float:
