@@ -372,7 +372,11 @@ def test_steady_corner_risk_of_a_settled_result():
 
 @pytest.mark.parametrize(
     "name",
-    ["corner_risk_validation_105mm", "corner_risk_validation_105mm_31slices", "corner_risk_validation_31slices"],
+    [
+        "corner_risk_validation_105mm",
+        "corner_risk_validation_105mm_31slices",
+        "corner_risk_validation_31slices",
+    ],
 )
 def test_normal_method_covers_the_brute_force_rate_on_the_dynamics(name):
     """The normal model on the settled dynamics where the corner rate is observable: 105 mm /
