@@ -254,11 +254,13 @@ def tied_with_best(h: History) -> tuple[np.ndarray, tuple | None]:
     """The feasible evaluations statistically tied with the best (iteration, start mask), and
     the best's index: the best is the feasible evaluation of the lowest upper 95 % bound of the
     objective (not the lowest point estimate: one with a wide interval may lie anywhere in it);
-    tied are those whose lower bound lies below that upper bound (the intervals overlap)."""
+    tied are those whose lower bound lies below that upper bound (the intervals overlap). An
+    evaluation without an interval (one seed) counts with its point estimate as both bounds."""
     feasible = _feasible(h) if len(h) else np.zeros((0, 0), bool)
     if not feasible.any():
         return feasible, None
     ci = np.asarray(h.ci, float)
+    ci = np.where(np.isfinite(ci), ci, np.asarray(h.objective, float)[..., None])
     high = np.where(feasible, ci[..., 1], np.inf)
     best = np.unravel_index(int(np.argmin(high)), high.shape)
     return feasible & (ci[..., 0] <= high[best]), best

@@ -79,6 +79,9 @@ def test_the_safest_of_the_tied_designs_is_returned_unless_asked_otherwise():
     wide = dataclasses.replace(h, ci=np.array(h.ci, float))
     wide.objective[2, 0], wide.ci[2, 0] = 1.0, (0.2, 1.8)  # lowest point, widest interval
     assert choose(wide, "best") == (2, 1)
+    fresh = _result().history
+    one_seed = dataclasses.replace(fresh, ci=np.full_like(np.array(fresh.ci, float), np.nan))  # no intervals
+    assert choose(one_seed, "safest") == choose(one_seed, "best") == (2, 1)  # the lowest point estimate
     near = near_optimal_set(_result())
     assert [d.corner_risk for d in near] == [2e-3, 1e-4, 3e-4]
     assert near[0].corner_margin_m == 3e-6

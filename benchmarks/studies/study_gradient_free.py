@@ -209,14 +209,8 @@ def main(argv=None) -> int:
     p.add_argument("--quick", action="store_true")
     args = p.parse_args(argv)
     if args.quick:
-        args.slices, args.seeds, args.verify_seeds, args.starts, args.iterations, args.repeats = (
-            5,
-            1,
-            1,
-            1,
-            1,
-            1,
-        )
+        args.slices, args.seeds, args.verify_seeds = 5, 2, 2
+        args.starts, args.iterations, args.repeats = 1, 1, 1
         args.population, args.name = 3, args.name + "_quick"
     t0 = time.perf_counter()
     problem, settings = _problem(args)
