@@ -39,7 +39,7 @@ from ._evaluate import evaluate_starts, in_shared_pool
 from ._problem import DesignProblem, margins_batch
 from ._settings import SteadySettings
 from ._state import load_checkpoint, save_checkpoint
-from ._steady import constraints
+from ._steady import constraints, interval_bounds
 
 #: the fitness offset of an infeasible design [GPa m/s]: far above every objective
 INFEASIBLE = 1e3
@@ -65,14 +65,15 @@ class GradientFreeResult:
 
     @property
     def best(self) -> int:
-        """Index of the returned design: the feasible one of the lowest upper bound (-1: none)."""
-        high = np.where(self.feasible, self.ci[:, 1], np.inf)
+        """Index of the returned design: the feasible one of the lowest upper bound (-1: none; one
+        without an interval counts with its point estimate, as in `steady_search`)."""
+        high = np.where(self.feasible, interval_bounds(self.ci, self.objective)[:, 1], np.inf)
         return int(np.argmin(high)) if self.feasible.any() else -1
 
     def best_so_far(self) -> tuple[np.ndarray, np.ndarray]:
         """(members, objective of the design returned had the search stopped there) after each
         simulated design; NaN before the first feasible one."""
-        high = np.where(self.feasible, self.ci[:, 1], np.inf)
+        high = np.where(self.feasible, interval_bounds(self.ci, self.objective)[:, 1], np.inf)
         out = np.full(len(high), np.nan)
         best = -1
         for i in range(len(high)):

@@ -250,6 +250,13 @@ def _feasible(h: History) -> np.ndarray:
     return np.all(margins > 0, axis=-1) & np.isfinite(objective)
 
 
+def interval_bounds(ci, objective) -> np.ndarray:
+    """The 95 % bounds (..., 2) of evaluations' objectives, an evaluation without an interval (one
+    seed: NaN bounds) counting with its point estimate as both."""
+    ci = np.asarray(ci, float)
+    return np.where(np.isfinite(ci), ci, np.asarray(objective, float)[..., None])
+
+
 def tied_with_best(h: History) -> tuple[np.ndarray, tuple | None]:
     """The feasible evaluations statistically tied with the best (iteration, start mask), and
     the best's index: the best is the feasible evaluation of the lowest upper 95 % bound of the
@@ -259,8 +266,7 @@ def tied_with_best(h: History) -> tuple[np.ndarray, tuple | None]:
     feasible = _feasible(h) if len(h) else np.zeros((0, 0), bool)
     if not feasible.any():
         return feasible, None
-    ci = np.asarray(h.ci, float)
-    ci = np.where(np.isfinite(ci), ci, np.asarray(h.objective, float)[..., None])
+    ci = interval_bounds(h.ci, h.objective)
     high = np.where(feasible, ci[..., 1], np.inf)
     best = np.unravel_index(int(np.argmin(high)), high.shape)
     return feasible & (ci[..., 0] <= high[best]), best

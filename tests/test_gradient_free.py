@@ -5,6 +5,8 @@ tests/test_steady_design.py); the study at full size is benchmarks/studies/study
 
 from __future__ import annotations
 
+import dataclasses
+
 import jax.numpy as jnp
 import numpy as np
 import pytest
@@ -69,6 +71,8 @@ def test_search_counts_members_and_returns_the_best_feasible_design(problem, met
     assert np.all(np.diff(finite) <= 0) and members[-1] == res.members[-1]
     u = np.asarray(problem.bounds.to_scaled(res.x[best]))
     assert u[0] < 0.8  # the dynamic constraint holds
+    one_seed = dataclasses.replace(res, ci=np.full_like(res.ci, np.nan))  # no intervals: point estimates
+    assert one_seed.best == int(np.argmin(np.where(res.feasible, res.objective, np.inf)))
 
 
 def test_cmaes_beats_random_search_on_a_smooth_objective(problem):
