@@ -109,7 +109,7 @@ def frozen_tail_samples(bearing, op, x, states):
     return (q0 > CONTACT_THRESHOLD).astype(float), pv, dpv
 
 
-def tail_integrals(samples) -> tuple[list, float]:
+def tail_integrals(samples, num_variables: int = 3) -> tuple[list, float]:
     """The tail statistic's per-trajectory integrals from `frozen_tail_samples` of every
     trajectory of one design ((w, pv, dpv) each, or None for a failed one): q, the 95th
     percentile of the frozen PV / PV_ref over every touching sample, and per trajectory
@@ -118,18 +118,18 @@ def tail_integrals(samples) -> tuple[list, float]:
     touching = [np.asarray(pv)[np.asarray(w) > 0.5] for w, pv, _ in filter(None, samples)]
     pooled = np.concatenate(touching) if touching else np.zeros(0)
     if pooled.size == 0:
-        return [_failed_integrals() for _ in samples], float("nan")
+        return [_failed_integrals(num_variables) for _ in samples], float("nan")
     q = float(np.percentile(pooled, 100.0 * TAIL_LEVEL))
     outs = []
     for sample in samples:
         if sample is None:
-            outs.append(_failed_integrals())
+            outs.append(_failed_integrals(num_variables))
             continue
         w, pv, dpv = (np.asarray(a) for a in sample)
         above = w * (pv > q)
         a = float(np.sum(w * np.maximum(pv - q, 0.0)))
         da = np.sum(above[None] * dpv, axis=tuple(range(1, dpv.ndim)))
-        outs.append((np.array([a, float(np.sum(w))]), np.stack([da, np.zeros(3)], axis=1)))
+        outs.append((np.array([a, float(np.sum(w))]), np.stack([da, np.zeros_like(da)], axis=1)))
     return outs, q
 
 
@@ -156,7 +156,7 @@ class _FrozenSample:
         trajectory = lambda b, o, s, d, r: trajectory_states(b, o, s, d, num_saves, rtol=r)
         states, code = compiled_program("trajectory_states", trajectory, args, num_saves)(*args)
         if int(code) != 0:  # a failed trajectory: no samples (tail), NaN integrals (sums)
-            return {s: _failed_sample(s) for s in self.statistics}
+            return {s: _failed_sample(s, len(self.x)) for s in self.statistics}
         out = {}
         for statistic in self.statistics:
             if statistic == "tail":
@@ -175,9 +175,9 @@ def _exponent(statistic: str) -> np.float64:
     return np.float64(_functionals(statistic).pv_exponent)
 
 
-def _failed_sample(statistic: str):
+def _failed_sample(statistic: str, num_variables: int = 3):
     """A failed trajectory's sample: no tail samples (None), NaN integrals otherwise."""
-    return None if statistic == "tail" else _failed_integrals()
+    return None if statistic == "tail" else _failed_integrals(num_variables)
 
 
 def _frozen_jacobian(bearing, op, x, states, exponent=1.0):
@@ -259,16 +259,22 @@ def frozen_load_statistics(
         owner += [k] * len(states)
     outs = _run_frozen(jobs, strategy, workers)
     per_case = [[o for o, j in zip(outs, owner) if j == k] for k in range(len(cases))]
-    return [{s: _combine_statistic(s, [o[s] for o in per], window) for s in statistics} for per in per_case]
+    sizes = [int(np.size(design.as_array())) for _, _, design, _ in cases]
+    return [
+        {s: _combine_statistic(s, [o[s] for o in per], window, n) for s in statistics}
+        for per, n in zip(per_case, sizes)
+    ]
 
 
-def _combine_statistic(statistic: str, samples: list, window: float) -> SteadyGradient:
+def _combine_statistic(statistic: str, samples: list, window: float, num_variables: int) -> SteadyGradient:
     """One statistic's estimate from its per-trajectory samples (`_FrozenSample`): the ratio
     estimator at its exponent (mean, peak), or at the tail threshold of its samples (tail)."""
     if statistic != "tail":
-        return _combine(samples, window, float(_exponent(statistic)))
-    integrals, q = tail_integrals(samples)
-    return _combine(integrals, window, tail_threshold=q * STEADY_FUNCTIONALS.pv_reference)
+        return _combine(samples, window, float(_exponent(statistic)), num_variables=num_variables)
+    integrals, q = tail_integrals(samples, num_variables)
+    return _combine(
+        integrals, window, tail_threshold=q * STEADY_FUNCTIONALS.pv_reference, num_variables=num_variables
+    )
 
 
 def _run_frozen(jobs, strategy: str, workers: int) -> list:
@@ -321,5 +327,5 @@ def _frozen_samples_batched(jobs) -> list:
         one_member = {s: (sum_outs[j][0][i], sum_outs[j][1][i]) for j, s in enumerate(sums)}
         if tail:
             one_member["tail"] = tuple(a[i] for a in tail_outs)
-        found.append({s: one_member[s] if ok else _failed_sample(s) for s in statistics})
+        found.append({s: one_member[s] if ok else _failed_sample(s, len(jobs[i][0].x)) for s in statistics})
     return found

@@ -56,8 +56,8 @@ from ..flange import (
     DEFAULT_FLANGE_LOAD,
     MARGIN_NAMES,
     DesignVariables,
+    ProfileVariables,
     check_design,
-    with_design,
     zone_margins,
 )
 from ..geometry import Bearing, OperatingPoint
@@ -148,7 +148,7 @@ def steady_design_metrics(
 def steady_design_metrics_points(
     bearing: Bearing | list[Bearing],
     ops,
-    design: DesignVariables | list[DesignVariables],
+    design: DesignVariables | ProfileVariables | list,
     settings: SteadySettings | None = None,
     *,
     corner_margin: float = CORNER_MARGIN,
@@ -168,7 +168,7 @@ def steady_design_metrics_points(
     `first_seed` selects the seeds (first_seed .. first_seed + seeds - 1): a verification uses
     seeds a search never saw. `initial_states`: None, or per point None or one state per seed."""
     ops = list(ops)
-    designs = per_point("design", design, DesignVariables, len(ops))
+    designs = per_point("design", design, (DesignVariables, ProfileVariables), len(ops))
     bases = per_point("bearing", bearing, Bearing, len(ops))
     for b, d in zip(bases, designs):
         check_design(b, d)
@@ -176,9 +176,7 @@ def steady_design_metrics_points(
     require("first_seed", first_seed, lambda v: (v >= 0) & (v == np.round(v)), "an integer >= 0")
     changes.setdefault("functionals", _functionals(statistic))
     settings = (settings if settings is not None else SteadySettings()).replace(**changes)
-    bearings = [
-        with_design(b, d.end_radius, d.layback_angle, d.axial_clearance) for b, d in zip(bases, designs)
-    ]
+    bearings = [d.apply(b) for b, d in zip(bases, designs)]
     pert = dataclasses.replace(perturbation, seed=int(first_seed))
     results = simulate_steady_points(
         bearings, ops, settings, initial_states=initial_states, perturbation=pert
@@ -208,7 +206,7 @@ def _tail_per_seed(result, run) -> float:
 
 def _metrics(
     result,
-    design: DesignVariables,
+    design: DesignVariables | ProfileVariables,
     margins,
     corner_margin: float,
     functionals,
@@ -233,11 +231,7 @@ def _metrics(
     if per_seed is None:  # functionals of the caller's own
         per_seed = _objective_per_seed(result, statistic, functionals)
     return SteadyDesignMetrics(
-        design={
-            "end_radius_m": float(design.end_radius),
-            "layback_angle_rad": float(design.layback_angle),
-            "axial_clearance_m": float(design.axial_clearance),
-        },
+        design=_design_record(design),
         objective=student_t_interval(per_seed),
         objective_per_seed=[float(v) for v in per_seed],
         mean_pv=nothing if stats is None else stats.flange_pv_contact_time_Pa_m_s.mean,
@@ -259,6 +253,28 @@ def _metrics(
         contact_radius_maxima=steady_revolution_maxima(result).contact_radius_m,
         limited_circle_radius_m=float(rho_lim),
     )
+
+
+#: SI units of the profile fields beyond the three-variable design (`flange.PROFILE_NAMES`)
+_PROFILE_UNITS = {
+    "end_offset": "m",
+    "corner_radius": "m",
+    "rib_curvature": "1_per_m",
+    "rib_tangent_height": "m",
+    "flange_height": "m",
+}
+
+
+def _design_record(design) -> dict:
+    """The design as {name_unit: value} in SI units; a profile adds its five face fields."""
+    out = {
+        "end_radius_m": float(design.end_radius),
+        "layback_angle_rad": float(design.layback_angle),
+        "axial_clearance_m": float(design.axial_clearance),
+    }
+    if isinstance(design, ProfileVariables):
+        out |= {f"{name}_{unit}": float(getattr(design, name)) for name, unit in _PROFILE_UNITS.items()}
+    return out
 
 
 def _simulated_ms(result) -> float:

@@ -45,7 +45,7 @@ import numpy as np
 
 from .._errors import UserInputError
 from ..dynamics import Functionals, Params
-from ..flange import with_design
+from ..flange import variables_from_array, with_design
 from ..geometry import Bearing, OperatingPoint
 from ..io import require
 from ..run import TAIL_LEVEL
@@ -82,18 +82,23 @@ GRADIENT_WINDOW = 1.0e-3
 
 
 def _design_params(bearing: Bearing, op: OperatingPoint, x) -> Params:
-    b = with_design(bearing, x[0], x[1], x[2])
+    b = (
+        with_design(bearing, x[0], x[1], x[2])
+        if np.shape(x)[-1] == 3
+        else variables_from_array(x).apply(bearing)
+    )
     return Params(bearing=b, operating=op, functionals=STEADY_FUNCTIONALS)
 
 
 @dataclasses.dataclass
 class SteadyGradient:
-    """The ensemble short-window estimate of J and dJ/d(R_end, theta_f, Delta_bf) (module
-    docstring). SI units: J [Pa m/s], gradient [Pa m/s per m, per rad, per m]."""
+    """The ensemble short-window estimate of J and its gradient in the n design variables
+    (module docstring): (R_end, theta_f, Delta_bf), or the eight of a `flange.ProfileVariables`.
+    SI units: J [Pa m/s], gradient [Pa m/s per m, per rad, per m, per 1/m]."""
 
     value: float
-    gradient: np.ndarray  # (3,)
-    gradient_stderr: np.ndarray  # (3,) jackknife
+    gradient: np.ndarray  # (n,)
+    gradient_stderr: np.ndarray  # (n,) jackknife
     value_stderr: float
     window_s: float
     num_samples: int  # samples that succeeded
@@ -102,11 +107,19 @@ class SteadyGradient:
     ok: np.ndarray  # (K,) bool
 
     @classmethod
-    def missing(cls) -> SteadyGradient:
+    def missing(cls, num_variables: int = 3) -> SteadyGradient:
         """No estimate (value-only evaluations): NaN value and gradient, no samples."""
-        nan3 = np.full(3, np.nan)
+        nan = np.full(num_variables, np.nan)
         return cls(
-            np.nan, nan3, nan3, np.nan, 0.0, 0, np.zeros((0, 2)), np.zeros((0, 3, 2)), np.zeros(0, bool)
+            np.nan,
+            nan,
+            nan,
+            np.nan,
+            0.0,
+            0,
+            np.zeros((0, 2)),
+            np.zeros((0, num_variables, 2)),
+            np.zeros(0, bool),
         )
 
 
@@ -149,8 +162,10 @@ def _jackknife_stderr(a, c, da, dc, pv_reference):
     )
 
 
-def _combine(outs, window, exponent: float = 1.0, tail_threshold: float | None = None) -> SteadyGradient:
-    """The ratio estimator and its jackknife from per-sample ((A, C), Jacobian (3, 2)); a
+def _combine(
+    outs, window, exponent: float = 1.0, tail_threshold: float | None = None, num_variables: int = 3
+) -> SteadyGradient:
+    """The ratio estimator and its jackknife from per-sample ((A, C), Jacobian (n, 2)); a
     failed sample carries NaN and is left out. With `exponent` p (A the integral of
     (PV/PV_ref)^p): J = PV_ref R^(1/p) with R = sum A / sum C, dJ = J dR / (p R), and the
     standard errors by the same factor (delta method). With `tail_threshold` q [Pa m/s] (A the
@@ -158,17 +173,17 @@ def _combine(outs, window, exponent: float = 1.0, tail_threshold: float | None =
     J = q + PV_ref R / (1 - alpha), dJ = PV_ref dR / (1 - alpha) at fixed q, alpha = `TAIL_LEVEL`
     (module docstring, the tail statistic)."""
     if not outs:  # no states given
-        return dataclasses.replace(SteadyGradient.missing(), window_s=float(window))
+        return dataclasses.replace(SteadyGradient.missing(num_variables), window_s=float(window))
     vals = np.stack([v for v, _ in outs])  # (K, 2): A, C
-    jacs = np.stack([j for _, j in outs])  # (K, 3 variables, 2 outputs)
+    jacs = np.stack([j for _, j in outs])  # (K, n variables, 2 outputs)
     ok = np.all(np.isfinite(vals), axis=1) & np.all(np.isfinite(jacs), axis=(1, 2))
     a, c = vals[ok, 0], vals[ok, 1]
     da, dc = jacs[ok, :, 0], jacs[ok, :, 1]
     pv_ref = STEADY_FUNCTIONALS.pv_reference
     if not ok.any() or np.sum(c) <= 0:
-        nan3 = np.full(3, np.nan)
+        nan = np.full(jacs.shape[1], np.nan)
         return SteadyGradient(
-            float("nan"), nan3, nan3, float("nan"), float(window), int(ok.sum()), vals, jacs, ok
+            float("nan"), nan, nan, float("nan"), float(window), int(ok.sum()), vals, jacs, ok
         )
     value, grad = ratio_gradient(a, c, da, dc, pv_ref)
     value_se, grad_se = _jackknife_stderr(a, c, da, dc, pv_ref)
@@ -209,6 +224,6 @@ def _functionals(statistic: Statistic | str) -> Functionals:
     return STATISTICS[statistic_of(statistic)]
 
 
-def _failed_integrals() -> tuple[np.ndarray, np.ndarray]:
-    """The ((A, C), Jacobian (3, 2)) of a failed trajectory: NaN, left out by `_combine`."""
-    return np.full(2, np.nan), np.full((3, 2), np.nan)
+def _failed_integrals(num_variables: int = 3) -> tuple[np.ndarray, np.ndarray]:
+    """The ((A, C), Jacobian (n, 2)) of a failed trajectory: NaN, left out by `_combine`."""
+    return np.full(2, np.nan), np.full((num_variables, 2), np.nan)

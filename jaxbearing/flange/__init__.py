@@ -22,7 +22,7 @@
 - the design variables R_end, theta_f, Delta_bf: `DesignVariables`, `with_design`, and the one
   range check every design entry point uses, `check_design`; the eight profile variables
   (R_end, e, R_cor, 1/R_rib, h_t, theta_f, H_rf, Delta_bf): `ProfileVariables`,
-  `PROFILE_NAMES`, `check_profile`.
+  `PROFILE_NAMES`, `check_profile`; `variables_from_array` (either kind from its SI array).
 
 The shape of the roller end itself (support function, limited circle) is in
 `jaxbearing.geometry`, because the roller's mass properties need it.
@@ -59,7 +59,7 @@ from ._lubrication import (
     flange_film,
     flange_friction_coefficient,
 )
-from ._profile import PROFILE_NAMES, ProfileVariables, check_profile, with_faces
+from ._profile import PROFILE_NAMES, ProfileVariables, check_profile, variables_from_array, with_faces
 from ._zone import MARGIN_NAMES, DesignZone, design_zone, design_zone_grid, zone_margins
 
 __all__ = [
@@ -74,6 +74,7 @@ __all__ = [
     "FLANGE_ORDER",
     "MARGIN_NAMES",
     "PROFILE_NAMES",
+    "variables_from_array",
     "DesignVariables",
     "DesignZone",
     "FaceContact",

@@ -184,3 +184,15 @@ def check_profile(bearing: Bearing, profile: ProfileVariables) -> None:
         f"in [0, H_rf = {h_rf:g}] m",
     )
     require("profile.axial_clearance", p.axial_clearance, lambda v: v > 0, "> 0 m")
+
+
+def variables_from_array(x) -> DesignVariables | ProfileVariables:
+    """The design of an array of SI values by its trailing length: 3, a `DesignVariables`
+    (R_end, theta_f, Delta_bf); 8, a `ProfileVariables` (in the order `PROFILE_NAMES`). The
+    length is static, so a traced function of x builds one kind of bearing."""
+    n = int(np.shape(x)[-1])
+    if n == 3:
+        return DesignVariables.from_array(x)
+    if n == len(PROFILE_NAMES):
+        return ProfileVariables.from_array(x)
+    raise ValueError(f"design array of trailing length {n}: expected 3 or {len(PROFILE_NAMES)}")
