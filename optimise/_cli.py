@@ -47,10 +47,12 @@ def build_parser() -> argparse.ArgumentParser:
     from jaxbearing.cli import exit_codes_text
     from jaxbearing.flange import DEFAULT_FLANGE_LOAD
 
+    from ._bounds import PROFILE_TABLE, ProfileBounds
+    from ._cli_settings import PROFILE_OPTIONS
     from ._problem import DEFAULT_DURATION, Bounds
     from ._settings import ESTIMATORS, SteadySettings
 
-    st, b, d = SteadySettings(), Bounds(), SEARCH_DEFAULTS
+    st, b, pb, d = SteadySettings(), Bounds(), ProfileBounds(), SEARCH_DEFAULTS
     mm, deg = 1e3, 180 / math.pi
     p = argparse.ArgumentParser(
         prog="optimise",
@@ -100,6 +102,21 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument(
         "--clearance-mm", help=f"Delta_bf bounds LO,HI [mm] (default: {_range_text(b.axial_clearance, mm)})"
     )
+    r.add_argument(
+        "--profile",
+        action="store_true",
+        default=None,
+        help="search the eight profile variables (roller end and rib faces: R_end, e, R_cor, "
+        "1/R_rib, h_t, theta_f, H_rf, Delta_bf; steady objective, frozen-load estimator) instead "
+        "of R_end, theta_f, Delta_bf (default: off; on when a profile bound is given)",
+    )
+    for key, text in PROFILE_OPTIONS.items():
+        pair = getattr(pb, next(v.name for v in PROFILE_TABLE if v.key == key))
+        unit = next(v for v in PROFILE_TABLE if v.key == key)
+        r.add_argument(
+            "--" + key.replace("_", "-"),
+            help=f"profile: {text} bounds LO,HI (default: {_range_text(pair, unit.scale)})",
+        )
     r.add_argument(
         "--min-clearance-mm",
         type=float,
@@ -266,6 +283,7 @@ def run(args) -> int:
 
     from ._cli_startup import run_startup
     from ._cli_steady import run_steady
+    from ._steady import check_profile_settings
 
     try:
         cfg = load_config(args.config)
@@ -275,6 +293,12 @@ def run(args) -> int:
     s = _settings(args)
     problem, options = problem_from_settings(bearing, op, s, constant_corners=constant_corners(cfg, s))
     steady = steady_settings_from(s) if objective_of(s) == "steady" else None
+    if steady is None and problem.num_variables != 3:
+        raise UserInputError(
+            "objective = 'startup': a profile search needs the steady objective (objective = 'steady')"
+        )
+    if steady is not None:
+        check_profile_settings(problem, steady)
     # every input is checked before --out is made, so a rejected command leaves no directory
     check_output_dir(args.out, "--out")
     for line in plausibility_warnings(cfg):

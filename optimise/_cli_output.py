@@ -10,7 +10,15 @@ from jaxbearing.cli import EXIT_INFEASIBLE  # noqa: F401  (3: no feasible design
 
 
 def _design_text(x) -> str:
-    return f"R_end {x[0] * 1e3:7.2f} mm  theta_f {math.degrees(x[1]):6.3f} deg  Delta_bf {x[2] * 1e3:6.4f} mm"
+    """A design array in engineering units: (R_end, theta_f, Delta_bf), or a profile's eight."""
+    if len(x) == 3:
+        return f"R_end {x[0] * 1e3:7.2f} mm  theta_f {math.degrees(x[1]):6.3f} deg  Delta_bf {x[2] * 1e3:6.4f} mm"
+    r_end, e, r_cor, kappa, h_t, theta, h_rf, clearance = (float(v) for v in x)
+    return (
+        f"R_end {r_end * 1e3:7.2f} mm  e {e * 1e3:5.3f} mm  R_cor {r_cor * 1e3:5.3f} mm  "
+        f"1/R_rib {kappa:5.3f} 1/m  h_t {h_t * 1e3:5.3f} mm  theta_f {math.degrees(theta):6.3f} deg  "
+        f"H_rf {h_rf * 1e3:5.3f} mm  Delta_bf {clearance * 1e3:6.4f} mm"
+    )
 
 
 def _margin_text(m) -> str:
@@ -58,10 +66,10 @@ def _write_results(out, result: dict, plot) -> tuple[pathlib.Path, int]:
 
 
 def _engineering(x):
+    """A design array by its engineering keys (`end_radius_mm`, ...), three or eight."""
     if x is None:
         return None
-    return {
-        "end_radius_mm": float(x[0]) * 1e3,
-        "layback_angle_deg": math.degrees(float(x[1])),
-        "axial_clearance_mm": float(x[2]) * 1e3,
-    }
+    from ._bounds import DESIGN_TABLE, PROFILE_TABLE
+
+    table = DESIGN_TABLE if len(x) == 3 else PROFILE_TABLE
+    return {var.key: float(v) * var.scale for var, v in zip(table, x)}

@@ -27,6 +27,15 @@ def _pair(text: str | None, name: str):
     return v
 
 
+#: the profile variables' bounds options (beyond R_end, theta_f, Delta_bf), by TOML key
+PROFILE_OPTIONS = {
+    "end_offset_mm": "end offset e [mm]",
+    "corner_radius_mm": "corner radius R_cor [mm]",
+    "rib_curvature_per_m": "rib curvature 1/R_rib [1/m] (0: the cone)",
+    "rib_tangent_height_mm": "rib tangent height h_t [mm]",
+    "flange_height_mm": "flange height H_rf [mm]",
+}
+
 #: defaults of the search settings that are not `SteadySettings` fields (per objective where
 #: they differ); the help strings below and `problem_from_settings` both read them
 SEARCH_DEFAULTS = {
@@ -55,6 +64,8 @@ def _settings(args) -> dict:
         ("end_radius_mm", _pair(args.end_radius_mm, "--end-radius-mm")),
         ("layback_angle_deg", _pair(args.layback_deg, "--layback-deg")),
         ("axial_clearance_mm", _pair(args.clearance_mm, "--clearance-mm")),
+        *((key, _pair(getattr(args, key), "--" + key.replace("_", "-"))) for key in PROFILE_OPTIONS),
+        ("profile", args.profile),
         ("min_clearance_mm", args.min_clearance_mm),
         ("flange_load_N", args.flange_load_N),
         ("speeds_rpm", _floats(args.speeds_rpm, "--speeds-rpm") if args.speeds_rpm else None),
@@ -131,14 +142,22 @@ def constant_corners(cfg, s: dict):
     return [(corner.name, c.bearing()) for corner, c in corners]
 
 
+def bounds_of(s: dict):
+    """The search box from merged settings: `ProfileBounds` when `profile` is set or a profile
+    variable's bounds are given, else `Bounds` (R_end, theta_f, Delta_bf)."""
+    from ._bounds import Bounds, ProfileBounds, box_from_engineering
+
+    profile = bool(s.get("profile")) or any(s.get(key) is not None for key in PROFILE_OPTIONS)
+    kind = ProfileBounds if profile else Bounds
+    return box_from_engineering(kind, {v.key: s.get(v.key) for v in kind.TABLE})
+
+
 def problem_from_settings(bearing, op, s: dict, constant_corners=None):
     """DesignProblem and search options from merged settings (engineering units);
     `constant_corners`: see `make_problem`."""
-    from ._problem import DEFAULT_DURATION, bounds_from_engineering, make_problem
+    from ._problem import DEFAULT_DURATION, make_problem
 
-    bounds = bounds_from_engineering(
-        s.get("end_radius_mm"), s.get("layback_angle_deg"), s.get("axial_clearance_mm")
-    )
+    bounds = bounds_of(s)
     problem = make_problem(
         bearing,
         op,

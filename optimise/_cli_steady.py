@@ -35,7 +35,7 @@ def run_steady(args, problem, options, settings, out, meta=None) -> int:
         return (
             f"J {info.objective[j]:7.4f} [{lo:.4f}, {hi:.4f}] GPa m/s  "
             f"min margin {CONSTRAINT_NAMES[w]} {m[w] * 1e3:+.4f} mm  {_design_text(info.x[j])}  "
-            f"dJ/du ({g[0]:+.3f}, {g[1]:+.3f}, {g[2]:+.3f})"
+            f"dJ/du ({', '.join(f'{v:+.3f}' for v in g)})"
         )
 
     progress = _progress(args.quiet, start_line)
@@ -210,7 +210,7 @@ def _steady_result_json(problem, options, settings, res) -> dict:
         "simulated_ms": float(np.sum(h.simulated_ms)) if len(h) else 0.0,
         "resumed_from_iteration": res.resumed_from,
         "wall_time_s": res.wall_time_s,
-        "history": _history_json(h),
+        "history": _history_json(h, problem.bounds),
     }
 
 
@@ -242,6 +242,7 @@ def _clearance_json(problem, settings, res) -> dict:
     from ._settings import CLEARANCE_MISALIGNMENT, CLEARANCE_STEP, clearance_step_for
 
     step = clearance_step_for(problem, settings)
+    ci = problem.bounds.clearance_index
     seen = {
         "estimator_sees_it": True,
         "why": "common-random-number central differences of the settled objective in "
@@ -261,27 +262,26 @@ def _clearance_json(problem, settings, res) -> dict:
         f"{CLEARANCE_STEP * 1e3:g} mm where an operating point is misaligned by more than "
         f"{CLEARANCE_MISALIGNMENT * 1e3:g} mrad, else 0 (off)",
         "moved": bool(
-            res.design is not None and abs(float(res.design[2]) - float(res.start_design[2])) > 1e-12
+            res.design is not None and abs(float(res.design[ci]) - float(res.start_design[ci])) > 1e-12
         ),
     }
 
 
-def _history_json(h) -> dict:
-    """The search's history in engineering units (per iteration and start)."""
+def _history_json(h, bounds) -> dict:
+    """The search's history in engineering units (per iteration and start): every design
+    variable by its key (`end_radius_mm`, ...)."""
     import numpy as np
 
     from ._steady import CONSTRAINT_NAMES
 
-    x = np.asarray(h.x) if len(h) else np.zeros((0, 0, 3))
+    x = np.asarray(h.x) if len(h) else np.zeros((0, 0, len(bounds.names)))
     margins = np.asarray(h.margins) if len(h) else np.zeros((0, 0, 5))
     return {
         "objective_GPa_m_s": np.asarray(h.objective).tolist(),
         "ci95_GPa_m_s": np.asarray(h.ci).tolist(),
         "gradient_per_unit_box": np.asarray(h.gradient).tolist(),
         "gradient_stderr": np.asarray(h.gradient_stderr).tolist(),
-        "end_radius_mm": (x[..., 0] * 1e3).tolist(),
-        "layback_angle_deg": np.degrees(x[..., 1]).tolist(),
-        "axial_clearance_mm": (x[..., 2] * 1e3).tolist(),
+        **{var.key: (x[..., i] * var.scale).tolist() for i, var in enumerate(bounds.TABLE)},
         "margins_mm": {n: (margins[..., i] * 1e3).tolist() for i, n in enumerate(CONSTRAINT_NAMES)},
         # the upper 95 % bound of the corner-contact risk per revolution, worst operating point
         "corner_risk_per_revolution_upper95": np.asarray(h.corner_risk, float).tolist(),

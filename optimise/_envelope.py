@@ -62,7 +62,7 @@ class Envelope:
     risk: np.ndarray
 
     @classmethod
-    def fresh(cls, num_starts: int, num_points: int) -> Envelope:
+    def fresh(cls, num_starts: int, num_points: int, num_variables: int = 3) -> Envelope:
         """Every point active, nothing measured."""
         shape = (num_starts, num_points)
         nan = np.full(shape, np.nan)
@@ -71,10 +71,10 @@ class Envelope:
             since=np.zeros(shape, np.int64),
             value=nan.copy(),
             ci=np.full(shape + (2,), np.nan),
-            gradient=np.zeros(shape + (3,)),
-            gradient_stderr=np.zeros(shape + (3,)),
+            gradient=np.zeros(shape + (num_variables,)),
+            gradient_stderr=np.zeros(shape + (num_variables,)),
             corner_margin=nan.copy(),
-            measured_at=np.zeros(shape + (3,)),
+            measured_at=np.zeros(shape + (num_variables,)),
             share=nan.copy(),
             settled=np.zeros(shape, bool),
             risk=nan.copy(),

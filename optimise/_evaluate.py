@@ -26,6 +26,7 @@ import jax.numpy as jnp
 import numpy as np
 from scipy import stats
 
+from jaxbearing import UserInputError
 from jaxbearing.design import (
     SteadyGradient,
     frozen_load_gradients,
@@ -33,7 +34,7 @@ from jaxbearing.design import (
     steady_design_metrics_points,
     steady_gradient,
 )
-from jaxbearing.flange import MARGIN_NAMES, DesignVariables
+from jaxbearing.flange import MARGIN_NAMES, variables_from_array
 from jaxbearing.run import CORNER_RISK_CONFIDENCE, shared_workers, tolerance_bound
 
 from ._problem import PV_SCALE, DesignProblem
@@ -47,13 +48,13 @@ class PointRecord:
 
     value: float
     ci: tuple  # (low, high): the point's 95 % interval
-    gradient: np.ndarray  # (3,)
-    gradient_stderr: np.ndarray  # (3,)
+    gradient: np.ndarray  # (n,)
+    gradient_stderr: np.ndarray  # (n,)
     #: the dynamic corner margin the search constrains (`SteadySettings.corner_constraint`), moved
     #: by the static limited-circle margin's change where the point was not simulated
     corner_margin: float
     measured_corner_margin: float  # ... as measured, at `measured_at`
-    measured_at: np.ndarray  # the scaled design (3,) where it was measured
+    measured_at: np.ndarray  # the scaled design (n,) where it was measured
     corner_contact_share: float
     settled: bool
     simulated: bool  # False: the values of an earlier evaluation (`next_active`)
@@ -68,8 +69,8 @@ class Evaluation:
 
     objective: float  # combined over the envelope [GPa m/s]
     objective_ci: tuple  # (low, high): its 95 % interval (`combined_interval`) [GPa m/s]
-    gradient: np.ndarray  # dJ/du (3,)
-    gradient_stderr: np.ndarray  # (3,)
+    gradient: np.ndarray  # dJ/du (n,)
+    gradient_stderr: np.ndarray  # (n,)
     per_point: list[PointRecord]
     static_margins: np.ndarray  # (4,) [m]
     dynamic_margin: float  # [m], worst operating point
@@ -149,10 +150,10 @@ def _checked_active(active, n: int, num_designs: int, previous) -> list[list[boo
     return active
 
 
-def _gradients(settings: SteadySettings, cases, gradient: bool) -> list[SteadyGradient]:
+def _gradients(settings: SteadySettings, cases, gradient: bool, num_variables: int) -> list[SteadyGradient]:
     """The gradient estimates of `cases` (bearing, op, design, states) by `settings.estimator`."""
     if not gradient:
-        return [SteadyGradient.missing() for _ in cases]
+        return [SteadyGradient.missing(num_variables) for _ in cases]
     if settings.estimator is Estimator.FROZEN:
         return frozen_load_gradients(
             cases,
@@ -160,6 +161,10 @@ def _gradients(settings: SteadySettings, cases, gradient: bool) -> list[SteadyGr
             rtol=settings.rtol,
             workers=settings.num_workers,
             statistic=settings.statistic,
+        )
+    if num_variables != 3:
+        raise UserInputError(
+            f"estimator = {settings.estimator.value!r}: a profile search needs the frozen-load estimator ('frozen')"
         )
     return [
         steady_gradient(
@@ -200,7 +205,8 @@ def evaluate_starts(
     ops = operating_points(problem)
     n = len(ops)
     h = clearance_step_for(problem, settings)
-    shifts = (0.0, h, -h) if gradient and h > 0 and width[2] > 0 else (0.0,)
+    ci = problem.bounds.clearance_index
+    shifts = (0.0, h, -h) if gradient and h > 0 and width[ci] > 0 else (0.0,)
     designs = [problem.design(jnp.asarray(u)) for u in us]
     chains = [None] * len(designs) if chains is None else list(chains)
     active = _checked_active(active, n, len(designs), previous)
@@ -212,7 +218,7 @@ def evaluate_starts(
         problem,
         settings,
         [k for _, _, k in jobs],
-        [_shift_clearance(designs[s], shifts[j]) for s, j, _ in jobs],
+        [_shift_clearance(designs[s], shifts[j], ci) for s, j, _ in jobs],
         initial_states=None
         if all(c is None for c in chains)
         else [None if chains[s] is None else chains[s][k] for s, _, k in jobs],
@@ -223,11 +229,11 @@ def evaluate_starts(
         (designs[s].apply(problem.bearing_at(k)), ops[k], designs[s], metrics[(s, 0, k)].sample_states)
         for s, k in keys
     ]
-    gradients = dict(zip(keys, _gradients(settings, cases, gradient)))
+    gradients = dict(zip(keys, _gradients(settings, cases, gradient, problem.num_variables)))
     if len(shifts) == 3:
         for s, k in keys:
             gradients[(s, k)] = _with_clearance_difference(
-                gradients[(s, k)], metrics[(s, 1, k)], metrics[(s, 2, k)], h
+                gradients[(s, k)], metrics[(s, 1, k)], metrics[(s, 2, k)], h, ci
             )
     wall = time.perf_counter() - t0
     evaluations = []
@@ -248,11 +254,13 @@ def simulated_ms(m) -> float:
     return m.simulated_ms
 
 
-def _shift_clearance(design: DesignVariables, dh: float) -> DesignVariables:
+def _shift_clearance(design, dh: float, index: int):
+    """`design` with Delta_bf (at `index` of its array) moved by dh."""
     if dh == 0.0:
         return design
-    x = np.asarray(design.as_array(), dtype=float)
-    return DesignVariables.from_array(jnp.asarray([x[0], x[1], x[2] + dh]))
+    x = np.array(design.as_array(), dtype=float)
+    x[index] += dh
+    return variables_from_array(jnp.asarray(x))
 
 
 def clearance_signal(plus, minus, h: float) -> tuple[float, float]:
@@ -270,11 +278,11 @@ def clearance_signal(plus, minus, h: float) -> tuple[float, float]:
     return d, se
 
 
-def _with_clearance_difference(g: SteadyGradient, plus, minus, h: float) -> SteadyGradient:
+def _with_clearance_difference(g: SteadyGradient, plus, minus, h: float, index: int) -> SteadyGradient:
     """`g` with its Delta_bf component the paired common-random-number central difference of
     the objective per seed where significant (`clearance_signal`) and its standard error."""
     grad, se = np.array(g.gradient, dtype=float), np.array(g.gradient_stderr, dtype=float)
-    grad[2], se[2] = clearance_signal(plus.objective_per_seed, minus.objective_per_seed, h)
+    grad[index], se[index] = clearance_signal(plus.objective_per_seed, minus.objective_per_seed, h)
     return dataclasses.replace(g, gradient=grad, gradient_stderr=se)
 
 

@@ -89,7 +89,7 @@ def _members_per_design(problem: DesignProblem, settings: SteadySettings) -> int
 
 
 def _generation(problem: DesignProblem, settings: SteadySettings, us: np.ndarray) -> dict:
-    """Simulate the statically feasible designs of `us` (scaled, (P, 3)) in one engine call."""
+    """Simulate the statically feasible designs of `us` (scaled, (P, n)) in one engine call."""
     static = np.asarray(margins_batch(problem, jnp.asarray(us)))
     inside = np.all(static > 0, axis=1)
     n = len(us)

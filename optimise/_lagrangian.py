@@ -37,8 +37,8 @@ class Hyper:
 
 def augmented_lagrangian_step(optimiser, rho: float, free, g_obj, c, jc, lam, opt_state, u):
     """One step (module docstring) from the scaled design `u`: the objective's gradient
-    `g_obj` (3,), the scaled constraints `c` (m,) and their Jacobian `jc` (m, 3), the
-    multipliers `lam` (m,), the optimiser's state; `free` (3,) marks the variables that move.
+    `g_obj` (n,), the scaled constraints `c` (m,) and their Jacobian `jc` (m, n), the
+    multipliers `lam` (m,), the optimiser's state; `free` (n,) marks the variables that move.
     Returns the projected next iterate, the optimiser's next state and the next multipliers.
     Pure jax.numpy: traced and vmapped in `_search`, called eagerly in `_steady`."""
     act = jnp.maximum(0.0, lam - rho * c)

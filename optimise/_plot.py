@@ -81,9 +81,17 @@ def plot_search(problem, result, path) -> pathlib.Path:
     circles, the final design as a star, the near-optimal designs (`_steady.near_optimal_set`)
     as open diamonds. For a steady search (five margins per iterate), the
     dynamic corner margin's zero line too, dashed (`_steady`: the limited-circle margin equal to
-    the skew excursion measured at the final design plus the corner margin)."""
+    the skew excursion measured at the final design plus the corner margin). A profile search
+    (eight variables) draws the start's and the found design's faces instead (`plot_faces`)."""
     from jaxbearing.io import pyplot
 
+    if problem.num_variables != 3:  # a profile: the faces, not a map of two variables
+        from ._faces_plot import plot_faces
+
+        designs = {"start": result.start_design}
+        if result.design is not None:
+            designs["found"] = result.design
+        return plot_faces(problem.bearing, designs, path)
     plt = pyplot()
 
     from ._problem import feasibility_map

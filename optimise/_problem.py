@@ -1,8 +1,10 @@
 """The design problem: bounds, operating envelope, scaled objective and constraints.
 
-Variables. The design x = (R_end [m], theta_f [rad], Delta_bf [m]) is searched in the unit box:
-x = lo + u (hi - lo), u in [0, 1]^3, so every variable is O(1) and the box bounds are a
-projection (a clip). A variable whose bounds coincide (lo = hi) is held fixed.
+Variables. The design x = (R_end [m], theta_f [rad], Delta_bf [m]) (`Bounds`), or the eight
+profile variables (`ProfileBounds`: the shapes of the roller end and the rib face, docs/model.md
+5.4), is searched in the unit box: x = lo + u (hi - lo), u in [0, 1]^n, so every variable is
+O(1) and the box bounds are a projection (a clip). A variable whose bounds coincide (lo = hi)
+is held fixed.
 
 Objective. The smooth peak flange PV of the dynamic run (`jaxbearing.design_metrics`: a p-norm
 over contact time of p_max |u|, integrated inside the diffrax solve) in GPa m/s, at every
@@ -31,7 +33,6 @@ Lagrangian leaves at its limit point still satisfies the true constraint.
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from collections.abc import Sequence
 
@@ -46,13 +47,14 @@ from jaxbearing.design import design_metrics, seated_perturbation
 from jaxbearing.flange import (
     DEFAULT_FLANGE_LOAD,
     DesignVariables,
+    ProfileVariables,
     design_zone_grid,
     zone_margins,
 )
-from jaxbearing.io import check_model_inputs, check_solver_arguments, is_concrete, require
+from jaxbearing.io import check_model_inputs, check_solver_arguments, require
 
-MM = 1e-3
-DEG = math.pi / 180
+from ._bounds import MM, Bounds, ProfileBounds, box_from_engineering
+
 #: scale of the design-zone margins (constraints are margin / MARGIN_SCALE)
 MARGIN_SCALE = 0.1 * MM
 #: scale of the objective (PV in GPa m/s)
@@ -68,79 +70,6 @@ DEFAULT_DURATION = 0.3e-3
 DEFAULT_SKEW = 1e-3
 
 
-@dataclasses.dataclass(frozen=True)
-class Bounds:
-    """Box bounds of the design, SI units (R_end [m], theta_f [rad], Delta_bf [m]).
-
-    Defaults: a sensible range around the reference design (R_end 60-120 mm, theta_f 1.0-2.0
-    deg, Delta_bf 0.10-0.30 mm). lo == hi fixes a variable."""
-
-    end_radius: tuple[float, float] = (60 * MM, 120 * MM)
-    layback_angle: tuple[float, float] = (1.0 * DEG, 2.0 * DEG)
-    axial_clearance: tuple[float, float] = (0.10 * MM, 0.30 * MM)
-
-    #: (field, unit, SI -> unit factor, valid range in that unit, its text); R_end > D/2 is
-    #: checked against the actual roller in `check(bearing)`
-    _RANGES = (
-        ("end_radius", "mm", 1 / MM, lambda v: v > 0, "> 0 mm (and > D/2 of the roller)"),
-        ("layback_angle", "deg", 1 / DEG, lambda v: (v >= 0) & (v < 45), "in [0, 45) deg"),
-        ("axial_clearance", "mm", 1 / MM, lambda v: v > 0, "> 0 mm"),
-    )
-
-    def __post_init__(self):
-        """Each bound finite and in its range (`jaxbearing.io.require`), lower <= upper."""
-        for name, unit, k, ok, valid in self._RANGES:
-            pair = getattr(self, name)
-            if len(pair) != 2:
-                raise UserInputError(f"bounds.{name}_{unit} = {pair!r}: expected (lower, upper)")
-            lo, hi = (float(f"{float(v) * k:.12g}") for v in pair)  # 60 deg, not 59.99999999999999
-            for which, v in (("lower", lo), ("upper", hi)):
-                require(f"bounds.{name}_{unit} {which} bound", v, lambda x: np.isfinite(x) & ok(x), valid)
-            if lo > hi:
-                raise UserInputError(
-                    f"bounds.{name}_{unit} = [{lo:g}, {hi:g}]: lower bound above upper bound"
-                )
-
-    def check(self, bearing: Bearing) -> None:
-        """The end-radius bounds against the roller of `bearing`: R_end > D/2 (the end must be
-        convex and meet the corner torus; the same range as `roller.end_radius_mm`)."""
-        if not is_concrete(bearing.roller.diameter):
-            return
-        half_d = float(f"{float(np.max(np.asarray(bearing.roller.diameter))) / 2 / MM:.12g}")
-        for which, v in zip(("lower", "upper"), self.end_radius):
-            require(
-                f"bounds.end_radius_mm {which} bound",
-                float(f"{float(v) / MM:.12g}"),
-                lambda x: x > half_d,
-                f"> D/2 = {half_d:g} mm (half the roller diameter of the bearing)",
-            )
-
-    @property
-    def lower(self) -> np.ndarray:
-        return np.array([self.end_radius[0], self.layback_angle[0], self.axial_clearance[0]])
-
-    @property
-    def upper(self) -> np.ndarray:
-        return np.array([self.end_radius[1], self.layback_angle[1], self.axial_clearance[1]])
-
-    def to_scaled(self, x) -> Array:
-        """u = (x - lo) / (hi - lo) (0 for fixed variables)."""
-        width = self.upper - self.lower
-        return jnp.where(width > 0, (jnp.asarray(x) - self.lower) / jnp.where(width > 0, width, 1.0), 0.0)
-
-    def from_scaled(self, u) -> Array:
-        """x = lo + u (hi - lo)."""
-        return self.lower + jnp.asarray(u) * (self.upper - self.lower)
-
-    def engineering(self) -> dict:
-        """Bounds in engineering units (mm, deg, mm)."""
-        return {
-            "end_radius_mm": [v / MM for v in self.end_radius],
-            "layback_angle_deg": [v / DEG for v in self.layback_angle],
-            "axial_clearance_mm": [v / MM for v in self.axial_clearance],
-        }
-
-
 def bounds_from_engineering(
     end_radius_mm: Sequence[float] | None = None,
     layback_angle_deg: Sequence[float] | None = None,
@@ -148,21 +77,12 @@ def bounds_from_engineering(
     base: Bounds | None = None,
 ) -> Bounds:
     """Bounds from engineering units (None keeps `base`, default `Bounds()`)."""
-    base = base or Bounds()
-
-    def pair(name, v, k):
-        if v is None:
-            return getattr(base, name)
-        v = list(v)
-        if len(v) != 2:
-            raise UserInputError(f"bounds.{name}: expected [lower, upper], got {v}")
-        return (float(v[0]) * k, float(v[1]) * k)
-
-    return Bounds(
-        end_radius=pair("end_radius", end_radius_mm, MM),
-        layback_angle=pair("layback_angle", layback_angle_deg, DEG),
-        axial_clearance=pair("axial_clearance", axial_clearance_mm, MM),
+    values = dict(
+        end_radius_mm=end_radius_mm,
+        layback_angle_deg=layback_angle_deg,
+        axial_clearance_mm=axial_clearance_mm,
     )
+    return box_from_engineering(Bounds, values, base)
 
 
 def operating_envelope(
@@ -204,7 +124,9 @@ class DesignProblem(eqx.Module):
     bearing: Bearing
     operating: OperatingPoint
     weights: Float[Array, " K"]
-    bounds: Bounds = eqx.field(static=True)
+    #: the search box: `Bounds` (R_end, theta_f, Delta_bf) or `ProfileBounds` (the eight
+    #: profile variables); its kind decides the kind of design searched
+    bounds: Bounds | ProfileBounds = eqx.field(static=True)
     duration: float = eqx.field(static=True, default=DEFAULT_DURATION)
     flange_load: float = eqx.field(static=True, default=DEFAULT_FLANGE_LOAD)
     min_clearance: float = eqx.field(static=True, default=0.0)
@@ -267,17 +189,27 @@ class DesignProblem(eqx.Module):
             return self.bearing
         return jax.tree_util.tree_map(lambda a: a[k], self.point_bearings)
 
-    def design(self, u) -> DesignVariables:
-        return DesignVariables.from_array(self.bounds.from_scaled(u))
+    @property
+    def num_variables(self) -> int:
+        """n, the length of the design arrays (3, or 8 for a profile)."""
+        return len(self.bounds.names)
+
+    def design(self, u) -> DesignVariables | ProfileVariables:
+        """The design at the scaled point u (`Bounds.variables`)."""
+        return self.bounds.variables(self.bounds.from_scaled(u))
 
     # -- objective (expensive: one dynamic solve per operating point) --------------------
-    def peak_pv(self, u: Float[Array, 3]) -> Float[Array, " K"]:
+    def peak_pv(self, u: Float[Array, " n"]) -> Float[Array, " K"]:
         """Smooth peak PV [GPa m/s] at every operating point (one vmapped batch)."""
         import diffrax
 
         if self.point_bearings is not None:
             raise UserInputError(
                 "uncertain constants: the start-up objective runs one bearing; use the steady objective"
+            )
+        if self.num_variables != 3:
+            raise UserInputError(
+                "profile bounds: the start-up objective searches R_end, theta_f, Delta_bf; use the steady objective"
             )
 
         design = self.design(u)
@@ -313,17 +245,17 @@ class DesignProblem(eqx.Module):
         m = jax.lax.stop_gradient(jnp.max(pv))
         return m + t * jnp.log(jnp.sum(w * jnp.exp((pv - m) / t)))
 
-    def objective(self, u: Float[Array, 3]) -> Float[Array, ""]:
+    def objective(self, u: Float[Array, " n"]) -> Float[Array, ""]:
         """Robust smooth peak PV [GPa m/s] of the scaled design u."""
         return self.combine(self.peak_pv(u))
 
     # -- constraints (cheap, static) -------------------------------------------------------
-    def margins(self, u: Float[Array, 3]) -> Float[Array, 4]:
+    def margins(self, u: Float[Array, " n"]) -> Float[Array, 4]:
         """Design-zone margins [m] (relief, height, limited circle, clearance), as one compiled
         program per problem structure (`_zone_margins`)."""
         return _zone_margins(self, u)
 
-    def constraints(self, u: Float[Array, 3]) -> Float[Array, 4]:
+    def constraints(self, u: Float[Array, " n"]) -> Float[Array, 4]:
         """Scaled, tightened constraints c(u) = margins / MARGIN_SCALE - tighten >= 0."""
         return self.margins(u) / MARGIN_SCALE - self.tighten
 
@@ -374,6 +306,8 @@ def feasibility_map(problem: DesignProblem, axial_clearance: float, n: int = 81)
     """Design-zone margins over an n x n grid of (R_end, theta_f) within the bounds at fixed
     Delta_bf (`jaxbearing.design_zone_grid`, one vmap). Returns (R_end [m], theta_f [rad],
     DesignZone) with fields of shape (n, n), axis 0 = R_end."""
+    if problem.num_variables != 3:
+        raise UserInputError("feasibility_map: a map of (R_end, theta_f) needs the three-variable bounds")
     lo, hi = problem.bounds.lower, problem.bounds.upper
     r = np.linspace(lo[0], hi[0], n)
     t = np.linspace(lo[1], hi[1], n)
@@ -389,7 +323,7 @@ def feasibility_map(problem: DesignProblem, axial_clearance: float, n: int = 81)
 
 
 @eqx.filter_jit
-def _zone_margins(problem: DesignProblem, u: Float[Array, 3]) -> Float[Array, 4]:
+def _zone_margins(problem: DesignProblem, u: Float[Array, " n"]) -> Float[Array, 4]:
     """`DesignProblem.margins` compiled: called eagerly, the loops inside `zone_margins` compiled
     a program of their own at every call (0.2 s each; 40 calls in one command-line test of the
     search), and inside a traced function the jit is inlined."""
@@ -402,17 +336,46 @@ def _zone_margins(problem: DesignProblem, u: Float[Array, 3]) -> Float[Array, 4]
 
 
 @eqx.filter_jit
-def margins_batch(problem: DesignProblem, u: Float[Array, "N 3"]) -> Float[Array, "N 4"]:
+def margins_batch(problem: DesignProblem, u: Float[Array, "N n"]) -> Float[Array, "N 4"]:
     """Design-zone margins [m] of a batch of scaled designs (one compiled vmap)."""
     return jax.vmap(problem.margins)(u)
 
 
 def any_feasible(problem: DesignProblem, n: int = 41) -> tuple[bool, np.ndarray | None]:
-    """Whether some design on an n^3 grid over the bounds satisfies every (tightened) margin;
-    returns (found, the grid point with the largest minimum margin, scaled u)."""
-    axes = [np.linspace(0.0, 1.0, n if w > 0 else 1) for w in problem.bounds.upper - problem.bounds.lower]
-    uu = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+    """Whether some design on a grid over the bounds satisfies every (tightened) margin;
+    returns (found, the point with the largest minimum margin, scaled u). Three variables: the
+    n^3 grid; more: n^3 points of a Halton sequence over the free variables (a grid of eight
+    variables would be n^8)."""
+    free = (problem.bounds.upper - problem.bounds.lower) > 0
+    if problem.num_variables == 3:
+        axes = [np.linspace(0.0, 1.0, n if f else 1) for f in free]
+        uu = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+    else:
+        uu = np.where(free, halton_points(n**3, problem.num_variables), 0.0)
     c = np.asarray(margins_batch(problem, jnp.asarray(uu))) / MARGIN_SCALE - problem.tighten
     worst = c.min(axis=1)
     i = int(np.argmax(worst))
     return bool(worst[i] > 0), uu[i]
+
+
+#: the first primes: the bases of the Halton sequence, one per variable
+PRIMES = (2, 3, 5, 7, 11, 13, 17, 19, 23, 29, 31, 37)
+
+
+def halton(i: int, base: int) -> float:
+    """The i-th element (i >= 1) of the van der Corput sequence in `base`."""
+    f, r = 1.0, 0.0
+    while i > 0:
+        f /= base
+        r += f * (i % base)
+        i //= base
+    return r
+
+
+def halton_points(count: int, dimension: int, first: int = 1) -> np.ndarray:
+    """`count` points (count, dimension) of the Halton sequence in [0, 1]^dimension, from
+    element `first`; bases the first primes."""
+    if dimension > len(PRIMES):
+        raise ValueError(f"dimension = {dimension}: at most {len(PRIMES)}")
+    rows = [[halton(i, b) for b in PRIMES[:dimension]] for i in range(first, first + count)]
+    return np.array(rows, dtype=float).reshape(count, dimension)

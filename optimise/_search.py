@@ -44,10 +44,10 @@ import numpy as np
 
 from jaxbearing import UserInputError
 from jaxbearing.design import forward_jacobian
-from jaxbearing.flange import DesignVariables
+from jaxbearing.flange import DesignVariables, ProfileVariables
 
 from ._lagrangian import Hyper, IterationReport, augmented_lagrangian_step
-from ._problem import DesignProblem, any_feasible, margins_batch
+from ._problem import DesignProblem, any_feasible, halton_points, margins_batch
 
 
 @dataclasses.dataclass
@@ -81,25 +81,14 @@ class SearchResult:
 
 
 def start_points(problem: DesignProblem, num_starts: int, first: np.ndarray | None = None) -> np.ndarray:
-    """Scaled starts (S, 3): the bearing's own design (clipped to the bounds, or `first`),
-    then a deterministic scrambled-free Halton sequence over the box (bases 2, 3, 5)."""
+    """Scaled starts (S, n): the bearing's own design (clipped to the bounds, or `first`),
+    then a deterministic scrambled-free Halton sequence over the box (bases the first primes)."""
 
     if first is None:
-        first = np.asarray(DesignVariables.of(problem.bearing).as_array())
+        own = DesignVariables if problem.num_variables == 3 else ProfileVariables
+        first = np.asarray(own.of(problem.bearing).as_array())
     u0 = np.clip(np.asarray(problem.bounds.to_scaled(first)), 0.0, 1.0)
-    pts = [u0]
-
-    def halton(i, base):
-        f, r = 1.0, 0.0
-        while i > 0:
-            f /= base
-            r += f * (i % base)
-            i //= base
-        return r
-
-    for i in range(1, num_starts):
-        pts.append(np.array([halton(i, 2), halton(i, 3), halton(i, 5)]))
-    u = np.stack(pts)
+    u = np.concatenate([u0[None], halton_points(num_starts - 1, problem.num_variables)])
     fixed = (problem.bounds.upper - problem.bounds.lower) <= 0
     u[:, fixed] = 0.0
     return u

@@ -52,7 +52,7 @@ CONSTRAINT_NAMES = (*MARGIN_NAMES, "dynamic_corner")
 
 
 def constraints(problem: DesignProblem, u, dynamic_margin: float, u_measured):
-    """Scaled, tightened constraints (5,) and their Jacobian (5, 3): the static ones exactly,
+    """Scaled, tightened constraints (5,) and their Jacobian (5, n): the static ones exactly,
     the dynamic corner margin by its measured value plus the static limited-circle margin's
     change from `u_measured` (module docstring)."""
 
@@ -85,6 +85,15 @@ class SteadySearchResult:
     best_start: int = -1
     best_iteration: int = -1
     verification: dict | None = None
+
+
+def check_profile_settings(problem: DesignProblem, settings: SteadySettings) -> None:
+    """A profile search (eight variables) estimates its gradient with the frozen-load
+    estimator: the short-window sensitivities are written for R_end, theta_f, Delta_bf."""
+    if problem.num_variables != 3 and settings.estimator != "frozen":
+        raise UserInputError(
+            f"estimator = {settings.estimator.value!r}: a profile search needs the frozen-load estimator ('frozen')"
+        )
 
 
 def _checked_starts(problem: DesignProblem, num_starts, num_iterations, starts, initial_states):
@@ -129,7 +138,7 @@ def _iteration(problem: DesignProblem, settings: SteadySettings, hyper: Hyper, s
         rows["points_simulated"].append(env.active[s].copy())
         env.record(problem, settings, s, ev)
         c, jc = constraints(problem, us, ev.dynamic_margin, us)
-        g_obj = ev.gradient if np.all(np.isfinite(ev.gradient)) else np.zeros(3)
+        g_obj = ev.gradient if np.all(np.isfinite(ev.gradient)) else np.zeros(problem.num_variables)
         u_new, opt, act = augmented_lagrangian_step(
             optimiser, hyper.rho, free, g_obj, c, jc, state.lam[s], state.opt[s], jnp.asarray(us)
         )
@@ -199,6 +208,7 @@ def steady_search(
     `[[metrics.final_states]]`: a settled ensemble of the start design with `settings.seeds`
     seeds); a resumed checkpoint's own states win."""
     t_start = time.perf_counter()
+    check_profile_settings(problem, settings)
     u, chains = _checked_starts(problem, num_starts, num_iterations, starts, initial_states)
     x_start = np.asarray(problem.bounds.from_scaled(u[0]))
     hyper = Hyper(float(learning_rate), int(num_iterations), float(rho))
@@ -225,7 +235,7 @@ def steady_search(
         chains=chains,
         history=History(),
         evaluations=0,
-        envelope=Envelope.fresh(u.shape[0], problem.num_operating_points),
+        envelope=Envelope.fresh(u.shape[0], problem.num_operating_points, problem.num_variables),
     )
     path = None if directory is None else pathlib.Path(directory) / CHECKPOINT
     key = fingerprint(problem, settings, hyper, u)

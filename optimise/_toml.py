@@ -11,7 +11,16 @@ from jaxbearing import UserInputError
 
 #: keys of the optional optimiser TOML file (engineering units), with their meaning
 OPTIMISE_TOML_KEYS = {
-    "bounds": ("end_radius_mm", "layback_angle_deg", "axial_clearance_mm"),
+    "bounds": (
+        "end_radius_mm",
+        "layback_angle_deg",
+        "axial_clearance_mm",
+        "end_offset_mm",
+        "corner_radius_mm",
+        "rib_curvature_per_m",
+        "rib_tangent_height_mm",
+        "flange_height_mm",
+    ),
     "constraints": ("min_clearance_mm", "flange_load_N"),
     "envelope": (
         "speeds_rpm",
@@ -24,6 +33,7 @@ OPTIMISE_TOML_KEYS = {
         "uncertain_constants",
     ),
     "search": (
+        "profile",
         "objective",
         "starts",
         "iterations",
@@ -52,14 +62,16 @@ def load_optimise_toml(path: str) -> dict:
     """Read the optimiser's own small TOML file:
 
         [bounds]       end_radius_mm = [60, 120], layback_angle_deg = [1.0, 2.0],
-                       axial_clearance_mm = [0.10, 0.30]
+                       axial_clearance_mm = [0.10, 0.30]; a profile search (any of these, or
+                       [search] profile = true): end_offset_mm, corner_radius_mm,
+                       rib_curvature_per_m, rib_tangent_height_mm, flange_height_mm
         [constraints]  min_clearance_mm = 0.0, flange_load_N = 100
         [envelope]     speeds_rpm = [...], loads_N = [...], weights = [...],
                        aggregate = "max" | "mean", temperature_GPa_m_s = 0.1,
                        skip_weight = 1e-3, recheck_every = 3 (steady: the active set),
                        uncertain_constants = ["lubricant.traction_d", ...] (steady: every
                        point also at every corner of these constants' ranges)
-        [search]       objective = "steady" | "startup", starts, iterations, learning_rate,
+        [search]       profile = true | false, objective = "steady" | "startup", starts, iterations, learning_rate,
                        rtol; steady: seeds, window_revs, settle, gradient_window_ms, estimator,
                        corner_margin_mm, corner_constraint, choose, clearance_step_mm, statistic,
                        verify_seeds, corner_risk_level, workers;
@@ -89,7 +101,7 @@ def load_optimise_toml(path: str) -> dict:
     return out
 
 
-_PAIRS = ("end_radius_mm", "layback_angle_deg", "axial_clearance_mm")
+_PAIRS = OPTIMISE_TOML_KEYS["bounds"]
 _LISTS = ("speeds_rpm", "loads_N", "weights")
 _TEXTS = ("aggregate", "objective", "estimator", "statistic", "corner_constraint", "choose")
 _INTS = ("starts", "iterations", "seeds", "window_revs", "verify_seeds", "workers", "recheck_every")
@@ -129,6 +141,9 @@ def _checked_toml_value(path, name: str, key: str, value):
     elif key == "uncertain_constants":
         if not (isinstance(value, list) and value and all(isinstance(v, str) for v in value)):
             raise bad("a list of configuration keys (strings)")
+    elif key == "profile":
+        if not isinstance(value, bool):
+            raise bad("true or false")
     elif key == "settle":
         if value != "auto" and not _is_number(value):
             raise bad('"auto" or a settling time in ms')

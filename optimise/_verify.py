@@ -14,7 +14,7 @@ from __future__ import annotations
 import jax.numpy as jnp
 import numpy as np
 
-from jaxbearing.flange import DesignVariables
+from jaxbearing.flange import variables_from_array
 from jaxbearing.run import Estimate, revolutions_needed
 
 from ._evaluate import in_shared_pool, operating_points, settled_metrics
@@ -39,6 +39,12 @@ def _estimates(m) -> dict:
         # the mean of the worst 5 % of PV over contact time (the "tail" statistic)
         "tail_pv_GPa_m_s": _scaled(nothing if st is None else st.flange_pv_contact_time_Pa_m_s.tail95),
         "corner_contact_share": m.corner_contact_share.as_dict(),
+        # what the faces are designed for besides PV (docs/model.md 5.5): total flange friction
+        # power, the largest flash temperature rise of a contact event (mean per revolution),
+        # and the film parameter Lambda (its 5th percentile over contact time)
+        "friction_power_W": _scaled(nothing if st is None else st.flange_friction_power_W.total, 1.0),
+        "flash_temperature_K": _scaled(nothing if st is None else st.flange_flash_temperature_K.max, 1.0),
+        "film_parameter_p05": _scaled(nothing if st is None else st.film_parameter.p05, 1.0),
         "corner_margin_mm": _scaled(m.corner_margin, 1e-3),
         # the margin on the upper 95 % prediction bound of one revolution's largest contact radius
         "corner_margin_bound_mm": float(m.corner_margin_bound) * 1e3,
@@ -66,7 +72,7 @@ def verification(problem: DesignProblem, settings: SteadySettings, design, refer
         "seeds": list(range(settings.verify_first_seed, settings.verify_first_seed + settings.verify_seeds))
     }
     ops = operating_points(problem)
-    designs = [DesignVariables.from_array(jnp.asarray(x)) for x in (reference, design)]
+    designs = [variables_from_array(jnp.asarray(x)) for x in (reference, design)]
     metrics = settled_metrics(
         problem,
         settings,
@@ -96,6 +102,15 @@ def verification(problem: DesignProblem, settings: SteadySettings, design, refer
     if len(ops) > 1:
         out["mean_pv_lower_disjoint_per_operating_point"] = lower("mean_pv_GPa_m_s")
         out["objective_lower_disjoint_per_operating_point"] = lower("objective_GPa_m_s")
+    # "not worse": the optimum's interval not wholly on the wrong side of the reference's
+    out["friction_power_not_worse"] = all(
+        _not_worse(r["friction_power_W"], o["friction_power_W"], higher_is_better=False)
+        for r, o in zip(refs, opts)
+    )
+    out["film_parameter_not_worse"] = all(
+        _not_worse(r["film_parameter_p05"], o["film_parameter_p05"], higher_is_better=True)
+        for r, o in zip(refs, opts)
+    )
     out["optimum_corner_contacts"] = any((o["corner_contact_share"].get("value") or 0.0) > 0 for o in opts)
     for name in ("reference", "optimum"):  # the weakest bound over the operating points
         rows = out[name].get("per_operating_point", [out[name]])
@@ -106,6 +121,21 @@ def verification(problem: DesignProblem, settings: SteadySettings, design, refer
             )
     out["tail"] = tail_verification(opts, settings.corner_risk_level)
     return out
+
+
+def _not_worse(reference: dict, optimum: dict, *, higher_is_better: bool) -> bool:
+    """Whether the optimum's 95 % interval is not wholly on the worse side of the reference's
+    (unknown intervals count as not worse: nothing shows them worse)."""
+    if None in (
+        reference.get("ci95_low"),
+        reference.get("ci95_high"),
+        optimum.get("ci95_low"),
+        optimum.get("ci95_high"),
+    ):
+        return True
+    if higher_is_better:
+        return bool(optimum["ci95_high"] >= reference["ci95_low"])
+    return bool(optimum["ci95_low"] <= reference["ci95_high"])
 
 
 def tail_verification(rows: list[dict], level: float) -> dict:

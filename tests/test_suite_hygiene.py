@@ -346,6 +346,17 @@ CLI_CHECKS = {
     ("optimise", "run", "--layback-deg"): [_OPT_FILE],
     ("optimise", "run", "--clearance-mm"): [_STEADY_CLI, "test_optimise.py::test_cli_end_to_end"],
     ("optimise", "run", "--min-clearance-mm"): [_OPT_FILE],
+    **{
+        ("optimise", "run", option): ["test_optimise_profile.py::test_cli_profile_options_reach_the_problem"]
+        for option in (
+            "--profile",
+            "--end-offset-mm",
+            "--corner-radius-mm",
+            "--rib-curvature-per-m",
+            "--rib-tangent-height-mm",
+            "--flange-height-mm",
+        )
+    },
     ("optimise", "run", "--flange-load-N"): [_OPT_FILE],
     ("optimise", "run", "--speeds-rpm"): [_OPT_FILE],
     ("optimise", "run", "--loads-N"): [_OPT_FILE],
