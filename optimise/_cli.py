@@ -251,6 +251,18 @@ def build_parser() -> argparse.ArgumentParser:
         "risk) and the verification must bound (upper 95 %% bound) at every operating point, else the design "
         f"is reported unverified in the tail (default: {st.corner_risk_level:g})",
     )
+    r.add_argument(
+        "--min-film-parameter",
+        type=float,
+        help="steady: the film parameter Lambda the design must keep: the lower 95 %% bound of Lambda's 5th "
+        "percentile over contact time at least this at every operating point (default: no limit)",
+    )
+    r.add_argument(
+        "--max-flash-temperature-K",
+        type=float,
+        help="steady: the flash temperature rise at the rib the design must stay under [K]: the upper 95 %% "
+        "bound of a revolution's largest rise at most this at every operating point (default: no limit)",
+    )
     r.add_argument("--no-verify", action="store_true", help="steady: skip the verification (default: verify)")
     r.add_argument(
         "--workers",

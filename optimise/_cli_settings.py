@@ -93,6 +93,8 @@ def _settings(args) -> dict:
         ("recheck_every", args.recheck_every),
         ("verify_seeds", args.verify_seeds),
         ("corner_risk_level", args.corner_risk_level),
+        ("min_film_parameter", args.min_film_parameter),
+        ("max_flash_temperature_K", args.max_flash_temperature_K),
         ("workers", args.workers),
         ("learning_rate", args.learning_rate),
         ("duration_ms", args.duration_ms),
@@ -216,7 +218,14 @@ def steady_settings_from(s: dict):
         skip_weight=_positive(s, "skip_weight", st.skip_weight, strict=False),
         recheck_every=int(_positive(s, "recheck_every", st.recheck_every, int)),
         corner_risk_level=float(s.get("corner_risk_level", st.corner_risk_level)),
+        min_film_parameter=_optional_positive(s, "min_film_parameter"),
+        max_flash_temperature=_optional_positive(s, "max_flash_temperature_K"),
     )
+
+
+def _optional_positive(s: dict, key: str) -> float | None:
+    """A limit that is off unless given (> 0 when given)."""
+    return None if s.get(key) is None else _positive(s, key, None)
 
 
 def check_start_design(cfg, problem) -> None:

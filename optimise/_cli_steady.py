@@ -18,7 +18,7 @@ def run_steady(args, problem, options, settings, out, meta=None) -> int:
 
     from ._plot import plot_search
     from ._state import CHECKPOINT
-    from ._steady import CONSTRAINT_NAMES, steady_search
+    from ._steady import constraint_names, steady_search
 
     k = problem.num_operating_points
     print(
@@ -29,12 +29,14 @@ def run_steady(args, problem, options, settings, out, meta=None) -> int:
     )
     sys.stdout.flush()
 
+    names = constraint_names(settings)
+
     def start_line(j, info, m, w):
         lo, hi = info.ci[j]
         g = info.gradient[j]
         return (
             f"J {info.objective[j]:7.4f} [{lo:.4f}, {hi:.4f}] GPa m/s  "
-            f"min margin {CONSTRAINT_NAMES[w]} {m[w] * 1e3:+.4f} mm  {_design_text(info.x[j])}  "
+            f"min margin {names[w]} {_margin_value(names[w], m[w])}  {_design_text(info.x[j])}  "
             f"dJ/du ({', '.join(f'{v:+.3f}' for v in g)})"
         )
 
@@ -167,6 +169,8 @@ def _steady_result_json(problem, options, settings, res) -> dict:
 
     import numpy as np
 
+    from ._steady import constraint_names
+
     h = res.history
     return {
         "objective_kind": "steady",
@@ -210,7 +214,7 @@ def _steady_result_json(problem, options, settings, res) -> dict:
         "simulated_ms": float(np.sum(h.simulated_ms)) if len(h) else 0.0,
         "resumed_from_iteration": res.resumed_from,
         "wall_time_s": res.wall_time_s,
-        "history": _history_json(h, problem.bounds),
+        "history": _history_json(h, problem.bounds, constraint_names(settings)),
     }
 
 
@@ -267,7 +271,16 @@ def _clearance_json(problem, settings, res) -> dict:
     }
 
 
-def _history_json(h, bounds) -> dict:
+def _margin_value(name: str, value: float) -> str:
+    """One margin in its unit: mm for the geometric ones, Lambda or K for the limits."""
+    if name == "film_parameter":
+        return f"{value:+.3f}"
+    if name == "flash_temperature":
+        return f"{value:+.1f} K"
+    return f"{value * 1e3:+.4f} mm"
+
+
+def _history_json(h, bounds, names) -> dict:
     """The search's history in engineering units (per iteration and start): every design
     variable by its key (`end_radius_mm`, ...)."""
     import numpy as np
@@ -275,7 +288,14 @@ def _history_json(h, bounds) -> dict:
     from ._steady import CONSTRAINT_NAMES
 
     x = np.asarray(h.x) if len(h) else np.zeros((0, 0, len(bounds.names)))
-    margins = np.asarray(h.margins) if len(h) else np.zeros((0, 0, 5))
+    margins = np.asarray(h.margins) if len(h) else np.zeros((0, 0, len(names)))
+    limits = {
+        {"film_parameter": "film_parameter", "flash_temperature": "flash_temperature_K"}[n]: margins[
+            ..., i
+        ].tolist()
+        for i, n in enumerate(names)
+        if i >= len(CONSTRAINT_NAMES)
+    }
     return {
         "objective_GPa_m_s": np.asarray(h.objective).tolist(),
         "ci95_GPa_m_s": np.asarray(h.ci).tolist(),
@@ -283,6 +303,8 @@ def _history_json(h, bounds) -> dict:
         "gradient_stderr": np.asarray(h.gradient_stderr).tolist(),
         **{var.key: (x[..., i] * var.scale).tolist() for i, var in enumerate(bounds.TABLE)},
         "margins_mm": {n: (margins[..., i] * 1e3).tolist() for i, n in enumerate(CONSTRAINT_NAMES)},
+        # the limits' margins in their own units (Lambda - limit; limit - K), when set
+        **({"limit_margins": limits} if limits else {}),
         # the upper 95 % bound of the corner-contact risk per revolution, worst operating point
         "corner_risk_per_revolution_upper95": np.asarray(h.corner_risk, float).tolist(),
         "wall_s": np.asarray(h.wall_s).tolist(),

@@ -60,6 +60,8 @@ class Envelope:
     share: np.ndarray
     settled: np.ndarray
     risk: np.ndarray
+    film: np.ndarray  # the lower bound of Lambda's 5th percentile (`PointRecord`)
+    flash: np.ndarray  # the upper bound of the largest flash temperature rise [K]
 
     @classmethod
     def fresh(cls, num_starts: int, num_points: int, num_variables: int = 3) -> Envelope:
@@ -78,6 +80,8 @@ class Envelope:
             share=nan.copy(),
             settled=np.zeros(shape, bool),
             risk=nan.copy(),
+            film=nan.copy(),
+            flash=nan.copy(),
         )
 
     def record(self, problem: DesignProblem, settings: SteadySettings, s: int, ev: Evaluation) -> None:
@@ -92,6 +96,7 @@ class Envelope:
             self.corner_margin[s, k], self.measured_at[s, k] = p.measured_corner_margin, p.measured_at
             self.share[s, k], self.settled[s, k] = p.corner_contact_share, p.settled
             self.risk[s, k] = p.corner_risk
+            self.film[s, k], self.flash[s, k] = p.film_parameter_low, p.flash_temperature_high
         self.active[s] = next_active(problem, settings, ev, self.since[s])
 
     def previous(self, s: int, states) -> Previous | None:
@@ -112,6 +117,8 @@ class Envelope:
                 settled=bool(self.settled[s, k]),
                 simulated=False,
                 corner_risk=float(self.risk[s, k]),
+                film_parameter_low=float(self.film[s, k]),
+                flash_temperature_high=float(self.flash[s, k]),
             )
             for k in range(self.value.shape[1])
         ]

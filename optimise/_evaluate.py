@@ -61,6 +61,10 @@ class PointRecord:
     estimator_value: float = float("nan")  # the gradient estimator's own objective [GPa m/s]
     #: the upper 95 % bound of the corner-contact risk per cage revolution (`run.corner_risk`)
     corner_risk: float = float("nan")
+    #: the lower 95 % bound of the 5th percentile of the film parameter Lambda over contact time
+    film_parameter_low: float = float("nan")
+    #: the upper 95 % bound of a revolution's largest flash temperature rise at the rib [K]
+    flash_temperature_high: float = float("nan")
 
 
 @dataclasses.dataclass
@@ -79,6 +83,9 @@ class Evaluation:
     simulated_ms: float  # simulated time of every seed's settling, window and gradient samples
     #: the largest upper bound of the corner-contact risk per revolution over the points
     corner_risk: float = float("nan")
+    #: per limit of `SteadySettings.limits`, its margin at the worst operating point in the
+    #: limit's own unit (Lambda - limit; limit - K), +inf where no point measured it
+    limit_margins: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros(0))
 
 
 @dataclasses.dataclass(frozen=True)
@@ -307,10 +314,36 @@ def _risk_upper(m) -> float:
     return float("nan") if risk is None else float(risk.upper)
 
 
+def _limit_readouts(m) -> tuple[float, float]:
+    """(lower 95 % bound of Lambda's 5th percentile over contact time, upper 95 % bound of a
+    revolution's largest flash temperature rise [K]) of one point's metrics `m` (NaN: not
+    measured, e.g. no flange contact)."""
+    st = m.statistics
+    if st is None:
+        return float("nan"), float("nan")
+    return float(st.film_parameter.p05.ci95_low), float(st.flange_flash_temperature_K.max.ci95_high)
+
+
+def limit_margins(settings: SteadySettings, per: list[PointRecord]) -> np.ndarray:
+    """The margin of every limit of `settings.limits` at the worst operating point of `per`, in
+    the limit's unit: min_k Lambda_k^lo - Lambda_min and T_max - max_k T_k^hi; a point that did
+    not measure it (no flange contact, no film or heat to limit) is left out, +inf if none did."""
+    out = []
+    for name, limit in settings.limits:
+        if name == "film_parameter":
+            values = [p.film_parameter_low - limit for p in per]
+        else:
+            values = [limit - p.flash_temperature_high for p in per]
+        known = [v for v in values if np.isfinite(v)]
+        out.append(min(known) if known else np.inf)
+    return np.asarray(out, dtype=float)
+
+
 def _measured_record(settings: SteadySettings, u, m, g, width) -> PointRecord:
     """The record of one simulated operating point from its metrics `m` and gradient `g`."""
     j = m.objective
     margin = corner_margin_of(settings, m)
+    film, flash = _limit_readouts(m)
     return PointRecord(
         value=float(j.value) / PV_SCALE,
         ci=(float(j.ci95_low) / PV_SCALE, float(j.ci95_high) / PV_SCALE),
@@ -324,6 +357,8 @@ def _measured_record(settings: SteadySettings, u, m, g, width) -> PointRecord:
         settled=m.settled,
         simulated=True,
         corner_risk=_risk_upper(m),
+        film_parameter_low=film,
+        flash_temperature_high=flash,
     )
 
 
@@ -371,6 +406,7 @@ def _evaluation(problem, settings, u, measured, previous, wall, gradient: bool) 
         wall_time_s=wall,
         simulated_ms=simulated,
         corner_risk=worst_risk([p.corner_risk for p in per]),
+        limit_margins=limit_margins(settings, per),
     )
 
 

@@ -39,7 +39,7 @@ from ._evaluate import evaluate_starts, in_shared_pool
 from ._problem import DesignProblem, margins_batch
 from ._settings import SteadySettings
 from ._state import load_checkpoint, save_checkpoint
-from ._steady import constraints, interval_bounds
+from ._steady import constraints, interval_bounds, scaled_limits
 
 #: the fitness offset of an infeasible design [GPa m/s]: far above every objective
 INFEASIBLE = 1e3
@@ -106,7 +106,9 @@ def _generation(problem: DesignProblem, settings: SteadySettings, us: np.ndarray
     evs = evaluate_starts(problem, settings, list(us[inside]), None, gradient=False) if inside.any() else []
     np.random.set_state(state)
     for i, ev in zip(np.flatnonzero(inside), evs):
-        c, _ = constraints(problem, us[i], ev.dynamic_margin, us[i])
+        c, _ = constraints(
+            problem, us[i], ev.dynamic_margin, us[i], scaled_limits(settings, ev.limit_margins)
+        )
         row["objective"][i], row["ci"][i] = ev.objective, ev.objective_ci
         row["violation"][i] = float(np.sum(np.minimum(c, 0.0) ** 2) ** 0.5)
         row["feasible"][i] = bool(np.all(c > 0) and np.isfinite(ev.objective))

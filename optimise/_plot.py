@@ -31,7 +31,7 @@ def _draw_corner_margin(ax, rr, tt, z, result, h) -> None:
     """A steady search's dynamic corner margin (five margins per iterate in the history `h`):
     its zero line, dashed, where it falls on the grid."""
     margins = np.asarray(h.get("margins", [])) if h else np.zeros(0)
-    if margins.ndim == 3 and margins.shape[-1] == 5 and getattr(result, "best_iteration", -1) >= 0:
+    if margins.ndim == 3 and margins.shape[-1] >= 5 and getattr(result, "best_iteration", -1) >= 0:
         # steady search: the dynamic corner margin, with the skew excursion max - rho_c measured
         # at the final design: limited-circle margin = excursion + corner margin
         m = margins[result.best_iteration, result.best_start]
@@ -126,7 +126,7 @@ def _near_optimal(result) -> list:
     search."""
     h = _history(result)
     margins = np.asarray(h.get("margins", [])) if h else np.zeros(0)
-    if margins.ndim != 3 or margins.shape[-1] != 5:
+    if margins.ndim != 3 or margins.shape[-1] < 5:
         return []
     from ._steady import near_optimal_set
 

@@ -136,6 +136,12 @@ class SteadySettings:
     skip_weight: float = 1e-3
     #: ... for at most this many iterations in a row
     recheck_every: int = 3
+    #: the film parameter the design must keep (None: no limit): the lower 95 % bound of the
+    #: 5th percentile of Lambda over contact time >= this at every operating point
+    min_film_parameter: float | None = None
+    #: the flash temperature rise at the rib the design must stay under [K] (None: no limit):
+    #: the upper 95 % bound of a revolution's largest rise (its mean per revolution) <= this
+    max_flash_temperature: float | None = None
 
     def __post_init__(self):
         """One-line errors naming the setting, before anything runs; a choice given by its name
@@ -180,6 +186,15 @@ class SteadySettings:
         require("corner_margin", self.corner_margin, lambda v: np.isfinite(v) & (v >= 0), ">= 0 m")
         require("rtol", self.rtol, lambda v: np.isfinite(v) & (v > 0) & (v < 1), "in (0, 1)")
         require("workers", self.workers, lambda v: (v >= 0) & (v == np.round(v)), "an integer >= 0")
+        if self.min_film_parameter is not None:
+            require("min_film_parameter", self.min_film_parameter, lambda v: np.isfinite(v) & (v > 0), "> 0")
+        if self.max_flash_temperature is not None:
+            require(
+                "max_flash_temperature",
+                self.max_flash_temperature,
+                lambda v: np.isfinite(v) & (v > 0),
+                "> 0 K",
+            )
         if self.clearance_step != "auto":
             if isinstance(self.clearance_step, str):
                 raise UserInputError(
@@ -191,6 +206,18 @@ class SteadySettings:
                 lambda v: np.isfinite(v) & (v >= 0) & (v < 1e-3),
                 "'auto' or in [0, 1e-3) m",
             )
+
+    @property
+    def limits(self) -> tuple[tuple[str, float], ...]:
+        """The limits set on what the faces are designed for besides PV, as (constraint name,
+        value): "film_parameter" (`min_film_parameter`), "flash_temperature"
+        (`max_flash_temperature`), in that order; empty without limits."""
+        out = []
+        if self.min_film_parameter is not None:
+            out.append(("film_parameter", float(self.min_film_parameter)))
+        if self.max_flash_temperature is not None:
+            out.append(("flash_temperature", float(self.max_flash_temperature)))
+        return tuple(out)
 
     def measurement(self, *, verification: bool = False) -> run.SteadySettings:
         """The settled-run settings of one evaluation (or, with `verification`, of the

@@ -30,7 +30,7 @@ CHECKPOINT = "checkpoint.npz"
 LEGACY_CHECKPOINT = "checkpoint.pkl"
 #: version of the measured objective, margins and state layout, part of a checkpoint's
 #: fingerprint: a checkpoint of another version is refused, not resumed
-MEASUREMENT_VERSION = 7
+MEASUREMENT_VERSION = 8
 
 
 @jax.tree_util.register_dataclass
@@ -38,12 +38,14 @@ MEASUREMENT_VERSION = 7
 class History:
     """Per iteration, per start: what the search measured (lists of arrays, one per iteration)."""
 
-    x: list = dataclasses.field(default_factory=list)  # (S, 3) designs [SI]
+    x: list = dataclasses.field(default_factory=list)  # (S, n) designs [SI]
     objective: list = dataclasses.field(default_factory=list)  # (S,) [GPa m/s]
     ci: list = dataclasses.field(default_factory=list)  # (S, 2)
-    gradient: list = dataclasses.field(default_factory=list)  # (S, 3) per unit box
-    gradient_stderr: list = dataclasses.field(default_factory=list)  # (S, 3)
-    margins: list = dataclasses.field(default_factory=list)  # (S, 5) [m]: static, then dynamic
+    gradient: list = dataclasses.field(default_factory=list)  # (S, n) per unit box
+    gradient_stderr: list = dataclasses.field(default_factory=list)  # (S, n)
+    #: (S, 5 + L): the static margins and the dynamic corner margin [m], then the margins of
+    #: the L limits of `SteadySettings.limits` in their own units (Lambda; K)
+    margins: list = dataclasses.field(default_factory=list)
     wall_s: list = dataclasses.field(default_factory=list)  # (S,)
     simulated_ms: list = dataclasses.field(default_factory=list)  # (S,)
     points_simulated: list = dataclasses.field(default_factory=list)  # (S, K) bool
@@ -69,9 +71,9 @@ class SearchState:
     """Everything the search needs to continue after iteration `iteration` (-1: none yet)."""
 
     iteration: int
-    u: np.ndarray  # (S, 3) the next iterates, scaled
+    u: np.ndarray  # (S, n) the next iterates, scaled
     opt: list  # per start: the optimiser's state
-    lam: np.ndarray  # (S, 5) multipliers
+    lam: np.ndarray  # (S, 5 + L) multipliers
     chains: list  # per start: None or per operating point the settled states to continue from
     history: History
     evaluations: int  # settled ensembles run

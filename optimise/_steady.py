@@ -49,12 +49,33 @@ from ._verify import verification
 
 #: names of the five constraints of the steady search (static zone margins, then dynamic)
 CONSTRAINT_NAMES = (*MARGIN_NAMES, "dynamic_corner")
+#: the scale of each limit's margin (`SteadySettings.limits`): Lambda in units of 0.1, the
+#: flash temperature in units of 10 K, so that the scaled constraints are O(1) like the others
+LIMIT_SCALES = {"film_parameter": 0.1, "flash_temperature": 10.0}
+#: a limit no operating point measured (+inf margin) enters as this scaled value: far from
+#: binding, and finite in the augmented Lagrangian's arithmetic
+UNMEASURED_LIMIT = 1e3
 
 
-def constraints(problem: DesignProblem, u, dynamic_margin: float, u_measured):
-    """Scaled, tightened constraints (5,) and their Jacobian (5, n): the static ones exactly,
-    the dynamic corner margin by its measured value plus the static limited-circle margin's
-    change from `u_measured` (module docstring)."""
+def constraint_names(settings: SteadySettings) -> tuple[str, ...]:
+    """The names of the search's constraints: `CONSTRAINT_NAMES`, then the limits set."""
+    return (*CONSTRAINT_NAMES, *(name for name, _ in settings.limits))
+
+
+def scaled_limits(settings: SteadySettings, margins) -> np.ndarray:
+    """The limits' margins (`Evaluation.limit_margins`) as scaled, tightened constraints."""
+    scales = np.array([LIMIT_SCALES[name] for name, _ in settings.limits])
+    scaled = np.asarray(margins, dtype=float) / scales if len(scales) else np.zeros(0)
+    return np.minimum(scaled, UNMEASURED_LIMIT)
+
+
+def constraints(problem: DesignProblem, u, dynamic_margin: float, u_measured, limits=()):
+    """Scaled, tightened constraints (5 + L,) and their Jacobian (5 + L, n): the static ones
+    exactly, the dynamic corner margin by its measured value plus the static limited-circle
+    margin's change from `u_measured` (module docstring); then the L limits (`scaled_limits`:
+    film parameter, flash temperature) held at their measured values over one step (no
+    derivative of their own: a zero row; a limit binds through the choice of the returned
+    design and through its multiplier's pull on the step that crossed it)."""
 
     def c(v):
         static = problem.margins(v)
@@ -64,7 +85,10 @@ def constraints(problem: DesignProblem, u, dynamic_margin: float, u_measured):
         return jnp.concatenate([static, dyn[None]]) / MARGIN_SCALE - problem.tighten
 
     u = jnp.asarray(u)
-    return np.asarray(c(u)), np.asarray(jax.jacfwd(c)(u))
+    held = np.asarray(limits, dtype=float) - problem.tighten
+    value = np.concatenate([np.asarray(c(u)), held])
+    jac = np.concatenate([np.asarray(jax.jacfwd(c)(u)), np.zeros((held.size, u.size))])
+    return value, jac
 
 
 @dataclasses.dataclass
@@ -137,7 +161,7 @@ def _iteration(problem: DesignProblem, settings: SteadySettings, hyper: Hyper, s
         state.evaluations += int(np.sum(env.active[s]))
         rows["points_simulated"].append(env.active[s].copy())
         env.record(problem, settings, s, ev)
-        c, jc = constraints(problem, us, ev.dynamic_margin, us)
+        c, jc = constraints(problem, us, ev.dynamic_margin, us, scaled_limits(settings, ev.limit_margins))
         g_obj = ev.gradient if np.all(np.isfinite(ev.gradient)) else np.zeros(problem.num_variables)
         u_new, opt, act = augmented_lagrangian_step(
             optimiser, hyper.rho, free, g_obj, c, jc, state.lam[s], state.opt[s], jnp.asarray(us)
@@ -145,7 +169,7 @@ def _iteration(problem: DesignProblem, settings: SteadySettings, hyper: Hyper, s
         u_next.append(np.asarray(u_new))
         opt_next.append(opt)
         lam_next.append(np.asarray(act))
-        margins = np.concatenate([ev.static_margins, [ev.dynamic_margin]])
+        margins = np.concatenate([ev.static_margins, [ev.dynamic_margin], ev.limit_margins])
         x = np.asarray(problem.bounds.from_scaled(us))
         for name, value in _row(ev, x, margins).items():
             rows[name].append(value)
@@ -231,7 +255,7 @@ def steady_search(
         iteration=-1,
         u=u,
         opt=[hyper.optimiser().init(jnp.asarray(ui)) for ui in u],
-        lam=np.zeros((u.shape[0], len(CONSTRAINT_NAMES))),
+        lam=np.zeros((u.shape[0], len(constraint_names(settings)))),
         chains=chains,
         history=History(),
         evaluations=0,
@@ -292,7 +316,7 @@ def choose(h: History, how: Choice | str) -> tuple | None:
         return best
     risk = np.asarray(h.corner_risk, float)
     risk = np.where(np.isfinite(risk), risk, 1.0)  # an unknown risk is not the safest
-    dynamic = np.asarray(h.margins, float)[..., -1]
+    dynamic = np.asarray(h.margins, float)[..., len(CONSTRAINT_NAMES) - 1]
     candidates = np.argwhere(tied)
     order = sorted(candidates.tolist(), key=lambda i: (risk[tuple(i)], -dynamic[tuple(i)]))
     return tuple(order[0])
@@ -329,12 +353,12 @@ class NearOptimal:
     """A feasible design the search evaluated that is statistically tied with the best
     (`tied_with_best`), with its corner-contact risk and margins."""
 
-    design: np.ndarray  # (R_end, theta_f, Delta_bf) [SI]
+    design: np.ndarray  # (R_end, theta_f, Delta_bf) or the profile's eight [SI]
     objective: float  # [GPa m/s]
     ci95: tuple
     iteration: int
     start: int
-    binding_margin: str  # the smallest of its margins (`CONSTRAINT_NAMES`)
+    binding_margin: str  # the smallest of its margins in m (`CONSTRAINT_NAMES`)
     binding_margin_m: float
     corner_risk: float  # the upper 95 % bound of the corner-contact risk per revolution (worst point)
     corner_margin_m: float  # the dynamic corner margin (`SteadySettings.corner_constraint`)
@@ -350,8 +374,9 @@ def near_optimal_set(result: SteadySearchResult) -> list[NearOptimal]:
     if result.design is None or not len(h):
         return []
     tied, _ = tied_with_best(h)
-    x, objective = np.asarray(h.x), np.asarray(h.objective, float)  # (I, S, 3), (I, S)
-    ci, margins = np.asarray(h.ci, float), np.asarray(h.margins, float)  # (I, S, 2), (I, S, 5)
+    x, objective = np.asarray(h.x), np.asarray(h.objective, float)  # (I, S, n), (I, S)
+    ci = np.asarray(h.ci, float)  # (I, S, 2)
+    margins = np.asarray(h.margins, float)[..., : len(CONSTRAINT_NAMES)]  # (I, S, 5) [m]
     risk = np.asarray(h.corner_risk, float)
     out = []
     for it, s in zip(*np.nonzero(tied)):

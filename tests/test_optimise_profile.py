@@ -212,3 +212,113 @@ def test_meridians_match_their_closed_forms(tmp_path):
     assert plot_faces(
         BEARING, {"a": x, "b": ProfileVariables.of(BEARING).as_array()}, tmp_path / "f.png"
     ).exists()
+
+
+# -- limits on what the faces are designed for besides PV: Lambda and the flash temperature ---
+
+
+@pytest.mark.parametrize(
+    "kw,text",
+    [
+        (dict(min_film_parameter=0.0), "min_film_parameter = 0.0: must be > 0"),
+        (dict(min_film_parameter=float("nan")), "min_film_parameter = nan"),
+        (dict(max_flash_temperature=-5.0), "max_flash_temperature = -5.0: must be > 0 K"),
+    ],
+)
+def test_bad_limits_are_one_line(kw, text):
+    with pytest.raises(UserInputError, match=text):
+        opt.SteadySettings(**kw)
+
+
+def _record(film, flash):
+    return evaluation.PointRecord(
+        value=1.0,
+        ci=(0.9, 1.1),
+        gradient=np.zeros(3),
+        gradient_stderr=np.zeros(3),
+        corner_margin=1e-4,
+        measured_corner_margin=1e-4,
+        measured_at=np.zeros(3),
+        corner_contact_share=0.0,
+        settled=True,
+        simulated=True,
+        film_parameter_low=film,
+        flash_temperature_high=flash,
+    )
+
+
+def test_limit_margins_take_the_worst_measured_point():
+    import optimise._steady as steady
+
+    settings = opt.SteadySettings(min_film_parameter=1.5, max_flash_temperature=80.0)
+    assert settings.limits == (("film_parameter", 1.5), ("flash_temperature", 80.0))
+    assert steady.constraint_names(settings)[-2:] == ("film_parameter", "flash_temperature")
+    per = [_record(2.0, 60.0), _record(1.7, 90.0), _record(float("nan"), float("nan"))]
+    np.testing.assert_allclose(evaluation.limit_margins(settings, per), [0.2, -10.0])
+    # no point measured a film (no flange contact): nothing to limit
+    unmeasured = evaluation.limit_margins(settings, [_record(float("nan"), float("nan"))])
+    assert np.all(np.isinf(unmeasured))
+    scaled = steady.scaled_limits(settings, unmeasured)
+    assert np.all(scaled == steady.UNMEASURED_LIMIT)
+    assert evaluation.limit_margins(opt.SteadySettings(), per).shape == (0,)
+
+
+def test_limits_are_held_constraints_and_decide_feasibility():
+    import optimise._steady as steady
+    from optimise._state import History
+
+    problem = opt.make_problem(BEARING, OP)
+    settings = opt.SteadySettings(min_film_parameter=1.5, max_flash_temperature=80.0)
+    u = jnp.full(3, 0.5)
+    limits = steady.scaled_limits(settings, [0.2, -10.0])
+    np.testing.assert_allclose(limits, [2.0, -1.0])
+    c, jc = steady.constraints(problem, u, 1e-4, u, limits)
+    c0, jc0 = steady.constraints(problem, u, 1e-4, u)
+    assert c.shape == (7,) and jc.shape == (7, 3)
+    np.testing.assert_array_equal(c[:5], c0)
+    np.testing.assert_array_equal(jc[:5], jc0)
+    np.testing.assert_allclose(c[5:], limits - problem.tighten)
+    assert np.all(jc[5:] == 0)
+    # an evaluation over its flash limit is infeasible, however good its objective
+    h = History()
+    for margins, objective in (([1e-4] * 5 + [0.2, -10.0], 1.0), ([1e-4] * 5 + [0.2, 5.0], 2.0)):
+        h.append(
+            dict(
+                x=[np.zeros(3)],
+                objective=[objective],
+                ci=[(objective - 0.1, objective + 0.1)],
+                gradient=[np.zeros(3)],
+                gradient_stderr=[np.zeros(3)],
+                margins=[np.array(margins)],
+                wall_s=[1.0],
+                simulated_ms=[1.0],
+                points_simulated=[np.ones(1, bool)],
+                corner_risk=[1e-4],
+            )
+        )
+    assert steady.choose(History(**h.as_arrays()), "best") == (1, 0)
+
+
+def test_cli_limits_reach_the_settings(tmp_path, capsys, monkeypatch):
+    seen = []
+
+    def recording(problem, settings, **kw):
+        seen.append(settings)
+        raise UserInputError("stop here")
+
+    import optimise._steady as steady
+
+    monkeypatch.setattr(steady, "steady_search", recording)
+    args = [
+        "run",
+        "--min-film-parameter",
+        "1.5",
+        "--max-flash-temperature-K",
+        "80",
+        "--out",
+        str(tmp_path / "r"),
+    ]
+    assert cli.main(args) == 2
+    assert seen[0].limits == (("film_parameter", 1.5), ("flash_temperature", 80.0))
+    assert cli.main(["run", "--min-film-parameter", "-1", "--out", str(tmp_path / "s")]) == 2
+    assert "min_film_parameter = -1.0: must be > 0" in capsys.readouterr().err

@@ -257,6 +257,9 @@ def _metrics_stand_in(calls):
             statistics=types.SimpleNamespace(
                 flange_pv_Pa_m_s=types.SimpleNamespace(max=nothing),
                 flange_pv_contact_time_Pa_m_s=types.SimpleNamespace(tail95=nothing),
+                flange_friction_power_W=types.SimpleNamespace(total=nothing),
+                flange_flash_temperature_K=types.SimpleNamespace(max=nothing),
+                film_parameter=types.SimpleNamespace(p05=nothing),
                 corner_contact_bound=counted,
                 corner_risk=None,
             ),

@@ -346,6 +346,12 @@ CLI_CHECKS = {
     ("optimise", "run", "--layback-deg"): [_OPT_FILE],
     ("optimise", "run", "--clearance-mm"): [_STEADY_CLI, "test_optimise.py::test_cli_end_to_end"],
     ("optimise", "run", "--min-clearance-mm"): [_OPT_FILE],
+    ("optimise", "run", "--min-film-parameter"): [
+        "test_optimise_profile.py::test_cli_limits_reach_the_settings"
+    ],
+    ("optimise", "run", "--max-flash-temperature-K"): [
+        "test_optimise_profile.py::test_cli_limits_reach_the_settings"
+    ],
     **{
         ("optimise", "run", option): ["test_optimise_profile.py::test_cli_profile_options_reach_the_problem"]
         for option in (

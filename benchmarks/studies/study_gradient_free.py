@@ -5,8 +5,9 @@
     python benchmarks/studies/study_gradient_free.py --quick   (a minute: 5 slices, tiny budget)
 
 One problem for all: the reference bearing at `--slices` slices, 1000 N, `--speeds-rpm`, the box
-of examples/optimise.toml, `--seeds` seeds per design and every other setting the default of
-`optimise.SteadySettings` (the risk constraint). The gradient search (`optimise.steady_search`,
+of examples/optimise.toml (`--profile`: the eight variables of examples/optimise_profile.toml),
+`--seeds` seeds per design and every other setting the default of `optimise.SteadySettings`
+(the risk constraint). The gradient search (`optimise.steady_search`,
 `--starts` x `--iterations`) runs once; random search and CMA-ES
 (`optimise.gradient_free_search`, a generation of `--population` designs per engine call) run
 `--repeats` times each (seeds 0, 1, ...) with the settled members the gradient search spent as
@@ -43,13 +44,15 @@ ROOT = HERE.parents[2]
 
 
 def _problem(args):
-    """The problem and settings `optimise run --bounds examples/optimise.toml` builds, at
-    `--slices`, `--speeds-rpm`, `--seeds` and `--verify-seeds`."""
+    """The problem and settings `optimise run --bounds examples/optimise.toml` builds (with
+    `--profile`: examples/optimise_profile.toml, the eight profile variables), at `--slices`,
+    `--speeds-rpm`, `--seeds` and `--verify-seeds`."""
     import jaxbearing as jb
     from optimise import load_optimise_toml
     from optimise._cli_settings import problem_from_settings, steady_settings_from
 
-    spec = load_optimise_toml(str(ROOT / "examples" / "optimise.toml"))
+    example = "optimise_profile.toml" if args.profile else "optimise.toml"
+    spec = load_optimise_toml(str(ROOT / "examples" / example))
     spec |= dict(
         speeds_rpm=[float(v) for v in args.speeds_rpm.split(",")],
         seeds=args.seeds,
@@ -207,6 +210,9 @@ def main(argv=None) -> int:
     p.add_argument("--name", default="study_gradient_free")
     p.add_argument("--plot", default="", help="where to draw the figure (PNG); none by default")
     p.add_argument("--quick", action="store_true")
+    p.add_argument(
+        "--profile", action="store_true", help="the eight profile variables (examples/optimise_profile.toml)"
+    )
     args = p.parse_args(argv)
     if args.quick:
         args.slices, args.seeds, args.verify_seeds = 5, 2, 2
