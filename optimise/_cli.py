@@ -263,6 +263,13 @@ def build_parser() -> argparse.ArgumentParser:
         help="steady: the flash temperature rise at the rib the design must stay under [K]: the upper 95 %% "
         "bound of a revolution's largest rise at most this at every operating point (default: no limit)",
     )
+    r.add_argument(
+        "--max-friction-power-W",
+        type=float,
+        help="steady: the total flange friction power the design must stay under [W]: the upper 95 %% bound of "
+        "its time mean at most this at every operating point; one point of the PV / friction-power front "
+        "per value (default: no limit)",
+    )
     r.add_argument("--no-verify", action="store_true", help="steady: skip the verification (default: verify)")
     r.add_argument(
         "--workers",

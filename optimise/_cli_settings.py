@@ -95,6 +95,7 @@ def _settings(args) -> dict:
         ("corner_risk_level", args.corner_risk_level),
         ("min_film_parameter", args.min_film_parameter),
         ("max_flash_temperature_K", args.max_flash_temperature_K),
+        ("max_friction_power_W", args.max_friction_power_W),
         ("workers", args.workers),
         ("learning_rate", args.learning_rate),
         ("duration_ms", args.duration_ms),
@@ -220,6 +221,7 @@ def steady_settings_from(s: dict):
         corner_risk_level=float(s.get("corner_risk_level", st.corner_risk_level)),
         min_film_parameter=_optional_positive(s, "min_film_parameter"),
         max_flash_temperature=_optional_positive(s, "max_flash_temperature_K"),
+        max_friction_power=_optional_positive(s, "max_friction_power_W"),
     )
 
 

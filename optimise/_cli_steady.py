@@ -277,6 +277,8 @@ def _margin_value(name: str, value: float) -> str:
         return f"{value:+.3f}"
     if name == "flash_temperature":
         return f"{value:+.1f} K"
+    if name == "friction_power":
+        return f"{value:+.2f} W"
     return f"{value * 1e3:+.4f} mm"
 
 
@@ -290,9 +292,11 @@ def _history_json(h, bounds, names) -> dict:
     x = np.asarray(h.x) if len(h) else np.zeros((0, 0, len(bounds.names)))
     margins = np.asarray(h.margins) if len(h) else np.zeros((0, 0, len(names)))
     limits = {
-        {"film_parameter": "film_parameter", "flash_temperature": "flash_temperature_K"}[n]: margins[
-            ..., i
-        ].tolist()
+        {
+            "film_parameter": "film_parameter",
+            "flash_temperature": "flash_temperature_K",
+            "friction_power": "friction_power_W",
+        }[n]: margins[..., i].tolist()
         for i, n in enumerate(names)
         if i >= len(CONSTRAINT_NAMES)
     }

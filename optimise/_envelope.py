@@ -62,6 +62,7 @@ class Envelope:
     risk: np.ndarray
     film: np.ndarray  # the lower bound of Lambda's 5th percentile (`PointRecord`)
     flash: np.ndarray  # the upper bound of the largest flash temperature rise [K]
+    friction: np.ndarray  # the upper bound of the total flange friction power [W]
 
     @classmethod
     def fresh(cls, num_starts: int, num_points: int, num_variables: int = 3) -> Envelope:
@@ -82,6 +83,7 @@ class Envelope:
             risk=nan.copy(),
             film=nan.copy(),
             flash=nan.copy(),
+            friction=nan.copy(),
         )
 
     def record(self, problem: DesignProblem, settings: SteadySettings, s: int, ev: Evaluation) -> None:
@@ -97,6 +99,7 @@ class Envelope:
             self.share[s, k], self.settled[s, k] = p.corner_contact_share, p.settled
             self.risk[s, k] = p.corner_risk
             self.film[s, k], self.flash[s, k] = p.film_parameter_low, p.flash_temperature_high
+            self.friction[s, k] = p.friction_power_high
         self.active[s] = next_active(problem, settings, ev, self.since[s])
 
     def previous(self, s: int, states) -> Previous | None:
@@ -119,6 +122,7 @@ class Envelope:
                 corner_risk=float(self.risk[s, k]),
                 film_parameter_low=float(self.film[s, k]),
                 flash_temperature_high=float(self.flash[s, k]),
+                friction_power_high=float(self.friction[s, k]),
             )
             for k in range(self.value.shape[1])
         ]

@@ -65,6 +65,8 @@ class PointRecord:
     film_parameter_low: float = float("nan")
     #: the upper 95 % bound of a revolution's largest flash temperature rise at the rib [K]
     flash_temperature_high: float = float("nan")
+    #: the upper 95 % bound of the time-mean total flange friction power [W]
+    friction_power_high: float = float("nan")
 
 
 @dataclasses.dataclass
@@ -314,26 +316,34 @@ def _risk_upper(m) -> float:
     return float("nan") if risk is None else float(risk.upper)
 
 
-def _limit_readouts(m) -> tuple[float, float]:
+def _limit_readouts(m) -> tuple[float, float, float]:
     """(lower 95 % bound of Lambda's 5th percentile over contact time, upper 95 % bound of a
-    revolution's largest flash temperature rise [K]) of one point's metrics `m` (NaN: not
-    measured, e.g. no flange contact)."""
+    revolution's largest flash temperature rise [K], upper 95 % bound of the time-mean total
+    flange friction power [W]) of one point's metrics `m` (NaN: not measured, e.g. no flange
+    contact)."""
     st = m.statistics
     if st is None:
-        return float("nan"), float("nan")
-    return float(st.film_parameter.p05.ci95_low), float(st.flange_flash_temperature_K.max.ci95_high)
+        return float("nan"), float("nan"), float("nan")
+    return (
+        float(st.film_parameter.p05.ci95_low),
+        float(st.flange_flash_temperature_K.max.ci95_high),
+        float(st.flange_friction_power_W.total.ci95_high),
+    )
 
 
 def limit_margins(settings: SteadySettings, per: list[PointRecord]) -> np.ndarray:
     """The margin of every limit of `settings.limits` at the worst operating point of `per`, in
-    the limit's unit: min_k Lambda_k^lo - Lambda_min and T_max - max_k T_k^hi; a point that did
-    not measure it (no flange contact, no film or heat to limit) is left out, +inf if none did."""
+    the limit's unit: min_k Lambda_k^lo - Lambda_min, T_max - max_k T_k^hi and
+    P_max - max_k P_k^hi; a point that did not measure it (no flange contact, no film or heat
+    to limit) is left out, +inf if none did."""
     out = []
     for name, limit in settings.limits:
         if name == "film_parameter":
             values = [p.film_parameter_low - limit for p in per]
-        else:
+        elif name == "flash_temperature":
             values = [limit - p.flash_temperature_high for p in per]
+        else:
+            values = [limit - p.friction_power_high for p in per]
         known = [v for v in values if np.isfinite(v)]
         out.append(min(known) if known else np.inf)
     return np.asarray(out, dtype=float)
@@ -343,7 +353,7 @@ def _measured_record(settings: SteadySettings, u, m, g, width) -> PointRecord:
     """The record of one simulated operating point from its metrics `m` and gradient `g`."""
     j = m.objective
     margin = corner_margin_of(settings, m)
-    film, flash = _limit_readouts(m)
+    film, flash, friction = _limit_readouts(m)
     return PointRecord(
         value=float(j.value) / PV_SCALE,
         ci=(float(j.ci95_low) / PV_SCALE, float(j.ci95_high) / PV_SCALE),
@@ -359,6 +369,7 @@ def _measured_record(settings: SteadySettings, u, m, g, width) -> PointRecord:
         corner_risk=_risk_upper(m),
         film_parameter_low=film,
         flash_temperature_high=flash,
+        friction_power_high=friction,
     )
 
 

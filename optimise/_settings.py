@@ -142,6 +142,10 @@ class SteadySettings:
     #: the flash temperature rise at the rib the design must stay under [K] (None: no limit):
     #: the upper 95 % bound of a revolution's largest rise (its mean per revolution) <= this
     max_flash_temperature: float | None = None
+    #: the total flange friction power the design must stay under [W] (None: no limit): the
+    #: upper 95 % bound of its time mean at most this at every operating point; the
+    #: epsilon-constraint runs of the PV / friction-power front set it
+    max_friction_power: float | None = None
 
     def __post_init__(self):
         """One-line errors naming the setting, before anything runs; a choice given by its name
@@ -195,6 +199,10 @@ class SteadySettings:
                 lambda v: np.isfinite(v) & (v > 0),
                 "> 0 K",
             )
+        if self.max_friction_power is not None:
+            require(
+                "max_friction_power", self.max_friction_power, lambda v: np.isfinite(v) & (v > 0), "> 0 W"
+            )
         if self.clearance_step != "auto":
             if isinstance(self.clearance_step, str):
                 raise UserInputError(
@@ -211,12 +219,15 @@ class SteadySettings:
     def limits(self) -> tuple[tuple[str, float], ...]:
         """The limits set on what the faces are designed for besides PV, as (constraint name,
         value): "film_parameter" (`min_film_parameter`), "flash_temperature"
-        (`max_flash_temperature`), in that order; empty without limits."""
+        (`max_flash_temperature`), "friction_power" (`max_friction_power`), in that order;
+        empty without limits."""
         out = []
         if self.min_film_parameter is not None:
             out.append(("film_parameter", float(self.min_film_parameter)))
         if self.max_flash_temperature is not None:
             out.append(("flash_temperature", float(self.max_flash_temperature)))
+        if self.max_friction_power is not None:
+            out.append(("friction_power", float(self.max_friction_power)))
         return tuple(out)
 
     def measurement(self, *, verification: bool = False) -> run.SteadySettings:

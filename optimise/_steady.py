@@ -50,8 +50,8 @@ from ._verify import verification
 #: names of the five constraints of the steady search (static zone margins, then dynamic)
 CONSTRAINT_NAMES = (*MARGIN_NAMES, "dynamic_corner")
 #: the scale of each limit's margin (`SteadySettings.limits`): Lambda in units of 0.1, the
-#: flash temperature in units of 10 K, so that the scaled constraints are O(1) like the others
-LIMIT_SCALES = {"film_parameter": 0.1, "flash_temperature": 10.0}
+#: flash temperature in units of 10 K, the friction power in W, so that the scaled constraints are O(1) like the others
+LIMIT_SCALES = {"film_parameter": 0.1, "flash_temperature": 10.0, "friction_power": 1.0}
 #: a limit no operating point measured (+inf margin) enters as this scaled value: far from
 #: binding, and finite in the augmented Lagrangian's arithmetic
 UNMEASURED_LIMIT = 1e3
@@ -73,7 +73,7 @@ def constraints(problem: DesignProblem, u, dynamic_margin: float, u_measured, li
     """Scaled, tightened constraints (5 + L,) and their Jacobian (5 + L, n): the static ones
     exactly, the dynamic corner margin by its measured value plus the static limited-circle
     margin's change from `u_measured` (module docstring); then the L limits (`scaled_limits`:
-    film parameter, flash temperature) held at their measured values over one step (no
+    film parameter, flash temperature, friction power) held at their measured values over one step (no
     derivative of their own: a zero row; a limit binds through the choice of the returned
     design and through its multiplier's pull on the step that crossed it)."""
 

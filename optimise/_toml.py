@@ -21,7 +21,13 @@ OPTIMISE_TOML_KEYS = {
         "rib_tangent_height_mm",
         "flange_height_mm",
     ),
-    "constraints": ("min_clearance_mm", "flange_load_N", "min_film_parameter", "max_flash_temperature_K"),
+    "constraints": (
+        "min_clearance_mm",
+        "flange_load_N",
+        "min_film_parameter",
+        "max_flash_temperature_K",
+        "max_friction_power_W",
+    ),
     "envelope": (
         "speeds_rpm",
         "loads_N",
@@ -66,7 +72,8 @@ def load_optimise_toml(path: str) -> dict:
                        [search] profile = true): end_offset_mm, corner_radius_mm,
                        rib_curvature_per_m, rib_tangent_height_mm, flange_height_mm
         [constraints]  min_clearance_mm = 0.0, flange_load_N = 100; steady, off unless given:
-                       min_film_parameter (Lambda), max_flash_temperature_K
+                       min_film_parameter (Lambda), max_flash_temperature_K,
+                       max_friction_power_W
         [envelope]     speeds_rpm = [...], loads_N = [...], weights = [...],
                        aggregate = "max" | "mean", temperature_GPa_m_s = 0.1,
                        skip_weight = 1e-3, recheck_every = 3 (steady: the active set),

@@ -223,6 +223,7 @@ def test_meridians_match_their_closed_forms(tmp_path):
         (dict(min_film_parameter=0.0), "min_film_parameter = 0.0: must be > 0"),
         (dict(min_film_parameter=float("nan")), "min_film_parameter = nan"),
         (dict(max_flash_temperature=-5.0), "max_flash_temperature = -5.0: must be > 0 K"),
+        (dict(max_friction_power=float("inf")), "max_friction_power = inf: must be > 0 W"),
     ],
 )
 def test_bad_limits_are_one_line(kw, text):
@@ -230,7 +231,7 @@ def test_bad_limits_are_one_line(kw, text):
         opt.SteadySettings(**kw)
 
 
-def _record(film, flash):
+def _record(film, flash, friction=float("nan")):
     return evaluation.PointRecord(
         value=1.0,
         ci=(0.9, 1.1),
@@ -244,20 +245,25 @@ def _record(film, flash):
         simulated=True,
         film_parameter_low=film,
         flash_temperature_high=flash,
+        friction_power_high=friction,
     )
 
 
 def test_limit_margins_take_the_worst_measured_point():
     import optimise._steady as steady
 
-    settings = opt.SteadySettings(min_film_parameter=1.5, max_flash_temperature=80.0)
-    assert settings.limits == (("film_parameter", 1.5), ("flash_temperature", 80.0))
-    assert steady.constraint_names(settings)[-2:] == ("film_parameter", "flash_temperature")
-    per = [_record(2.0, 60.0), _record(1.7, 90.0), _record(float("nan"), float("nan"))]
-    np.testing.assert_allclose(evaluation.limit_margins(settings, per), [0.2, -10.0])
+    settings = opt.SteadySettings(min_film_parameter=1.5, max_flash_temperature=80.0, max_friction_power=12.0)
+    assert settings.limits == (("film_parameter", 1.5), ("flash_temperature", 80.0), ("friction_power", 12.0))
+    assert steady.constraint_names(settings)[-3:] == ("film_parameter", "flash_temperature", "friction_power")
+    per = [
+        _record(2.0, 60.0, 10.0),
+        _record(1.7, 90.0, 11.0),
+        _record(float("nan"), float("nan"), float("nan")),
+    ]
+    np.testing.assert_allclose(evaluation.limit_margins(settings, per), [0.2, -10.0, 1.0])
     # no point measured a film (no flange contact): nothing to limit
-    unmeasured = evaluation.limit_margins(settings, [_record(float("nan"), float("nan"))])
-    assert np.all(np.isinf(unmeasured))
+    unmeasured = evaluation.limit_margins(settings, [_record(float("nan"), float("nan"), float("nan"))])
+    assert np.all(np.isinf(unmeasured)) and unmeasured.shape == (3,)
     scaled = steady.scaled_limits(settings, unmeasured)
     assert np.all(scaled == steady.UNMEASURED_LIMIT)
     assert evaluation.limit_margins(opt.SteadySettings(), per).shape == (0,)
@@ -269,7 +275,7 @@ def test_limits_are_held_constraints_and_decide_feasibility():
 
     problem = opt.make_problem(BEARING, OP)
     settings = opt.SteadySettings(min_film_parameter=1.5, max_flash_temperature=80.0)
-    u = jnp.full(3, 0.5)
+    u = jnp.full(3, 0.5)  # two limits set: seven constraints
     limits = steady.scaled_limits(settings, [0.2, -10.0])
     np.testing.assert_allclose(limits, [2.0, -1.0])
     c, jc = steady.constraints(problem, u, 1e-4, u, limits)

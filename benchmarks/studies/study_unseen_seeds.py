@@ -3,6 +3,10 @@
     python benchmarks/studies/study_unseen_seeds.py --design 84.8,1.680,0.150 \
         --speeds-rpm 20000,30000 --seeds 8 --first-seed 5000 --window-revs 4 --name NAME
 
+A design is three values (R_end [mm], theta_f [deg], Delta_bf [mm]) or a profile's eight (R_end
+[mm], e [mm], R_cor [mm], 1/R_rib [1/m], h_t [mm], theta_f [deg], H_rf [mm], Delta_bf [mm]; the
+keys of `optimise.ProfileBounds`); `--reference` (default: the reference bearing's own design)
+is the design it is compared with, e.g. the three-variable optimum against a profile.
 Both designs at every speed, every seed one member of one call of the steady-running engine
 (skid start, settling by the verdict, a window of `--window-revs` cage revolutions), the
 reference bearing at 1000 N. Per design and speed: mean and peak flange PV with 95 % intervals,
@@ -48,14 +52,33 @@ def _row(m) -> dict:
         "largest_contact_radius_mm": float(maxima.max() * 1e3) if maxima.size else None,
         "limited_circle_radius_mm": float(m.limited_circle_radius_m * 1e3),
         "corner_risk": None if st is None or st.corner_risk is None else st.corner_risk.as_dict(),
+        "friction_power_W": None if st is None else st.flange_friction_power_W.total.as_dict(),
+        "flash_temperature_K": None if st is None else st.flange_flash_temperature_K.max.as_dict(),
+        "film_parameter_p05": None if st is None else st.film_parameter.p05.as_dict(),
         "settled": m.settled,
         "seeds": m.seeds,
     }
 
 
+def _design(values):
+    """A design from its engineering values: three (`DesignVariables`) or a profile's eight."""
+    import jax.numpy as jnp
+
+    from jaxbearing.flange import variables_from_array
+    from optimise._bounds import DESIGN_TABLE, PROFILE_TABLE
+
+    table = {3: DESIGN_TABLE, 8: PROFILE_TABLE}.get(len(values))
+    if table is None:
+        raise SystemExit(f"--design: {len(values)} values, expected 3 or 8")
+    return variables_from_array(jnp.asarray([v * var.si for v, var in zip(values, table)]))
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--design", required=True, help="R_end [mm], theta_f [deg], Delta_bf [mm]")
+    p.add_argument(
+        "--design", required=True, help="R_end [mm], theta_f [deg], Delta_bf [mm], or a profile's eight"
+    )
+    p.add_argument("--reference", default="", help="the design compared with (default: the bearing's own)")
     p.add_argument("--speeds-rpm", default="20000,30000")
     p.add_argument("--seeds", type=int, default=8)
     p.add_argument("--first-seed", type=int, default=5000)
@@ -70,10 +93,11 @@ def main(argv=None) -> int:
     from jaxbearing.geometry import rpm_to_rad_s
     from jaxbearing.run import SteadySettings
 
-    r, t, c = (float(v) for v in args.design.split(","))
     bearing = dataclasses.replace(jb.reference_bearing(), num_slices=args.slices)
-    found = DesignVariables(r * 1e-3, np.radians(t), c * 1e-3)
-    reference = DesignVariables.of(bearing)
+    values = [float(v) for v in args.design.split(",")]
+    found = _design(values)
+    reference = _design([float(v) for v in args.reference.split(",")]) if args.reference else None
+    reference = DesignVariables.of(bearing) if reference is None else reference
     speeds = [float(v) for v in args.speeds_rpm.split(",")]
     op0 = jb.reference_operating_point()
     ops = [dataclasses.replace(op0, inner_speed=np.asarray(rpm_to_rad_s(v))) for v in speeds]
@@ -84,7 +108,8 @@ def main(argv=None) -> int:
     )
     wall = time.perf_counter() - t0
     out = {
-        "design_mm_deg_mm": [r, t, c],
+        "design_mm_deg_mm": values,
+        "reference_design": [float(v) for v in args.reference.split(",")] if args.reference else None,
         "speeds_rpm": speeds,
         "slices": args.slices,
         "seeds": list(range(args.first_seed, args.first_seed + args.seeds)),
