@@ -349,6 +349,9 @@ CLI_CHECKS = {
     ("optimise", "run", "--min-film-parameter"): [
         "test_optimise_profile.py::test_cli_limits_reach_the_settings"
     ],
+    ("optimise", "run", "--max-friction-power-W"): [
+        "test_optimise_profile.py::test_cli_limits_reach_the_settings"
+    ],
     ("optimise", "run", "--max-flash-temperature-K"): [
         "test_optimise_profile.py::test_cli_limits_reach_the_settings"
     ],
