@@ -321,10 +321,12 @@ def test_cli_limits_reach_the_settings(tmp_path, capsys, monkeypatch):
         "1.5",
         "--max-flash-temperature-K",
         "80",
+        "--max-friction-power-W",
+        "12",
         "--out",
         str(tmp_path / "r"),
     ]
     assert cli.main(args) == 2
-    assert seen[0].limits == (("film_parameter", 1.5), ("flash_temperature", 80.0))
+    assert seen[0].limits == (("film_parameter", 1.5), ("flash_temperature", 80.0), ("friction_power", 12.0))
     assert cli.main(["run", "--min-film-parameter", "-1", "--out", str(tmp_path / "s")]) == 2
     assert "min_film_parameter = -1.0: must be > 0" in capsys.readouterr().err
