@@ -66,23 +66,27 @@ def plot_faces(bearing: Bearing, designs: dict, path) -> pathlib.Path:
     from jaxbearing.io import pyplot
 
     plt = pyplot()
-    fig, (scale, dev) = plt.subplots(1, 2, figsize=(11, 4.5), gridspec_kw={"width_ratios": [1, 2]})
+    fig, (scale, dev) = plt.subplots(1, 2, figsize=(11, 5.5), gridspec_kw={"width_ratios": [1, 2.2]})
+    right = []
     for i, (label, x) in enumerate(designs.items()):
         m = face_meridians(bearing, x)
         colour = f"C{i}"
-        scale.plot(*m["end"], color=colour, label=f"{label}: roller end")
-        scale.plot(*m["rib"], color=colour, linestyle="--", label=f"{label}: rib")
+        scale.plot(*m["end"], color=colour)
+        scale.plot(*m["rib"], color=colour, linestyle="--")
+        right.append(float(np.max(m["rib"][0])))
         dev.plot(*m["end_deviation"], color=colour, label=f"{label}: end, beyond the flat end plane")
         dev.plot(*m["rib_deviation"], color=colour, linestyle="--", label=f"{label}: rib, off its cone")
+    plane = float(bearing.roller.length) / 2 / MM
+    scale.set_xlim(plane - 1.0, max(right) + 0.3)
     scale.set_aspect("equal")
+    scale.locator_params(axis="x", nbins=3)
     scale.set_xlabel("axial position from the roller centre [mm]")
     scale.set_ylabel("height above the raceway [mm]")
-    scale.set_title("meridians to scale")
+    scale.set_title("to scale (solid: end, dashed: rib)")
     dev.set_xlabel("axial deviation [um]")
     dev.set_ylabel("height above the raceway [mm]")
     dev.set_title("deviations (end from its flat plane, rib from its cone)")
     dev.legend(fontsize=7)
-    scale.legend(fontsize=7, loc="lower right")
     fig.tight_layout()
     out = pathlib.Path(path)
     fig.savefig(out, dpi=120)
