@@ -68,7 +68,8 @@ def build_parser() -> argparse.ArgumentParser:
         "run",
         help="run the multi-start projected augmented-Lagrangian design search",
         description="Search the roller-end/flange design (end radius R_end, layback angle "
-        "theta_f, axial clearance Delta_bf) that minimises, by default (--objective steady), the "
+        "theta_f, axial clearance Delta_bf; with --profile the eight variables of the roller end "
+        "and rib faces) that minimises, by default (--objective steady), the "
         "mean flange PV of settled running over seeds, with 95 % confidence intervals, inside the "
         "static design zone (relief, height limit, limited circle, actual axial clearance) and a "
         "dynamic corner margin; the best design is verified on unseen seeds. --objective startup "

@@ -35,8 +35,10 @@ jax.config.update("jax_enable_x64", True)
 #: the file alone and cold, before and after, side by side on one core): test_steady_gradient
 #: by 23 s (one integration per trajectory for every statistic, one vmapped program),
 #: test_rosenbrock by 15 s (its Tsit5 program the settled runs'), test_validate by 1 s, test_speed by
-#: 3 s (one worker pool fewer).
+#: 3 s (one worker pool fewer). Since added: test_profile_gradients (170 s alone on one core
+#: beside another process, `pytest -p no:xdist tests/test_profile_gradients.py`).
 FILE_SECONDS = {
+    "test_profile_gradients.py": 170,
     "test_engine.py": 114,
     "test_notebooks.py": 98,
     "test_steady_gradient.py": 95,

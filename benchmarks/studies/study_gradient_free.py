@@ -20,7 +20,7 @@ Per run: the best-so-far objective (search seeds; the design the run would retur
 against members, the returned design, its verified objective with its 95 % interval, and the
 members at which the run's best-so-far first reached the median of CMA-ES's final objectives
 (`members_to_cmaes_final`). Writes results/NAME.json (every finished run kept: a rerun with the
-same options continues) and, with `--plot PATH`, the curves with the verified objectives as
+same options continues, also with another `--repeats`) and, with `--plot PATH`, the curves with the verified objectives as
 bars at the members spent.
 """
 
@@ -196,6 +196,11 @@ def _plot(out, path) -> None:
     fig.savefig(path, dpi=120)
 
 
+#: options a rerun may change and still continue the file's runs: the repeats (fewer: the
+#: later repeats' runs move to `runs_left_out`; more: they run) and where the figure goes
+_ANY = ("repeats", "plot")
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--speeds-rpm", default="30000")
@@ -223,8 +228,14 @@ def main(argv=None) -> int:
     path = _common.RESULTS_DIR / f"{args.name}.json"
     options = {k: v for k, v in vars(args).items() if k != "name"}
     out = json.loads(path.read_text()) if path.exists() else {}
-    if out.get("options") != options:
+    if {k: v for k, v in out.get("options", {}).items() if k not in _ANY} != {
+        k: v for k, v in options.items() if k not in _ANY
+    }:
         out = {"options": options, "runs": []}
+    out["options"] = options
+    kept = [r for r in out["runs"] if r["method"] == "gradient" or r["repeat"] < args.repeats]
+    out["runs_left_out"] = out.get("runs_left_out", []) + [r for r in out["runs"] if r not in kept]
+    out["runs"] = kept
     done = {(r["method"], r["repeat"]) for r in out["runs"]}
     jobs = [("gradient", 0)] + [(m, k) for m in ("cmaes", "random") for k in range(args.repeats)]
     for method, repeat in jobs:
