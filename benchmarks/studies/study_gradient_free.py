@@ -189,16 +189,21 @@ def _plot(out, path) -> None:
                 color=c,
                 capsize=3,
             )
+    ref = next((r["verified_reference"][0] for r in out["runs"] if r.get("verified_reference")), None)
+    if ref is not None:
+        ax.axhline(ref["value"], color="0.5", linestyle="--", label="start design, verified")
     ax.set_xlabel("settled members simulated")
-    ax.set_ylabel("objective [GPa m/s] (lines: search seeds; dots: verified)")
+    ax.set_ylabel("objective [GPa m/s]")
+    ax.set_title("lines: best so far on the search's seeds; dots: verified on unseen seeds", fontsize=9)
     ax.legend()
     fig.tight_layout()
     fig.savefig(path, dpi=120)
 
 
 #: options a rerun may change and still continue the file's runs: the repeats (fewer: the
-#: later repeats' runs move to `runs_left_out`; more: they run) and where the figure goes
-_ANY = ("repeats", "plot")
+#: later repeats' runs move to `runs_left_out`; more: they run), the gradient-free methods run
+#: and where the figure goes
+_ANY = ("repeats", "plot", "methods")
 
 
 def main(argv=None) -> int:
@@ -211,6 +216,7 @@ def main(argv=None) -> int:
     p.add_argument("--iterations", type=int, default=4)
     p.add_argument("--repeats", type=int, default=3)
     p.add_argument("--population", type=int, default=6)
+    p.add_argument("--methods", default="cmaes,random", help="the gradient-free methods run, in order")
     p.add_argument("--budget-members", type=int, default=0, help="0: what the gradient search spent")
     p.add_argument("--name", default="study_gradient_free")
     p.add_argument("--plot", default="", help="where to draw the figure (PNG); none by default")
@@ -237,7 +243,8 @@ def main(argv=None) -> int:
     out["runs_left_out"] = out.get("runs_left_out", []) + [r for r in out["runs"] if r not in kept]
     out["runs"] = kept
     done = {(r["method"], r["repeat"]) for r in out["runs"]}
-    jobs = [("gradient", 0)] + [(m, k) for m in ("cmaes", "random") for k in range(args.repeats)]
+    methods = args.methods.split(",")
+    jobs = [("gradient", 0)] + [(m, k) for m in methods for k in range(args.repeats)]
     for method, repeat in jobs:
         if (method, repeat) in done:
             continue
