@@ -127,18 +127,25 @@ def test_profile_search_needs_the_steady_frozen_search():
         problem.peak_pv(jnp.zeros(8))
 
 
-def test_cli_profile_options_reach_the_problem(tmp_path, capsys, monkeypatch):
-    """`optimise run --profile` and each profile variable's bounds option: the problem the
-    steady search receives has `ProfileBounds` with those bounds (the search itself is not run)."""
+def _record_search(monkeypatch) -> list:
+    """The (problem, settings) of every `optimise run` that reaches the steady search, which is
+    replaced by a recorder that stops the run with a one-line error (exit status 2)."""
+    import optimise._steady as steady
+
     seen = []
 
     def recording(problem, settings, **kw):
-        seen.append(problem)
+        seen.append((problem, settings))
         raise UserInputError("stop here")
 
-    import optimise._steady as steady
-
     monkeypatch.setattr(steady, "steady_search", recording)
+    return seen
+
+
+def test_cli_profile_options_reach_the_problem(tmp_path, capsys, monkeypatch):
+    """`optimise run --profile` and each profile variable's bounds option: the problem the
+    steady search receives has `ProfileBounds` with those bounds (the search itself is not run)."""
+    seen = _record_search(monkeypatch)
     args = [
         "run",
         "--profile",
@@ -157,7 +164,7 @@ def test_cli_profile_options_reach_the_problem(tmp_path, capsys, monkeypatch):
     ]
     assert cli.main(args) == 2
     assert "stop here" in capsys.readouterr().err
-    (problem,) = seen
+    ((problem, _),) = seen
     assert isinstance(problem.bounds, ProfileBounds)
     e = problem.bounds.engineering()
     assert e["end_offset_mm"] == pytest.approx([0, 0.5])
@@ -306,15 +313,7 @@ def test_limits_are_held_constraints_and_decide_feasibility():
 
 
 def test_cli_limits_reach_the_settings(tmp_path, capsys, monkeypatch):
-    seen = []
-
-    def recording(problem, settings, **kw):
-        seen.append(settings)
-        raise UserInputError("stop here")
-
-    import optimise._steady as steady
-
-    monkeypatch.setattr(steady, "steady_search", recording)
+    seen = _record_search(monkeypatch)
     args = [
         "run",
         "--min-film-parameter",
@@ -327,6 +326,10 @@ def test_cli_limits_reach_the_settings(tmp_path, capsys, monkeypatch):
         str(tmp_path / "r"),
     ]
     assert cli.main(args) == 2
-    assert seen[0].limits == (("film_parameter", 1.5), ("flash_temperature", 80.0), ("friction_power", 12.0))
+    assert seen[0][1].limits == (
+        ("film_parameter", 1.5),
+        ("flash_temperature", 80.0),
+        ("friction_power", 12.0),
+    )
     assert cli.main(["run", "--min-film-parameter", "-1", "--out", str(tmp_path / "s")]) == 2
     assert "min_film_parameter = -1.0: must be > 0" in capsys.readouterr().err
