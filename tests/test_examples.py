@@ -25,7 +25,7 @@ def test_examples_exist():
 
 @pytest.mark.parametrize(
     "path",
-    [p for p in _files("*.toml") if "sweep" not in p.name and p.name != "optimise.toml"],
+    [p for p in _files("*.toml") if "sweep" not in p.name and not p.name.startswith("optimise")],
     ids=lambda p: p.name,
 )
 def test_configuration_loads(path):
@@ -53,6 +53,11 @@ def test_sweep_spec_validates(path):
 def test_optimise_settings_parse():
     settings = load_optimise_toml(str(EXAMPLES / "optimise.toml"))
     assert settings["end_radius_mm"] == [60.0, 120.0]
+
+
+def test_optimise_profile_example_parses_as_a_profile_search():
+    settings = load_optimise_toml(str(EXAMPLES / "optimise_profile.toml"))
+    assert settings["profile"] is True and settings["end_offset_mm"] == [0.0, 1.0]
 
 
 def test_optimise_example_builds_the_steady_settings():
