@@ -22,6 +22,7 @@ from ._plot import plot_search
 from ._problem import (
     Bounds,
     DesignProblem,
+    ProfileBounds,
     any_feasible,
     bounds_from_engineering,
     feasibility_map,
@@ -37,6 +38,7 @@ from ._verify import verification
 __all__ = [
     "MARGIN_NAMES",
     "Bounds",
+    "ProfileBounds",
     "Choice",
     "CornerConstraint",
     "Estimator",

@@ -134,6 +134,18 @@ class _Box:
         """The SI design array x in engineering units, by key."""
         return {v.key: float(xi) * v.scale for v, xi in zip(self.TABLE, np.asarray(x, dtype=float))}
 
+    @classmethod
+    def from_engineering(cls, values) -> np.ndarray:
+        """The SI design array of `values` in engineering units, in the order of `TABLE` (the
+        inverse of `engineering_values`)."""
+        values = np.asarray(values, dtype=float)
+        if values.shape != (len(cls.TABLE),):
+            raise UserInputError(
+                f"design = {values.tolist()}: must be {len(cls.TABLE)} values "
+                f"({', '.join(v.key for v in cls.TABLE)})"
+            )
+        return np.array([value * v.si for value, v in zip(values, cls.TABLE)])
+
     def _require_bound(self, name: str, which: str, ok, valid: str) -> None:
         var = next(v for v in self.TABLE if v.name == name)
         value = getattr(self, name)[0 if which == "lower" else 1]

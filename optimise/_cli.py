@@ -199,10 +199,11 @@ def build_parser() -> argparse.ArgumentParser:
     )
     r.add_argument(
         "--statistic",
-        metavar="{mean,peak,tail}",  # checked by `SteadySettings`: one-line errors
-        help="steady: the flange PV statistic minimised, mean (over contact time), peak (its p-mean, "
+        metavar="{mean,peak,tail,friction}",  # checked by `SteadySettings`: one-line errors
+        help="steady: the statistic minimised, of flange PV mean (over contact time), peak (its p-mean, "
         "p = 8, weighting the peaks) or tail (the mean of its worst 5 %%, bounding the p95 from "
-        f"above) (default: {st.statistic})",
+        "above), or friction (the time-mean total flange friction power, in W; with --aggregate max "
+        f"the temperature is then in W) (default: {st.statistic})",
     )
     r.add_argument(
         "--clearance-step-mm",

@@ -29,9 +29,10 @@ def _margin_text(m) -> str:
     )
 
 
-def _progress(quiet: bool, start_line):
-    """The per-iteration progress callback of both searches: the best feasible objective, then
-    one line per start (`start_line(j, info, margins, index of the smallest margin)`)."""
+def _progress(quiet: bool, start_line, unit: str = "GPa m/s"):
+    """The per-iteration progress callback of both searches: the best feasible objective (in
+    `unit`), then one line per start (`start_line(j, info, margins, index of the smallest
+    margin)`)."""
     import numpy as np
 
     def progress(it, info):
@@ -39,7 +40,7 @@ def _progress(quiet: bool, start_line):
             return
         best = info.best
         print(
-            f"iter {it:3d}  best feasible {best:.4f} GPa m/s"
+            f"iter {it:3d}  best feasible {best:.4f} {unit}"
             if np.isfinite(best)
             else f"iter {it:3d}  best feasible   none yet"
         )

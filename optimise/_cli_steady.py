@@ -30,17 +30,18 @@ def run_steady(args, problem, options, settings, out, meta=None) -> int:
     sys.stdout.flush()
 
     names = constraint_names(settings)
+    unit = settings.statistic.shown[1]
 
     def start_line(j, info, m, w):
         lo, hi = info.ci[j]
         g = info.gradient[j]
         return (
-            f"J {info.objective[j]:7.4f} [{lo:.4f}, {hi:.4f}] GPa m/s  "
+            f"J {info.objective[j]:7.4f} [{lo:.4f}, {hi:.4f}] {unit}  "
             f"min margin {names[w]} {_margin_value(names[w], m[w])}  {_design_text(info.x[j])}  "
             f"dJ/du ({', '.join(f'{v:+.3f}' for v in g)})"
         )
 
-    progress = _progress(args.quiet, start_line)
+    progress = _progress(args.quiet, start_line, unit)
 
     # a line at least every 30 s while members settle: an evaluation takes minutes
     heartbeat = contextlib.nullcontext() if args.quiet else MemberProgress(30.0, label="   ")
@@ -81,8 +82,11 @@ def _print_found(res, settings, plot_path) -> None:
     print(
         f"final design: {_design_text(res.design)}  (start {res.best_start}, iteration {res.best_iteration})"
     )
-    what = {"mean": "mean PV", "peak": "peak PV (p-mean)", "tail": "tail PV"}.get(settings.statistic, "PV")
-    print(f"  steady {what} {res.objective:.4f} [{lo:.4f}, {hi:.4f}] GPa m/s (search seeds)")
+    what = {"mean": "mean PV", "peak": "peak PV (p-mean)", "tail": "tail PV", "friction": "friction power"}
+    unit = settings.statistic.shown[1]
+    print(
+        f"  steady {what[settings.statistic]} {res.objective:.4f} [{lo:.4f}, {hi:.4f}] {unit} (search seeds)"
+    )
     near = near_optimal_set(res)
     if not near:
         return
@@ -177,14 +181,14 @@ def _steady_result_json(problem, options, settings, res) -> dict:
         "status": res.status,
         "feasible": bool(res.feasible),
         "design": _engineering(res.design),
-        "objective_GPa_m_s": {
+        settings.statistic.key: {
             "value": res.objective,
             "ci95_low": None if res.objective_ci is None else res.objective_ci[0],
             "ci95_high": None if res.objective_ci is None else res.objective_ci[1],
         },
         "start_design": _engineering(res.start_design),
         "verification": res.verification,
-        "near_optimal": _near_optimal_json(res),
+        "near_optimal": _near_optimal_json(res, settings.statistic.key),
         "axial_clearance_effect": _clearance_json(problem, settings, res),
         "near_optimal_rule": (
             "every feasible design the search evaluated that is statistically tied with the best (its "
@@ -214,11 +218,11 @@ def _steady_result_json(problem, options, settings, res) -> dict:
         "simulated_ms": float(np.sum(h.simulated_ms)) if len(h) else 0.0,
         "resumed_from_iteration": res.resumed_from,
         "wall_time_s": res.wall_time_s,
-        "history": _history_json(h, problem.bounds, constraint_names(settings)),
+        "history": _history_json(h, problem.bounds, constraint_names(settings), settings.statistic.key),
     }
 
 
-def _near_optimal_json(res) -> list:
+def _near_optimal_json(res, key: str) -> list:
     import numpy as np
 
     from ._steady import near_optimal_set
@@ -226,7 +230,7 @@ def _near_optimal_json(res) -> list:
     return [
         {
             **_engineering(d.design),
-            "objective_GPa_m_s": {"value": d.objective, "ci95_low": d.ci95[0], "ci95_high": d.ci95[1]},
+            key: {"value": d.objective, "ci95_low": d.ci95[0], "ci95_high": d.ci95[1]},
             "iteration": d.iteration,
             "start": d.start,
             "binding_margin": d.binding_margin,
@@ -282,9 +286,9 @@ def _margin_value(name: str, value: float) -> str:
     return f"{value * 1e3:+.4f} mm"
 
 
-def _history_json(h, bounds, names) -> dict:
+def _history_json(h, bounds, names, key: str = "objective_GPa_m_s") -> dict:
     """The search's history in engineering units (per iteration and start): every design
-    variable by its key (`end_radius_mm`, ...)."""
+    variable by its key (`end_radius_mm`, ...), the objective under `key` (`Statistic.key`)."""
     import numpy as np
 
     from ._steady import CONSTRAINT_NAMES
@@ -301,8 +305,8 @@ def _history_json(h, bounds, names) -> dict:
         if i >= len(CONSTRAINT_NAMES)
     }
     return {
-        "objective_GPa_m_s": np.asarray(h.objective).tolist(),
-        "ci95_GPa_m_s": np.asarray(h.ci).tolist(),
+        key: np.asarray(h.objective).tolist(),
+        "ci95" + key.removeprefix("objective"): np.asarray(h.ci).tolist(),
         "gradient_per_unit_box": np.asarray(h.gradient).tolist(),
         "gradient_stderr": np.asarray(h.gradient_stderr).tolist(),
         **{var.key: (x[..., i] * var.scale).tolist() for i, var in enumerate(bounds.TABLE)},

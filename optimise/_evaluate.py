@@ -2,13 +2,14 @@
 and the constraints of every start's design at every operating point of the envelope
 (docs/model.md 17).
 
-Objective. At every operating point k the smooth mean flange PV over contact time of settled
-running (`jaxbearing.design.steady_design_metrics_points`: skid start or continuation, settling,
+Objective. At every operating point k the statistic of settled running the settings name
+(`jaxbearing.design.Statistic`: mean, peak or tail flange PV, or the total flange friction
+power; `jaxbearing.design.steady_design_metrics_points`: skid start or continuation, settling,
 a window of `window_revs` cage revolutions, `seeds` seeded scatters; Student-t CI over the
 seeds), combined over the envelope as in `DesignProblem.combine` (smooth max or weighted mean),
-in GPa m/s, with the delta-method interval of `combined_interval`.
+in GPa m/s (W for the friction power), with the delta-method interval of `combined_interval`.
 
-Gradient. "frozen": the frozen-load estimate (`jaxbearing.design.frozen_load_gradients`) from
+Gradient. "frozen": the frozen-load estimate (`jaxbearing.design.frozen_load_statistics`) from
 the settled states the objective's runs passed through; "window": short-window forward-mode
 sensitivities (`jaxbearing.design.steady_gradient`). Neither sees the axial clearance: where
 `clearance_step_for` gives h > 0, dJ/dDelta_bf is the paired common-random-number central
@@ -28,8 +29,9 @@ from scipy import stats
 
 from jaxbearing import UserInputError
 from jaxbearing.design import (
+    Statistic,
     SteadyGradient,
-    frozen_load_gradients,
+    frozen_load_statistics,
     paired_central_difference,
     steady_design_metrics_points,
     steady_gradient,
@@ -37,14 +39,15 @@ from jaxbearing.design import (
 from jaxbearing.flange import MARGIN_NAMES, variables_from_array
 from jaxbearing.run import CORNER_RISK_CONFIDENCE, shared_workers, tolerance_bound
 
-from ._problem import PV_SCALE, DesignProblem
+from ._problem import DesignProblem
 from ._settings import CornerConstraint, Estimator, SteadySettings, clearance_step_for
 
 
 @dataclasses.dataclass
 class PointRecord:
-    """What one evaluation measured at one operating point (objective values in GPa m/s,
-    gradients per unit of the scaled box, margins in m)."""
+    """What one evaluation measured at one operating point (objective values in the statistic's
+    unit, `Statistic.shown`: GPa m/s, or W for the friction power; gradients per unit of the
+    scaled box, margins in m)."""
 
     value: float
     ci: tuple  # (low, high): the point's 95 % interval
@@ -58,7 +61,7 @@ class PointRecord:
     corner_contact_share: float
     settled: bool
     simulated: bool  # False: the values of an earlier evaluation (`next_active`)
-    estimator_value: float = float("nan")  # the gradient estimator's own objective [GPa m/s]
+    estimator_value: float = float("nan")  # the gradient estimator's own objective
     #: the upper 95 % bound of the corner-contact risk per cage revolution (`run.corner_risk`)
     corner_risk: float = float("nan")
     #: the lower 95 % bound of the 5th percentile of the film parameter Lambda over contact time
@@ -67,14 +70,17 @@ class PointRecord:
     flash_temperature_high: float = float("nan")
     #: the upper 95 % bound of the time-mean total flange friction power [W]
     friction_power_high: float = float("nan")
+    #: the frozen-load gradient of the time-mean total flange friction power per unit of the
+    #: scaled box [W] (`friction_gradients`; NaN where not estimated)
+    friction_gradient: np.ndarray | None = None
 
 
 @dataclasses.dataclass
 class Evaluation:
     """The steady objective, its gradient and the constraints of one design (scaled u)."""
 
-    objective: float  # combined over the envelope [GPa m/s]
-    objective_ci: tuple  # (low, high): its 95 % interval (`combined_interval`) [GPa m/s]
+    objective: float  # combined over the envelope, in the statistic's unit (`PointRecord`)
+    objective_ci: tuple  # (low, high): its 95 % interval (`combined_interval`)
     gradient: np.ndarray  # dJ/du (n,)
     gradient_stderr: np.ndarray  # (n,)
     per_point: list[PointRecord]
@@ -88,6 +94,9 @@ class Evaluation:
     #: per limit of `SteadySettings.limits`, its margin at the worst operating point in the
     #: limit's own unit (Lambda - limit; limit - K), +inf where no point measured it
     limit_margins: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros(0))
+    #: per limit, the gradient of its margin per unit of the scaled box (L, n): the friction
+    #: power's from the frozen-load estimate at the worst point (`limit_jacobian`), the others 0
+    limit_jacobian: np.ndarray | None = None
 
 
 @dataclasses.dataclass(frozen=True)
@@ -159,25 +168,33 @@ def _checked_active(active, n: int, num_designs: int, previous) -> list[list[boo
     return active
 
 
-def _gradients(settings: SteadySettings, cases, gradient: bool, num_variables: int) -> list[SteadyGradient]:
-    """The gradient estimates of `cases` (bearing, op, design, states) by `settings.estimator`."""
+def _gradients(settings: SteadySettings, cases, gradient: bool, num_variables: int) -> list[tuple]:
+    """The gradient estimates of `cases` (bearing, op, design, states) by `settings.estimator`:
+    per case (the objective's `SteadyGradient`, the friction power's or None). The friction
+    power's is estimated where a friction limit is set (`SteadySettings.max_friction_power`),
+    from the same trajectories as the objective's (`frozen_load_statistics`)."""
     if not gradient:
-        return [SteadyGradient.missing(num_variables) for _ in cases]
+        return [(SteadyGradient.missing(num_variables), None) for _ in cases]
     if settings.estimator is Estimator.FROZEN:
-        return frozen_load_gradients(
+        friction = settings.max_friction_power is not None
+        found = frozen_load_statistics(
             cases,
+            statistics=(settings.statistic, Statistic.FRICTION) if friction else (settings.statistic,),
             window=settings.gradient_window,
             rtol=settings.rtol,
             workers=settings.num_workers,
-            statistic=settings.statistic,
         )
+        return [(f[settings.statistic], f[Statistic.FRICTION] if friction else None) for f in found]
     if num_variables != 3:
         raise UserInputError(
             f"estimator = {settings.estimator.value!r}: a profile search needs the frozen-load estimator ('frozen')"
         )
     return [
-        steady_gradient(
-            *case, window=settings.gradient_window, rtol=settings.rtol, workers=settings.num_workers
+        (
+            steady_gradient(
+                *case, window=settings.gradient_window, rtol=settings.rtol, workers=settings.num_workers
+            ),
+            None,
         )
         for case in cases
     ]
@@ -196,7 +213,7 @@ def evaluate_starts(
     """`evaluate` of every scaled design of `us` (the starts of one iteration; `chains`: the
     continuation states of each, or None): every start's operating points' seeds are members
     of one call of the steady-running engine, and every trajectory of the frozen-load
-    gradients of one call of `frozen_load_gradients` (on an accelerator, one vmapped program
+    gradients of one call of `frozen_load_statistics` (on an accelerator, one vmapped program
     each). The wall time of each evaluation is the whole call's.
 
     The clearance (h = `clearance_step_for(...)` > 0, Delta_bf free): dJ/dDelta_bf is the paired
@@ -241,8 +258,10 @@ def evaluate_starts(
     gradients = dict(zip(keys, _gradients(settings, cases, gradient, problem.num_variables)))
     if len(shifts) == 3:
         for s, k in keys:
-            gradients[(s, k)] = _with_clearance_difference(
-                gradients[(s, k)], metrics[(s, 1, k)], metrics[(s, 2, k)], h, ci
+            g, friction = gradients[(s, k)]
+            gradients[(s, k)] = (
+                _with_clearance_difference(g, metrics[(s, 1, k)], metrics[(s, 2, k)], h, ci),
+                friction,
             )
     wall = time.perf_counter() - t0
     evaluations = []
@@ -349,17 +368,39 @@ def limit_margins(settings: SteadySettings, per: list[PointRecord]) -> np.ndarra
     return np.asarray(out, dtype=float)
 
 
-def _measured_record(settings: SteadySettings, u, m, g, width) -> PointRecord:
-    """The record of one simulated operating point from its metrics `m` and gradient `g`."""
+def limit_jacobian(settings: SteadySettings, per: list[PointRecord]) -> np.ndarray:
+    """The gradient (L, n) per unit of the scaled box of every limit's margin of `limit_margins`:
+    for the friction power, -dP/du of the frozen-load estimate at the operating point of the
+    smallest margin (the upper bound moves with the mean); 0 for the film parameter and the
+    flash temperature (no estimator of their own) and where no estimate is known."""
+    n = len(per[0].gradient) if per else 0
+    rows = []
+    for name, limit in settings.limits:
+        row = np.zeros(n)
+        if name == "friction_power":
+            known = [p for p in per if np.isfinite(p.friction_power_high) and p.friction_gradient is not None]
+            if known:
+                worst = min(known, key=lambda p: limit - p.friction_power_high)
+                if np.all(np.isfinite(worst.friction_gradient)):
+                    row = -np.asarray(worst.friction_gradient, dtype=float)
+        rows.append(row)
+    return np.asarray(rows, dtype=float).reshape(len(rows), n)
+
+
+def _measured_record(settings: SteadySettings, u, m, gradients, width) -> PointRecord:
+    """The record of one simulated operating point from its metrics `m` and gradient estimates
+    (the objective's, the friction power's or None: `_gradients`)."""
+    g, friction_g = gradients
     j = m.objective
+    scale = settings.statistic.shown[0]  # GPa m/s, or W for the friction power
     margin = corner_margin_of(settings, m)
     film, flash, friction = _limit_readouts(m)
     return PointRecord(
-        value=float(j.value) / PV_SCALE,
-        ci=(float(j.ci95_low) / PV_SCALE, float(j.ci95_high) / PV_SCALE),
-        gradient=g.gradient * width / PV_SCALE,
-        gradient_stderr=g.gradient_stderr * width / PV_SCALE,
-        estimator_value=g.value / PV_SCALE,
+        value=float(j.value) / scale,
+        ci=(float(j.ci95_low) / scale, float(j.ci95_high) / scale),
+        gradient=g.gradient * width / scale,
+        gradient_stderr=g.gradient_stderr * width / scale,
+        estimator_value=g.value / scale,
         corner_margin=margin,
         measured_corner_margin=margin,
         measured_at=np.asarray(u, dtype=float),
@@ -370,6 +411,7 @@ def _measured_record(settings: SteadySettings, u, m, g, width) -> PointRecord:
         film_parameter_low=film,
         flash_temperature_high=flash,
         friction_power_high=friction,
+        friction_gradient=None if friction_g is None else friction_g.gradient * width,
     )
 
 
@@ -418,6 +460,7 @@ def _evaluation(problem, settings, u, measured, previous, wall, gradient: bool) 
         simulated_ms=simulated,
         corner_risk=worst_risk([p.corner_risk for p in per]),
         limit_margins=limit_margins(settings, per),
+        limit_jacobian=limit_jacobian(settings, per),
     )
 
 

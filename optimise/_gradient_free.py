@@ -107,7 +107,7 @@ def _generation(problem: DesignProblem, settings: SteadySettings, us: np.ndarray
     np.random.set_state(state)
     for i, ev in zip(np.flatnonzero(inside), evs):
         c, _ = constraints(
-            problem, us[i], ev.dynamic_margin, us[i], scaled_limits(settings, ev.limit_margins)
+            problem, us[i], ev.dynamic_margin, us[i], scaled_limits(settings, ev.limit_margins)[0]
         )
         row["objective"][i], row["ci"][i] = ev.objective, ev.objective_ci
         row["violation"][i] = float(np.sum(np.minimum(c, 0.0) ** 2) ** 0.5)

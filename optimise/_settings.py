@@ -113,8 +113,9 @@ class SteadySettings:
     verify_seeds: int = 4
     verify_first_seed: int = 1000
     verify_window_revs: int = 4
-    #: the statistic of flange PV minimised (`jaxbearing.design.Statistic`): the mean over
-    #: contact time, the peak (its p-mean) or the tail (the mean of its worst 5 %)
+    #: the statistic minimised (`jaxbearing.design.Statistic`): of flange PV the mean over
+    #: contact time, the peak (its p-mean) or the tail (the mean of its worst 5 %); or the
+    #: time-mean total flange friction power (objective in W)
     statistic: Statistic = Statistic.MEAN
     #: half-step of the common-random-number central difference in Delta_bf [m] (0: off), or
     #: "auto": `CLEARANCE_STEP` where the envelope is misaligned by more than

@@ -1,7 +1,7 @@
 """Design search on steady running: the default objective of `optimise run` (docs/model.md 17).
 
 Minimise the steady objective J(x) of the design x = (R_end, theta_f, Delta_bf) over the
-envelope (`_evaluate`: settled mean, peak or tail flange PV with its 95 % interval and its
+envelope (`_evaluate`: settled mean, peak or tail flange PV or the flange friction power, with its 95 % interval and its
 estimated gradient) inside the four static design-zone margins of `DesignProblem.constraints`
 and the dynamic corner-contact margin, from several starts, by the projected
 augmented-Lagrangian step of `_lagrangian` (one step per start and iteration).
@@ -62,20 +62,24 @@ def constraint_names(settings: SteadySettings) -> tuple[str, ...]:
     return (*CONSTRAINT_NAMES, *(name for name, _ in settings.limits))
 
 
-def scaled_limits(settings: SteadySettings, margins) -> np.ndarray:
-    """The limits' margins (`Evaluation.limit_margins`) as scaled, tightened constraints."""
+def scaled_limits(settings: SteadySettings, margins, jacobian=None) -> tuple[np.ndarray, np.ndarray | None]:
+    """The limits' margins (`Evaluation.limit_margins`) as scaled, tightened constraints, and
+    their Jacobian (`Evaluation.limit_jacobian`, or None) in the same scale."""
     scales = np.array([LIMIT_SCALES[name] for name, _ in settings.limits])
     scaled = np.asarray(margins, dtype=float) / scales if len(scales) else np.zeros(0)
-    return np.minimum(scaled, UNMEASURED_LIMIT)
+    jac = None if jacobian is None or not len(scales) else np.asarray(jacobian, dtype=float) / scales[:, None]
+    return np.minimum(scaled, UNMEASURED_LIMIT), jac
 
 
-def constraints(problem: DesignProblem, u, dynamic_margin: float, u_measured, limits=()):
+def constraints(problem: DesignProblem, u, dynamic_margin: float, u_measured, limits=(), limit_jacobian=None):
     """Scaled, tightened constraints (5 + L,) and their Jacobian (5 + L, n): the static ones
     exactly, the dynamic corner margin by its measured value plus the static limited-circle
     margin's change from `u_measured` (module docstring); then the L limits (`scaled_limits`:
-    film parameter, flash temperature, friction power) held at their measured values over one step (no
-    derivative of their own: a zero row; a limit binds through the choice of the returned
-    design and through its multiplier's pull on the step that crossed it)."""
+    film parameter, flash temperature, friction power) at their measured values, with the rows
+    of `limit_jacobian` where given (the friction power's frozen-load gradient,
+    `_evaluate.limit_jacobian`) and zero rows otherwise (the film parameter and the flash
+    temperature have no derivative of their own: such a limit binds through the choice of the
+    returned design and through its multiplier's pull on the step that crossed it)."""
 
     def c(v):
         static = problem.margins(v)
@@ -87,7 +91,10 @@ def constraints(problem: DesignProblem, u, dynamic_margin: float, u_measured, li
     u = jnp.asarray(u)
     held = np.asarray(limits, dtype=float) - problem.tighten
     value = np.concatenate([np.asarray(c(u)), held])
-    jac = np.concatenate([np.asarray(jax.jacfwd(c)(u)), np.zeros((held.size, u.size))])
+    rows = (
+        np.zeros((held.size, u.size)) if limit_jacobian is None else np.asarray(limit_jacobian, dtype=float)
+    )
+    jac = np.concatenate([np.asarray(jax.jacfwd(c)(u)), rows])
     return value, jac
 
 
@@ -161,7 +168,8 @@ def _iteration(problem: DesignProblem, settings: SteadySettings, hyper: Hyper, s
         state.evaluations += int(np.sum(env.active[s]))
         rows["points_simulated"].append(env.active[s].copy())
         env.record(problem, settings, s, ev)
-        c, jc = constraints(problem, us, ev.dynamic_margin, us, scaled_limits(settings, ev.limit_margins))
+        held, held_jac = scaled_limits(settings, ev.limit_margins, ev.limit_jacobian)
+        c, jc = constraints(problem, us, ev.dynamic_margin, us, held, held_jac)
         g_obj = ev.gradient if np.all(np.isfinite(ev.gradient)) else np.zeros(problem.num_variables)
         u_new, opt, act = augmented_lagrangian_step(
             optimiser, hyper.rho, free, g_obj, c, jc, state.lam[s], state.opt[s], jnp.asarray(us)

@@ -238,7 +238,7 @@ def test_bad_limits_are_one_line(kw, text):
         opt.SteadySettings(**kw)
 
 
-def _record(film, flash, friction=float("nan")):
+def _record(film, flash, friction=float("nan"), friction_gradient=None):
     return evaluation.PointRecord(
         value=1.0,
         ci=(0.9, 1.1),
@@ -253,7 +253,33 @@ def _record(film, flash, friction=float("nan")):
         film_parameter_low=film,
         flash_temperature_high=flash,
         friction_power_high=friction,
+        friction_gradient=friction_gradient,
     )
+
+
+def test_friction_limit_has_the_frozen_load_gradient_of_its_worst_point():
+    """The friction-power limit's constraint row is -dP/du of the operating point of the
+    smallest margin (its frozen-load estimate, W per unit box, scaled by 1 W), so the
+    epsilon-constraint search steps away from a friction limit it approaches; the film and
+    flash limits keep zero rows; a point without an estimate gives a zero row."""
+    import optimise._steady as steady
+
+    settings = opt.SteadySettings(min_film_parameter=1.5, max_friction_power=12.0)
+    per = [
+        _record(2.0, 60.0, 10.0, np.array([1.0, -2.0, 0.0])),
+        _record(1.7, 90.0, 11.5, np.array([3.0, 0.5, 0.0])),
+    ]
+    jac = evaluation.limit_jacobian(settings, per)
+    np.testing.assert_array_equal(jac, [[0.0, 0.0, 0.0], [-3.0, -0.5, 0.0]])
+    margins = evaluation.limit_margins(settings, per)
+    held, held_jac = steady.scaled_limits(settings, margins, jac)
+    problem = opt.make_problem(BEARING, OP)
+    u = jnp.full(3, 0.5)
+    c, jc = steady.constraints(problem, u, 1e-4, u, held, held_jac)
+    np.testing.assert_allclose(jc[5:], [[0.0, 0.0, 0.0], [-3.0, -0.5, 0.0]])
+    np.testing.assert_allclose(c[6], 0.5 - problem.tighten)
+    unknown = evaluation.limit_jacobian(settings, [_record(2.0, 60.0, 10.0)])
+    assert np.all(unknown == 0) and unknown.shape == (2, 3)
 
 
 def test_limit_margins_take_the_worst_measured_point():
@@ -271,7 +297,7 @@ def test_limit_margins_take_the_worst_measured_point():
     # no point measured a film (no flange contact): nothing to limit
     unmeasured = evaluation.limit_margins(settings, [_record(float("nan"), float("nan"), float("nan"))])
     assert np.all(np.isinf(unmeasured)) and unmeasured.shape == (3,)
-    scaled = steady.scaled_limits(settings, unmeasured)
+    scaled, _ = steady.scaled_limits(settings, unmeasured)
     assert np.all(scaled == steady.UNMEASURED_LIMIT)
     assert evaluation.limit_margins(opt.SteadySettings(), per).shape == (0,)
 
@@ -283,7 +309,7 @@ def test_limits_are_held_constraints_and_decide_feasibility():
     problem = opt.make_problem(BEARING, OP)
     settings = opt.SteadySettings(min_film_parameter=1.5, max_flash_temperature=80.0)
     u = jnp.full(3, 0.5)  # two limits set: seven constraints
-    limits = steady.scaled_limits(settings, [0.2, -10.0])
+    limits, _ = steady.scaled_limits(settings, [0.2, -10.0])
     np.testing.assert_allclose(limits, [2.0, -1.0])
     c, jc = steady.constraints(problem, u, 1e-4, u, limits)
     c0, jc0 = steady.constraints(problem, u, 1e-4, u)

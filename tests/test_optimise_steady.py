@@ -145,6 +145,27 @@ def _stand_in_starts(problem, settings, us, chains, *, gradient=True, active=Non
     return [_stand_in(problem, settings, u, c, gradient=gradient) for u, c in zip(us, chains)]
 
 
+def test_friction_statistic_is_stored_and_printed_in_watts(tmp_path, config, monkeypatch, capsys):
+    """`optimise run --statistic friction`: the objective is the friction power in W, printed
+    with its unit and stored under keys that name it (`Statistic.key`: objective_W, ci95_W),
+    never under the PV keys; on a stand-in for the settled ensemble."""
+    monkeypatch.setattr(steady, "evaluate_starts", _stand_in_starts)
+    out = tmp_path / "friction"
+    assert (
+        main(["run", "--config", config, "--statistic", "friction", *ARGS, "--no-verify", "--out", str(out)])
+        == 0
+    )
+    text = capsys.readouterr().out
+    assert "best feasible" in text and " W  " in text and "steady friction power" in text
+    r = json.loads((out / "result.json").read_text())
+    assert r["settings"]["statistic"] == "friction"
+    assert "objective_W" in r and "objective_GPa_m_s" not in r
+    assert (
+        "objective_W" in r["history"] and "ci95_W" in r["history"] and "objective_GPa_m_s" not in r["history"]
+    )
+    assert np.isfinite(r["objective_W"]["value"])
+
+
 def test_killed_run_resumes_with_the_same_result(tmp_path, config, monkeypatch, capsys):
     """The checkpoint mechanics of the steady search through the command line, on a stand-in
     for the settled ensemble: a run killed in its second evaluation exits 130 with a checkpoint
@@ -418,17 +439,15 @@ def _engine_stand_in(seen, samples=False):
 
 
 def _frozen_stand_in(calls=None):
-    """A stand-in for `frozen_load_gradients`: dJ/dx = (3e9, -4e9, 0) per case (the estimator
-    cannot see Delta_bf); `calls` records each call's cases."""
+    """A stand-in for `frozen_load_statistics`: dJ/dx = (3e9, -4e9, 0) per case and statistic
+    (the estimator cannot see Delta_bf); `calls` records each call's cases."""
     from jaxbearing.design import SteadyGradient
 
-    def frozen(cases, **kw):
+    def frozen(cases, statistics=("mean",), **kw):
         if calls is not None:
             calls.append(cases)
-        return [
-            SteadyGradient(1e9, np.array([3e9, -4e9, 0.0]), np.full(3, 1e7), 1e6, 1e-4, 4, None, None, None)
-            for _ in cases
-        ]
+        g = SteadyGradient(1e9, np.array([3e9, -4e9, 0.0]), np.full(3, 1e7), 1e6, 1e-4, 4, None, None, None)
+        return [dict.fromkeys(statistics, g) for _ in cases]
 
     return frozen
 
@@ -436,7 +455,7 @@ def _frozen_stand_in(calls=None):
 def test_an_iteration_evaluates_every_start_in_one_engine_call(monkeypatch):
     """`evaluate_starts` with two starts (stand-ins for the engine and the estimator,
     `_engine_stand_in`): every start's seeds are members of one call of the steady-running
-    engine and every start's gradient trajectories of one `frozen_load_gradients` call, each
+    engine and every start's gradient trajectories of one `frozen_load_statistics` call, each
     from its own start's settled states, and each start gets its own design's objective (its
     interval around it), gradient, static margins and continuation states."""
     import jaxbearing as jb
@@ -444,7 +463,7 @@ def test_an_iteration_evaluates_every_start_in_one_engine_call(monkeypatch):
 
     seen, cases = [], []
     monkeypatch.setattr(evaluation, "steady_design_metrics_points", _engine_stand_in(seen, samples=True))
-    monkeypatch.setattr(evaluation, "frozen_load_gradients", _frozen_stand_in(cases))
+    monkeypatch.setattr(evaluation, "frozen_load_statistics", _frozen_stand_in(cases))
     problem = make_problem(jb.reference_bearing(), jb.reference_operating_point())
     settings = search_settings.SteadySettings(
         seeds=2, window_revs=2, settle=0.005, gradient_window=0.1e-3, workers=1
@@ -477,7 +496,7 @@ def test_clearance_gradient_is_a_paired_crn_difference_in_the_same_engine_call(m
 
     seen = []
     monkeypatch.setattr(evaluation, "steady_design_metrics_points", _engine_stand_in(seen))
-    monkeypatch.setattr(evaluation, "frozen_load_gradients", _frozen_stand_in())
+    monkeypatch.setattr(evaluation, "frozen_load_statistics", _frozen_stand_in())
     problem = make_problem(jb.reference_bearing(), jb.reference_operating_point())
     h = 0.01e-3
     settings = search_settings.SteadySettings(seeds=3, workers=1, clearance_step=h)
@@ -593,18 +612,10 @@ def _three_speed_stand_ins(monkeypatch, engine):
     """The reference problem at 10,000, 20,000 and 30,000 rpm with `engine` for the settled
     ensembles and a constant frozen-load gradient; 2 seeds, one worker."""
     import jaxbearing as jb
-    from jaxbearing.design import SteadyGradient
     from optimise import make_problem
 
     monkeypatch.setattr(evaluation, "steady_design_metrics_points", engine)
-    monkeypatch.setattr(
-        evaluation,
-        "frozen_load_gradients",
-        lambda cases, **kw: [
-            SteadyGradient(1e9, np.array([3e9, -4e9, 0.0]), np.full(3, 1e7), 1e6, 1e-4, 4, None, None, None)
-            for _ in cases
-        ],
-    )
+    monkeypatch.setattr(evaluation, "frozen_load_statistics", _frozen_stand_in())
     problem = make_problem(
         jb.reference_bearing(), jb.reference_operating_point(), speeds_rpm=[10e3, 20e3, 30e3]
     )

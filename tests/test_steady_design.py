@@ -23,8 +23,14 @@ def test_steady_design_metrics_report_intervals_and_margins(small):
     # a settling time given as text is a settling time (it once ran as "auto", two revolutions more)
     m = jb.steady_design_metrics(b, op, design, seeds=2, window_revs=2, settle="0.5", first_seed=5)
     assert m.seeds == [5, 6] and m.settled
-    # the mean's accumulators give the tail statistic too, from the same runs; not the peak's
-    assert set(m.objectives_per_seed) == {"mean", "tail"}
+    # the mean's accumulators give the tail statistic and the friction power too, from the same
+    # runs; not the peak's
+    assert set(m.objectives_per_seed) == {"mean", "tail", "friction"}
+    # each seed's friction power is its own time mean; with equal windows their mean is the
+    # settled statistic over every revolution of both seeds
+    friction = np.asarray(m.objectives_per_seed["friction"])
+    assert np.all(friction > 0)
+    assert np.mean(friction) == pytest.approx(m.statistics.flange_friction_power_W.total.value, rel=1e-9)
     assert m.objectives_per_seed["mean"] == m.objective_per_seed
     assert (
         all(np.isfinite(m.objectives_per_seed["tail"]))

@@ -142,9 +142,10 @@ def _verified(problem, settings, run) -> None:
 
     if run["design"] is None or "verified" in run:
         return
-    from jaxbearing.flange import DesignVariables
+    from optimise import start_points
 
-    reference = np.asarray(DesignVariables.of(problem.bearing).as_array())
+    # the search's own reference: the bearing's design of the problem's kind (3 or 8 variables)
+    reference = np.asarray(problem.bounds.from_scaled(start_points(problem, 1)[0]))
     v = verification(problem, settings, np.asarray(run["design"]), reference)
     rows = v["optimum"].get("per_operating_point", [v["optimum"]])
     run["verified"] = [r["objective_GPa_m_s"] for r in rows]

@@ -66,19 +66,14 @@ NEW_VARIABLES = (
 STEP_FRACTION = 0.15
 
 
-def _box():
-    from optimise._bounds import PROFILE_TABLE, ProfileBounds
-
-    bounds = ProfileBounds()
-    return PROFILE_TABLE, bounds
-
-
 def steps(variables) -> dict:
     """The difference step [SI] of each variable: `STEP_FRACTION` of its default box range."""
-    table, bounds = _box()
-    lo, hi = bounds.lower, bounds.upper
-    keys = [v.key for v in table]
-    return {k: STEP_FRACTION * float(hi[keys.index(k)] - lo[keys.index(k)]) for k in variables}
+    from optimise import ProfileBounds
+
+    bounds = ProfileBounds()
+    keys = [v.key for v in bounds.TABLE]
+    width = bounds.upper - bounds.lower
+    return {k: STEP_FRACTION * float(width[keys.index(k)]) for k in variables}
 
 
 def check(design_mm, *, variables=NEW_VARIABLES, slices=11, seeds=6, window_revs=2, workers=1):
@@ -93,10 +88,10 @@ def check(design_mm, *, variables=NEW_VARIABLES, slices=11, seeds=6, window_revs
         steady_design_metrics_points,
     )
     from jaxbearing.flange import MARGIN_NAMES, ProfileVariables, zone_margins
+    from optimise import ProfileBounds
 
-    table, _ = _box()
-    keys = [v.key for v in table]
-    x = np.array([value * v.si for value, v in zip(design_mm, table)])
+    keys = [v.key for v in ProfileBounds.TABLE]
+    x = ProfileBounds.from_engineering(design_mm)
     b = dataclasses.replace(jb.reference_bearing(), num_slices=slices)
     op = jb.reference_operating_point()
     design = ProfileVariables.from_array(x)

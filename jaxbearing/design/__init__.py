@@ -14,8 +14,9 @@
 - its gradient: `steady_gradient` (an ensemble of short-window forward-mode sensitivities from
   settled states, `GRADIENT_WINDOW`), `frozen_load_gradient` (`frozen_load_gradients`: many cases, one call; `frozen_load_statistics`: several statistics from the same trajectories), `ratio_gradient`, `paired_central_difference` (common-random-number differences),
   `SteadyGradient`, `tangent_growth` (finite-time growth of the tangents) and the smooth
-  accumulators they differentiate, `STEADY_FUNCTIONALS` (`STATISTICS`, by `Statistic`: the mean, and the
-  peak statistic's p-mean with p = `PEAK_EXPONENT`).
+  accumulators they differentiate, `STEADY_FUNCTIONALS` (`STATISTICS`, by `Statistic`: the mean, the
+  peak statistic's p-mean with p = `PEAK_EXPONENT`, the tail mean, and the time-mean flange
+  friction power, `FRICTION_REFERENCE`).
 
 - which uncertain inputs matter (docs/model.md 18): `sensitivity` (the effect, derivative x
   stated uncertainty, of every `[uncertainty]` key and `MODEL_CONSTANTS` entry on settled
@@ -74,6 +75,7 @@ from ._steady_design import (
     steady_design_metrics_points,
 )
 from ._steady_objective import (
+    FRICTION_REFERENCE,
     GRADIENT_WINDOW,
     PEAK_EXPONENT,
     STATISTICS,
@@ -93,6 +95,7 @@ __all__ = [
     "GRADIENT_RTOL",
     "GRADIENT_WINDOW",
     "MODEL_CONSTANTS",
+    "FRICTION_REFERENCE",
     "PEAK_EXPONENT",
     "ROBUSTNESS_CONSTANTS",
     "SENSITIVITY_METHODS",

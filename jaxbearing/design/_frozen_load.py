@@ -9,7 +9,10 @@ with the contact point, curvatures and sliding velocity of design d. The per-tra
 A_k, C_k of the smooth-indicator-weighted samples and their Jacobians are combined through the
 ratio estimator, with the jackknife over the trajectories. The tail statistic applies the same
 estimator to the Rockafellar-Uryasev integrand at the 95th percentile of the trajectories' own
-touching samples (`tail_integrals`; `_steady_objective`, the tail statistic).
+touching samples (`tail_integrals`; `_steady_objective`, the tail statistic). The friction
+statistic holds the loads the same way: per saved state sum_c mu_c(x) Q0_c |u_c(x)| with the
+friction coefficient and sliding speed of design x (`frozen_friction_integrands`), a plain time
+average (C = 1 per saved state).
 """
 
 from __future__ import annotations
@@ -42,6 +45,7 @@ from ..run import (
 )
 from ._design import forward_jacobian
 from ._steady_objective import (
+    FRICTION_REFERENCE,
     STEADY_FUNCTIONALS,
     Statistic,
     SteadyGradient,
@@ -96,6 +100,20 @@ def frozen_load_integrands(bearing, op, x, state: State, reference_load, exponen
     contacts of one state, p = `exponent` (`frozen_pv`)."""
     w, frozen = frozen_pv(bearing, op, x, state, reference_load)
     return jnp.stack([jnp.sum(w * frozen**exponent), jnp.sum(w)])
+
+
+def frozen_friction_integrands(bearing, op, x, state: State, reference_load):
+    """(sum_c mu_c(x) Q0_c |u_c(x)| / P_ref, 1) over the flange contacts of one state: the total
+    flange friction power [W / P_ref] with design x at the loads Q0 = `reference_load` (Z, 4)
+    the dynamics gave, with the friction coefficient and the material sliding speed of design x
+    at the contact point of design x (docs/model.md 5.5). mu is evaluated at the design's own
+    load Q(x): its dependence on the load through the film parameter (h_min ~ Q^-0.073) is
+    left out of the frozen estimate. The second entry is the time average's weight: every
+    saved state counts once."""
+    fl = contact_loads(state, _design_params(bearing, op, x)).flange
+    q0 = jnp.where(reference_load > LOAD_FLOOR, reference_load, 0.0)
+    power = fl.friction_coefficient * q0 * fl.sliding_speed
+    return jnp.stack([jnp.sum(power) / FRICTION_REFERENCE, jnp.ones((), power.dtype)])
 
 
 def frozen_tail_samples(bearing, op, x, states):
@@ -163,6 +181,10 @@ class _FrozenSample:
                 args = (self.bearing, self.op, x, states)
                 program = compiled_program("frozen_tail_samples", frozen_tail_samples, args)
                 out[statistic] = tuple(map(np.asarray, program(*args)))
+            elif statistic == "friction":
+                args = (self.bearing, self.op, x, states)
+                val, jac = compiled_program("frozen_friction_jacobian", _friction_jacobian, args)(*args)
+                out[statistic] = (np.asarray(val), np.asarray(jac))
             else:
                 args = (self.bearing, self.op, x, states, _exponent(statistic))
                 val, jac = compiled_program("frozen_load_jacobian", _frozen_jacobian, args)(*args)
@@ -192,6 +214,18 @@ def _frozen_jacobian(bearing, op, x, states, exponent=1.0):
     return forward_jacobian(total, x)
 
 
+def _friction_jacobian(bearing, op, x, states):
+    """Sum over the saved states of the frozen friction integrands (`frozen_friction_integrands`)
+    and their Jacobian in x."""
+    q0 = _reference_loads(bearing, op, x, states)
+
+    def total(v):
+        per = jax.vmap(lambda s, q: frozen_friction_integrands(bearing, op, v, s, q))(states, q0)
+        return jnp.sum(per, axis=0)
+
+    return forward_jacobian(total, x)
+
+
 def frozen_load_gradient(
     bearing: Bearing, op: OperatingPoint, design: DesignVariables, states, **options
 ) -> SteadyGradient:
@@ -206,7 +240,8 @@ def frozen_load_gradients(
     """The frozen-load estimate (module docstring) of the steady objective and its gradient for
     every case (bearing, op, design, states), e.g. every start and operating point of one
     iteration of the design search; one `SteadyGradient` per case, in order. `statistic`:
-    "mean" (PV over contact time), "peak" (its p-mean) or "tail" (the mean of its worst 5 %);
+    "mean" (PV over contact time), "peak" (its p-mean), "tail" (the mean of its worst 5 %) or
+    "friction" (the time-mean total flange friction power);
     the other `options` and how the trajectories run: `frozen_load_statistics`, of this one
     statistic."""
     key = statistic_of(statistic)
@@ -216,7 +251,7 @@ def frozen_load_gradients(
 def frozen_load_statistics(
     cases,
     *,
-    statistics=("mean", "peak", "tail"),
+    statistics=("mean", "peak", "tail", "friction"),
     window: float = 1.0e-3,
     saves_per_ms: int = 200,
     rtol: float = 1e-3,
@@ -232,8 +267,9 @@ def frozen_load_statistics(
     (`frozen_load_integrands`), summed, and combined through the ratio estimator; jackknife over
     the trajectories. Each trajectory is integrated once for all the statistics: they differ
     only in what is summed over its saved states. Statistics (`STATISTICS`): "mean" (PV over
-    contact time), "peak" (its p-mean) or "tail" (the mean of its worst 5 %, at the 95th
-    percentile of the trajectories' own touching samples: `tail_integrals`). Every trajectory
+    contact time), "peak" (its p-mean), "tail" (the mean of its worst 5 %, at the 95th
+    percentile of the trajectories' own touching samples: `tail_integrals`) or "friction" (the
+    time-mean total flange friction power: `frozen_friction_integrands`). Every trajectory
     of every case is one member of one call (`strategy`, as the steady-running engine's
     `choose_strategy`): "vmap" (the default on an accelerator) integrates and differentiates
     them all in one vmapped program; on a CPU they run `workers` processes at a time
@@ -246,7 +282,7 @@ def frozen_load_statistics(
         dict.fromkeys(statistic_of(s) for s in ([statistics] if isinstance(statistics, str) else statistics))
     )
     if not statistics:
-        raise UserInputError("statistics = (): must name at least one of 'mean', 'peak', 'tail'")
+        raise UserInputError("statistics = (): must name at least one of 'mean', 'peak', 'tail', 'friction'")
     cases = list(cases)
     n = max(1, int(round(window * 1e3 * saves_per_ms)))
     jobs, owner = [], []
@@ -268,9 +304,16 @@ def frozen_load_statistics(
 
 def _combine_statistic(statistic: str, samples: list, window: float, num_variables: int) -> SteadyGradient:
     """One statistic's estimate from its per-trajectory samples (`_FrozenSample`): the ratio
-    estimator at its exponent (mean, peak), or at the tail threshold of its samples (tail)."""
+    estimator at its exponent (mean, peak), as a plain time average (friction), or at the tail
+    threshold of its samples (tail)."""
     if statistic != "tail":
-        return _combine(samples, window, float(_exponent(statistic)), num_variables=num_variables)
+        return _combine(
+            samples,
+            window,
+            float(_exponent(statistic)),
+            num_variables=num_variables,
+            reference=statistic_of(statistic).reference,
+        )
     integrals, q = tail_integrals(samples, num_variables)
     return _combine(
         integrals, window, tail_threshold=q * STEADY_FUNCTIONALS.pv_reference, num_variables=num_variables
@@ -295,14 +338,20 @@ def _frozen_job(item):
 def _frozen_samples_batched(jobs) -> list:
     """Every (`_FrozenSample`, state) of `jobs` as one member of one vmapped program: its
     trajectory, integrated once, and per statistic the frozen-load integrals and Jacobian (mean,
-    peak: their exponents a traced argument, so one program serves either) or the tail's samples."""
+    peak: their exponents a traced argument, so one program serves either; friction) or the
+    tail's samples."""
     num_saves, statistics = jobs[0][0].num_saves, jobs[0][0].statistics
     sums = [s for s in statistics if s != "tail"]
     tail = "tail" in statistics
 
     def one(b, o, x, s, d, r, p):
         states, code = trajectory_states(b, o, s, d, num_saves, rtol=r)
-        out = [_frozen_jacobian(b, o, x, states, p[i]) for i in range(len(sums))]
+        out = [
+            _friction_jacobian(b, o, x, states)
+            if name == "friction"
+            else _frozen_jacobian(b, o, x, states, p[i])
+            for i, name in enumerate(sums)
+        ]
         return (out, frozen_tail_samples(b, o, x, states) if tail else None), code
 
     args = stack_trees(
@@ -319,7 +368,7 @@ def _frozen_samples_batched(jobs) -> list:
             for job, state in jobs
         ]
     )
-    program = compiled_program("frozen_members", jax.vmap(one), args, (num_saves, len(sums), tail))
+    program = compiled_program("frozen_members", jax.vmap(one), args, (num_saves, tuple(sums), tail))
     (sum_outs, tail_outs), codes = jax.device_get(program(*args))
     found = []
     for i in range(len(jobs)):

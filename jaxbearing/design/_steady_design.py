@@ -31,9 +31,11 @@ limited circle, clearance; positive when satisfied) and the full settled summary
   average over the saved samples with the hard 1 N threshold); with `Statistic.PEAK` the
   p-mean PV_ref (int w (PV/PV_ref)^p dt / int w dt)^(1/p), p = `PEAK_EXPONENT`, which weights
   the peaks; with `Statistic.TAIL` the tail mean of PV over contact time per revolution, the
-  mean of its worst 5 % of the saved touching samples (`run.tail_mean`) (`STATISTICS`);
+  mean of its worst 5 % of the saved touching samples (`run.tail_mean`); with
+  `Statistic.FRICTION` the time-mean total flange friction power [W] (`STATISTICS`);
 - `objectives_per_seed`: per seed, the objective of every statistic the run's accumulators give
-  (the mean and the tail integrate the same ones, so one ensemble gives both);
+  (the mean, the tail and the friction power integrate the same ones, so one ensemble gives
+  all three);
 
 It is a measurement, not a differentiable function: the gradient of a long impacting trajectory
 is not a design signal (`_design`, docs/model.md 14); `steady_gradient` estimates the gradient
@@ -190,18 +192,26 @@ def steady_design_metrics_points(
     ]
 
 
-def _tail_per_seed(result, run) -> float:
-    """One seed's tail statistic: the mean over its window's revolutions of the tail mean of PV
-    over contact time (`run.tail_mean` of the touching samples, per revolution: the
-    `flange_pv_contact_time_Pa_m_s.tail95` field of that seed's own statistics); NaN without a
-    measured window or contact."""
+def _own_statistic(result, run, read) -> float:
+    """`read` of one seed's own settled statistics (`run.settled_statistics` of its window
+    alone), e.g. the tail mean of PV over contact time or the friction power of that seed; NaN
+    without a measured window."""
     if not run.measured:
         return float("nan")
     windows, edges, given = (
         ([run.window], [run.edges], None) if run.per_revolution is None else ([], [], [run.per_revolution])
     )
     own = settled_statistics(windows, edges, result.bearing, result.operating, per_revolution=given)
-    return float(own.flange_pv_contact_time_Pa_m_s.tail95.value)
+    return float(read(own))
+
+
+#: per statistic read from a seed's own settled statistics (`_own_statistic`): the tail mean of
+#: PV over contact time (the mean over the window's revolutions of `run.tail_mean` of the
+#: touching samples) and the time-mean total flange friction power
+_OWN_STATISTICS = {
+    Statistic.TAIL: lambda own: own.flange_pv_contact_time_Pa_m_s.tail95.value,
+    Statistic.FRICTION: lambda own: own.flange_friction_power_W.total.value,
+}
 
 
 def _metrics(
@@ -294,11 +304,11 @@ def _same_functionals(a, b) -> bool:
 
 def _objective_per_seed(result, statistic: Statistic | str, functionals) -> list:
     """Each seed's objective of `statistic` from the window of `result`'s runs (module
-    docstring): the tail from the revolutions' tail means, the mean and the peak from the
-    accumulated integrals of `functionals`, PV_ref (sum A / sum C)^(1/p); NaN where a seed has
-    no measured window or contact."""
-    if statistic == Statistic.TAIL:
-        return [_tail_per_seed(result, r) for r in result.runs]
+    docstring): the tail and the friction power from the seed's own statistics
+    (`_OWN_STATISTICS`), the mean and the peak from the accumulated integrals of `functionals`,
+    PV_ref (sum A / sum C)^(1/p); NaN where a seed has no measured window or contact."""
+    if statistic in _OWN_STATISTICS:
+        return [_own_statistic(result, r, _OWN_STATISTICS[statistic]) for r in result.runs]
     pv_ref, p = float(functionals.pv_reference), float(functionals.pv_exponent)
     return [
         pv_ref * (sum(a for a, _ in r.window_integrals) / sum(c for _, c in r.window_integrals)) ** (1.0 / p)

@@ -34,6 +34,14 @@ the integrand (PV / PV_ref - q / PV_ref)^+ and the statistics' hard contact indi
 so that 5 % of them lie above it. An error dq in q changes J by O(dq^2) only. Unlike the
 quantile itself, whose derivative E[dPV | PV = q] needs a kernel around q and the few samples
 inside it, every sample of the worst 5 % carries the signal.
+
+The friction statistic. The time-mean total flange friction power of settled running,
+
+    P(d) = P_ref sum_k A_k / sum_k C_k,   A_k = int sum_c mu_c Q_c |u_c| / P_ref dt,
+                                          C_k = int 1 dt,
+
+over every contact c (docs/model.md 5.5; P_ref = `FRICTION_REFERENCE` = 1 W): the same ratio
+estimator with a plain time average (C = the window's length, every sample counts).
 """
 
 from __future__ import annotations
@@ -58,17 +66,39 @@ STEADY_FUNCTIONALS = Functionals(pv_exponent=1.0, contact_load=CONTACT_LOAD)
 #: p of the peak statistic: the p-mean of PV over contact time, PV_ref (sum A_p / sum C)^(1/p),
 #: which weights the tail (p = 8: a sample at twice the mean counts 256 times as much)
 PEAK_EXPONENT = 8.0
+#: P_ref of the friction statistic's integrand [W] (module docstring, the friction statistic)
+FRICTION_REFERENCE = 1.0
 
 
 class Statistic(enum.StrEnum):
-    """The statistic of flange PV a steady objective measures (module docstring): `MEAN` over
+    """The statistic a steady objective measures (module docstring): of flange PV, `MEAN` over
     contact time (p = 1), `PEAK` (the p-mean, p = `PEAK_EXPONENT`) or `TAIL` (the tail mean of
     PV over contact time, the mean of its worst 1 - `TAIL_LEVEL` = 5 %, from the saved
-    samples). Its value is the name the command line and the TOML files use."""
+    samples); or `FRICTION`, the time-mean total flange friction power. Its value is the name
+    the command line and the TOML files use."""
 
     MEAN = "mean"
     PEAK = "peak"
     TAIL = "tail"
+    FRICTION = "friction"
+
+    @property
+    def reference(self) -> float:
+        """The SI reference the statistic's integrand is divided by: PV_ref [Pa m/s] or
+        `FRICTION_REFERENCE` [W]."""
+        return FRICTION_REFERENCE if self is Statistic.FRICTION else STEADY_FUNCTIONALS.pv_reference
+
+    @property
+    def shown(self) -> tuple[float, str]:
+        """(factor, unit) the statistic is printed and stored in: its SI value divided by the
+        factor is in the unit (GPa m/s for PV, W for friction power)."""
+        return (1.0, "W") if self is Statistic.FRICTION else (1e9, "GPa m/s")
+
+    @property
+    def key(self) -> str:
+        """The key a results file stores the statistic's value under, unit in the name:
+        "objective_GPa_m_s" or "objective_W"."""
+        return "objective_" + self.shown[1].replace(" ", "_").replace("/", "_")
 
 
 #: the accumulators each statistic's runs integrate
@@ -76,6 +106,7 @@ STATISTICS = {
     Statistic.MEAN: STEADY_FUNCTIONALS,
     Statistic.PEAK: Functionals(pv_exponent=PEAK_EXPONENT, contact_load=CONTACT_LOAD),
     Statistic.TAIL: STEADY_FUNCTIONALS,
+    Statistic.FRICTION: STEADY_FUNCTIONALS,
 }
 #: default window of the short-window sensitivities [s] (docs/validation.md)
 GRADIENT_WINDOW = 1.0e-3
@@ -141,19 +172,19 @@ def paired_central_difference(plus, minus, h: float) -> tuple[float, float, int]
     return mean, se, n
 
 
-def ratio_gradient(a, c, da, dc, pv_reference: float):
-    """(J, dJ/dx) of J = PV_ref sum a / sum c from per-sample a (K,), c (K,), da, dc (K, n)."""
+def ratio_gradient(a, c, da, dc, reference: float):
+    """(J, dJ/dx) of J = reference sum a / sum c from per-sample a (K,), c (K,), da, dc (K, n)."""
     sa, sc = np.sum(a), np.sum(c)
-    return pv_reference * sa / sc, pv_reference * (np.sum(da, 0) * sc - sa * np.sum(dc, 0)) / sc**2
+    return reference * sa / sc, reference * (np.sum(da, 0) * sc - sa * np.sum(dc, 0)) / sc**2
 
 
-def _jackknife_stderr(a, c, da, dc, pv_reference):
+def _jackknife_stderr(a, c, da, dc, reference):
     """Jackknife standard errors of (J, dJ/dx) of `ratio_gradient` over the K samples."""
     k = len(a)
     if k < 2:
         return float("nan"), np.full(da.shape[1], np.nan)
     keep = ~np.eye(k, dtype=bool)
-    loo = [ratio_gradient(a[m], c[m], da[m], dc[m], pv_reference) for m in keep]
+    loo = [ratio_gradient(a[m], c[m], da[m], dc[m], reference) for m in keep]
     vals = np.array([v for v, _ in loo])
     grads = np.stack([g for _, g in loo])
     f = (k - 1) / k
@@ -163,7 +194,12 @@ def _jackknife_stderr(a, c, da, dc, pv_reference):
 
 
 def _combine(
-    outs, window, exponent: float = 1.0, tail_threshold: float | None = None, num_variables: int = 3
+    outs,
+    window,
+    exponent: float = 1.0,
+    tail_threshold: float | None = None,
+    num_variables: int = 3,
+    reference: float = STEADY_FUNCTIONALS.pv_reference,
 ) -> SteadyGradient:
     """The ratio estimator and its jackknife from per-sample ((A, C), Jacobian (n, 2)); a
     failed sample carries NaN and is left out. With `exponent` p (A the integral of
@@ -171,7 +207,8 @@ def _combine(
     standard errors by the same factor (delta method). With `tail_threshold` q [Pa m/s] (A the
     integral of (PV/PV_ref - q/PV_ref)^+): the tail mean's Rockafellar-Uryasev form
     J = q + PV_ref R / (1 - alpha), dJ = PV_ref dR / (1 - alpha) at fixed q, alpha = `TAIL_LEVEL`
-    (module docstring, the tail statistic)."""
+    (module docstring, the tail statistic). `reference`: the integrand's reference (PV_ref, or
+    P_ref of the friction statistic)."""
     if not outs:  # no states given
         return dataclasses.replace(SteadyGradient.missing(num_variables), window_s=float(window))
     vals = np.stack([v for v, _ in outs])  # (K, 2): A, C
@@ -179,20 +216,19 @@ def _combine(
     ok = np.all(np.isfinite(vals), axis=1) & np.all(np.isfinite(jacs), axis=(1, 2))
     a, c = vals[ok, 0], vals[ok, 1]
     da, dc = jacs[ok, :, 0], jacs[ok, :, 1]
-    pv_ref = STEADY_FUNCTIONALS.pv_reference
     if not ok.any() or np.sum(c) <= 0:
         nan = np.full(jacs.shape[1], np.nan)
         return SteadyGradient(
             float("nan"), nan, nan, float("nan"), float(window), int(ok.sum()), vals, jacs, ok
         )
-    value, grad = ratio_gradient(a, c, da, dc, pv_ref)
-    value_se, grad_se = _jackknife_stderr(a, c, da, dc, pv_ref)
-    if tail_threshold is not None:  # value = PV_ref R above
+    value, grad = ratio_gradient(a, c, da, dc, reference)
+    value_se, grad_se = _jackknife_stderr(a, c, da, dc, reference)
+    if tail_threshold is not None:  # value = reference R above
         scale = 1.0 / (1.0 - TAIL_LEVEL)
         value, grad = tail_threshold + scale * value, scale * grad
         value_se, grad_se = scale * value_se, scale * grad_se
-    elif exponent != 1.0:  # value = PV_ref R above
-        j = pv_ref * (value / pv_ref) ** (1.0 / exponent)
+    elif exponent != 1.0:  # value = reference R above
+        j = reference * (value / reference) ** (1.0 / exponent)
         factor = j / (exponent * value)
         value, grad, value_se, grad_se = j, grad * factor, value_se * factor, grad_se * factor
     return SteadyGradient(
