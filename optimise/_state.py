@@ -23,7 +23,7 @@ from jaxbearing.io import TreeFileError, check_like, load_tree, save_tree
 from ._envelope import Envelope
 from ._lagrangian import Hyper
 from ._problem import DesignProblem
-from ._settings import SteadySettings
+from ._settings import Choice, SteadySettings
 
 CHECKPOINT = "checkpoint.npz"
 #: the name of the pickled checkpoints of older versions: refused, never loaded
@@ -39,7 +39,7 @@ class History:
     """Per iteration, per start: what the search measured (lists of arrays, one per iteration)."""
 
     x: list = dataclasses.field(default_factory=list)  # (S, n) designs [SI]
-    objective: list = dataclasses.field(default_factory=list)  # (S,) [GPa m/s]
+    objective: list = dataclasses.field(default_factory=list)  # (S,) [GPa m/s, or W: `Statistic.shown`]
     ci: list = dataclasses.field(default_factory=list)  # (S, 2)
     gradient: list = dataclasses.field(default_factory=list)  # (S, n) per unit box
     gradient_stderr: list = dataclasses.field(default_factory=list)  # (S, n)
@@ -81,8 +81,11 @@ class SearchState:
 
 
 def fingerprint(problem: DesignProblem, settings: SteadySettings, hyper: Hyper, starts) -> str:
-    """A hash of everything that decides the search's result (for resuming): the bearing and
-    operating points, bounds, constraints, envelope, measurement settings, step sizes, starts."""
+    """A hash of everything that decides the search's path (for resuming): the bearing and
+    operating points, bounds, constraints, envelope, measurement settings, step sizes, starts.
+    Not the worker count, nor which of the tied designs is returned (`SteadySettings.choose`
+    picks from the finished history), so a finished search resumed with another choice
+    returns that choice's design without simulating again."""
     leaves = [
         np.asarray(v).tobytes()
         for v in jax.tree_util.tree_leaves((problem.bearing, problem.operating, problem.point_bearings))
@@ -97,7 +100,8 @@ def fingerprint(problem: DesignProblem, settings: SteadySettings, hyper: Hyper, 
             problem.flange_load,
             problem.min_clearance,
             np.asarray(problem.weights).tolist(),
-            dataclasses.replace(settings, workers=0),  # the processes do not change the result
+            # the processes do not change the path, nor does the choice among the tied designs
+            dataclasses.replace(settings, workers=0, choose=Choice.SAFEST),
             hyper,
             np.asarray(starts).tolist(),
         )

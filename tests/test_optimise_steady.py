@@ -244,6 +244,14 @@ def test_killed_run_resumes_with_the_same_result(tmp_path, config, monkeypatch, 
     # other settings: the checkpoint is refused in one line
     assert main(["run", "--config", config, *args[:-2], "--no-verify", "--out", str(killed)]) == 2
     assert "checkpoint of a search with other settings" in capsys.readouterr().err
+    # another choice among the tied designs picks from the finished history: nothing simulated
+    monkeypatch.setattr(steady, "evaluate_starts", lambda *a, **k: pytest.fail("simulated again"))
+    other = [*args]
+    other[other.index("--choose") + 1] = "safest"
+    assert main(["run", "--config", config, *other, "--no-verify", "--quiet", "--out", str(killed)]) == 0
+    r3, j3, _ = _history(killed)
+    assert r3["settings"]["choose"] == "safest" and r3["resumed_from_iteration"] == 2
+    np.testing.assert_array_equal(j3, j1)
 
 
 def _metrics_stand_in(calls):
