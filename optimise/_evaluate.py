@@ -71,7 +71,8 @@ class PointRecord:
     #: the upper 95 % bound of the time-mean total flange friction power [W]
     friction_power_high: float = float("nan")
     #: the frozen-load gradient of the time-mean total flange friction power per unit of the
-    #: scaled box [W] (`friction_gradients`; NaN where not estimated)
+    #: scaled box [W] (`_gradients`: with a friction limit and the frozen-load estimator; None
+    #: otherwise)
     friction_gradient: np.ndarray | None = None
 
 

@@ -411,10 +411,10 @@ def frozen_estimates(settled):
 
     b, op, x, base = settled
     case = (b, op, DesignVariables.from_array(x), base.sample_states)
-    return frozen_load_statistics([case], statistics=("mean", "peak", "tail", "friction"), workers=1)[0]
+    return frozen_load_statistics([case], statistics=("mean", "peak", "tail"), workers=1)[0]
 
 
-@pytest.mark.parametrize("statistic", ["mean", "peak", "tail", "friction"])
+@pytest.mark.parametrize("statistic", ["mean", "peak", "tail"])
 def test_frozen_load_estimator_agrees_with_crn_differences_on_settled_running(
     settled, crn_runs, frozen_estimates, statistic
 ):
@@ -447,11 +447,16 @@ def test_frozen_load_estimator_agrees_with_crn_differences_on_settled_running(
     with them the chaotic runs; 2026-11-26, `pytest -rP tests/test_steady_gradient.py -k crn`
     with conftest's flags, one process): mean -8.84e10 +- 1.1e10 against -9.99e10 (13 %
     apart), peak -1.59e11 +- 1.6e10 against -1.61e11 (1 %), tail -2.10e11 +- 3.3e10 against
-    -2.20e11 (5 %). The friction statistic (the time-mean total flange friction power) from the
-    mean's ensembles (2026-11-29, one process): CRN FD -560 +- 44 W/rad (12.7 standard errors),
-    frozen load -622 +- 53 W/rad, 11 % apart. The mean, the tail and the friction power share
-    their ensembles (`_crn_ensembles`), and the four frozen-load estimates their trajectories
-    (`frozen_estimates`)."""
+    -2.20e11 (5 %). The mean and the tail share their ensembles (`_crn_ensembles`), and the
+    frozen-load estimates their trajectories (`frozen_estimates`).
+
+    Not the friction statistic (the time-mean total flange friction power): with these 3 seeds
+    its difference is significant in one setting and not in the other (2026-11-29, the mean's
+    ensembles; one process: CRN FD -560 +- 44 W/rad, 12.7 standard errors, frozen load
+    -622 +- 53 W/rad, 11 % apart; in `make test` from a fresh clone: -472 +- 167 W/rad,
+    2.8 standard errors, frozen load -723 +- 100): the friction power scatters more between
+    seeds than PV. Its frozen derivative is checked against central differences of its own
+    functional (`test_frozen_friction_derivative_matches_central_differences`)."""
     h = CRN_STEP
     ensembles = _crn_ensembles(settled, crn_runs, statistic)
     per_seed = [np.asarray(m.objectives_per_seed[statistic]) for m in ensembles]
@@ -476,9 +481,9 @@ def test_frozen_load_statistics_batched_equal_one_at_a_time(settled):
     the batch's size. The two are then two estimates of the same expectation, each with its own
     standard error, so they must agree within three standard errors of their difference,
     sqrt(SE_1^2 + SE_b^2) (a false alarm at most 0.3 % of the time for normal errors; one
-    standard error of one of them failed on a fresh machine). One program for the three
-    statistics: the mean's and the peak's Jacobians at their exponents, and every sample's frozen
-    PV and Jacobian for the tail."""
+    standard error of one of them failed on a fresh machine). One program for the four
+    statistics: the mean's and the peak's Jacobians at their exponents, the friction power's,
+    and every sample's frozen PV and Jacobian for the tail."""
     from jaxbearing.design import frozen_load_statistics
 
     b, op, x, base = settled
@@ -488,7 +493,7 @@ def test_frozen_load_statistics_batched_equal_one_at_a_time(settled):
         (b, op, DesignVariables.from_array(x), base.sample_states[:2]),
         (b, op, DesignVariables.from_array(x2), base.sample_states[:3]),
     ]
-    every = ("mean", "peak", "tail")
+    every = ("mean", "peak", "tail", "friction")
     one = frozen_load_statistics(cases, statistics=every, strategy="sequential")
     batched = frozen_load_statistics(cases, statistics=every, strategy="vmap")
     for statistic in every:

@@ -4,7 +4,7 @@
         --name profile_gradient_check
 
 At each of three profile designs (`DESIGNS`, inside the box of examples/optimise_profile.toml,
-the faces general: a torus end, a concave rib) the reference bearing at `--slices` slices and
+the faces general: a torus end, a concave rib; `--designs` picks some by position) the reference bearing at `--slices` slices and
 its operating point (20,000 rpm, 1000 N) settles `--seeds` seeds from the skid start (`design.steady_design_metrics`, a
 `--window-revs` window); the frozen-load estimator (`design.frozen_load_gradients`) gives the
 gradient of the settled mean flange PV in all eight variables from those settled states. For
@@ -167,18 +167,20 @@ def main(argv=None) -> int:
     p.add_argument("--seeds", type=int, default=6)
     p.add_argument("--window-revs", type=int, default=2)
     p.add_argument("--variables", default=",".join(NEW_VARIABLES))
+    p.add_argument("--designs", default="0,1,2", help="which of DESIGNS, by position (0, 1, 2)")
     p.add_argument("--workers", type=int, default=1)
     p.add_argument("--name", default="profile_gradient_check")
     args = p.parse_args(argv)
     variables = tuple(args.variables.split(","))
-    settings = {k: v for k, v in vars(args).items() if k != "name"}
+    settings = {k: v for k, v in vars(args).items() if k not in ("name", "designs")}
     path = _common.RESULTS_DIR / f"{args.name}.json"
     out = json.loads(path.read_text()) if path.exists() else {}
     if out.get("settings") != settings or out.get("step_fraction") != STEP_FRACTION:
         out = {"settings": settings, "step_fraction": STEP_FRACTION, "designs": {}}
     t0 = time.perf_counter()
+    chosen = [list(DESIGNS)[int(i)] for i in args.designs.split(",")]
     for label, design in DESIGNS.items():
-        if label in out["designs"]:
+        if label in out["designs"] or label not in chosen:
             continue
         out["designs"][label] = check(
             design,
