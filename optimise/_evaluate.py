@@ -43,6 +43,16 @@ from ._problem import DesignProblem
 from ._settings import CornerConstraint, Estimator, SteadySettings, clearance_step_for
 
 
+@dataclasses.dataclass(frozen=True)
+class PointGradients:
+    """The gradient estimates at one start and operating point (`_gradients`): the objective's
+    and, where a friction limit is set and the estimator is the frozen-load one, the total
+    flange friction power's from the same trajectories (None otherwise)."""
+
+    objective: SteadyGradient
+    friction: SteadyGradient | None = None
+
+
 @dataclasses.dataclass
 class PointRecord:
     """What one evaluation measured at one operating point (objective values in the statistic's
@@ -169,13 +179,13 @@ def _checked_active(active, n: int, num_designs: int, previous) -> list[list[boo
     return active
 
 
-def _gradients(settings: SteadySettings, cases, gradient: bool, num_variables: int) -> list[tuple]:
-    """The gradient estimates of `cases` (bearing, op, design, states) by `settings.estimator`:
-    per case (the objective's `SteadyGradient`, the friction power's or None). The friction
-    power's is estimated where a friction limit is set (`SteadySettings.max_friction_power`),
-    from the same trajectories as the objective's (`frozen_load_statistics`)."""
+def _gradients(settings: SteadySettings, cases, gradient: bool, num_variables: int) -> list[PointGradients]:
+    """The gradient estimates of `cases` (bearing, op, design, states) by `settings.estimator`,
+    one `PointGradients` per case. The friction power's is estimated where a friction limit is
+    set (`SteadySettings.max_friction_power`), from the same trajectories as the objective's
+    (`frozen_load_statistics`)."""
     if not gradient:
-        return [(SteadyGradient.missing(num_variables), None) for _ in cases]
+        return [PointGradients(SteadyGradient.missing(num_variables)) for _ in cases]
     if settings.estimator is Estimator.FROZEN:
         friction = settings.max_friction_power is not None
         found = frozen_load_statistics(
@@ -185,17 +195,16 @@ def _gradients(settings: SteadySettings, cases, gradient: bool, num_variables: i
             rtol=settings.rtol,
             workers=settings.num_workers,
         )
-        return [(f[settings.statistic], f[Statistic.FRICTION] if friction else None) for f in found]
+        return [PointGradients(f[settings.statistic], f.get(Statistic.FRICTION)) for f in found]
     if num_variables != 3:
         raise UserInputError(
             f"estimator = {settings.estimator.value!r}: a profile search needs the frozen-load estimator ('frozen')"
         )
     return [
-        (
+        PointGradients(
             steady_gradient(
                 *case, window=settings.gradient_window, rtol=settings.rtol, workers=settings.num_workers
-            ),
-            None,
+            )
         )
         for case in cases
     ]
@@ -259,11 +268,11 @@ def evaluate_starts(
     gradients = dict(zip(keys, _gradients(settings, cases, gradient, problem.num_variables)))
     if len(shifts) == 3:
         for s, k in keys:
-            g, friction = gradients[(s, k)]
-            gradients[(s, k)] = (
-                _with_clearance_difference(g, metrics[(s, 1, k)], metrics[(s, 2, k)], h, ci),
-                friction,
+            g = gradients[(s, k)]
+            with_clearance = _with_clearance_difference(
+                g.objective, metrics[(s, 1, k)], metrics[(s, 2, k)], h, ci
             )
+            gradients[(s, k)] = dataclasses.replace(g, objective=with_clearance)
     wall = time.perf_counter() - t0
     evaluations = []
     for s, u in enumerate(us):
@@ -388,10 +397,10 @@ def limit_jacobian(settings: SteadySettings, per: list[PointRecord]) -> np.ndarr
     return np.asarray(rows, dtype=float).reshape(len(rows), n)
 
 
-def _measured_record(settings: SteadySettings, u, m, gradients, width) -> PointRecord:
+def _measured_record(settings: SteadySettings, u, m, gradients: PointGradients, width) -> PointRecord:
     """The record of one simulated operating point from its metrics `m` and gradient estimates
-    (the objective's, the friction power's or None: `_gradients`)."""
-    g, friction_g = gradients
+    (`_gradients`)."""
+    g, friction_g = gradients.objective, gradients.friction
     j = m.objective
     scale = settings.statistic.shown[0]  # GPa m/s, or W for the friction power
     margin = corner_margin_of(settings, m)
@@ -427,8 +436,8 @@ def _reused_record(problem: DesignProblem, old: PointRecord, here) -> PointRecor
 
 def _evaluation(problem, settings, u, measured, previous, wall, gradient: bool) -> Evaluation:
     """One start's `Evaluation` from the metrics and gradient estimates of its simulated
-    operating points (`measured`: {point: (metrics, gradient)}) and, for the others, `previous`
-    (`evaluate_starts`)."""
+    operating points (`measured`: {point: (metrics, `PointGradients`)}) and, for the others,
+    `previous` (`evaluate_starts`)."""
     width = np.asarray(problem.bounds.upper - problem.bounds.lower)
     per, new_states, simulated = [], [], 0.0
     here = np.asarray(problem.margins(jnp.asarray(u)))

@@ -523,6 +523,13 @@ def test_clearance_gradient_is_a_paired_crn_difference_in_the_same_engine_call(m
     seen.clear()
     evaluation.evaluate_starts(problem, settings, [u], [chain], gradient=False)
     assert len(seen[0][0]) == 1
+    # with a friction limit the friction power's frozen-load gradient, from the same call,
+    # is kept beside the objective's; the clearance difference is the objective's only
+    seen.clear()
+    limited = dataclasses.replace(settings, max_friction_power=30.0)
+    (ev,) = evaluation.evaluate_starts(problem, limited, [u], [chain])
+    np.testing.assert_allclose(ev.gradient, np.array([3e9, -4e9, 2e12]) * width / 1e9, rtol=1e-6)
+    np.testing.assert_allclose(ev.per_point[0].friction_gradient, np.array([3e9, -4e9, 0.0]) * width)
     with pytest.raises(UserInputError, match=r"^clearance_step = -1"):
         search_settings.SteadySettings(clearance_step=-1.0)
     with pytest.raises(UserInputError, match=r"^clearance_step = 'soon': must be 'auto'"):

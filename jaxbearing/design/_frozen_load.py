@@ -202,28 +202,30 @@ def _failed_sample(statistic: str, num_variables: int = 3):
     return None if statistic == "tail" else _failed_integrals(num_variables)
 
 
-def _frozen_jacobian(bearing, op, x, states, exponent=1.0):
-    """Sum over the saved states of the frozen-load integrands (`frozen_load_integrands`) and
-    their Jacobian in x."""
+def _summed_jacobian(integrand, bearing, op, x, states):
+    """Sum over the saved `states` of `integrand(v, state, Q0)` (design v, the loads Q0 the
+    dynamics gave at that state, `_reference_loads`) and its Jacobian in x: what every
+    frozen-load statistic but the tail sums along a trajectory."""
     q0 = _reference_loads(bearing, op, x, states)
 
     def total(v):
-        per = jax.vmap(lambda s, q: frozen_load_integrands(bearing, op, v, s, q, exponent))(states, q0)
-        return jnp.sum(per, axis=0)
+        return jnp.sum(jax.vmap(lambda s, q: integrand(v, s, q))(states, q0), axis=0)
 
     return forward_jacobian(total, x)
+
+
+def _frozen_jacobian(bearing, op, x, states, exponent=1.0):
+    """Sum over the saved states of the frozen-load PV integrands (`frozen_load_integrands`)
+    and their Jacobian in x."""
+    pv = lambda v, s, q: frozen_load_integrands(bearing, op, v, s, q, exponent)
+    return _summed_jacobian(pv, bearing, op, x, states)
 
 
 def _friction_jacobian(bearing, op, x, states):
     """Sum over the saved states of the frozen friction integrands (`frozen_friction_integrands`)
     and their Jacobian in x."""
-    q0 = _reference_loads(bearing, op, x, states)
-
-    def total(v):
-        per = jax.vmap(lambda s, q: frozen_friction_integrands(bearing, op, v, s, q))(states, q0)
-        return jnp.sum(per, axis=0)
-
-    return forward_jacobian(total, x)
+    friction = lambda v, s, q: frozen_friction_integrands(bearing, op, v, s, q)
+    return _summed_jacobian(friction, bearing, op, x, states)
 
 
 def frozen_load_gradient(
