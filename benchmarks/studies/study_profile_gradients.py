@@ -15,7 +15,8 @@ reference the estimate is compared with: significant (|FD| > 3 SE), the same sig
 `--statistic` differentiates another settled statistic than the mean PV (e.g. "friction", the
 time-mean total flange friction power), `--variables` may name any of the eight.
 h is `STEP_FRACTION` of the variable's box range, as the theta_f check in
-tests/test_steady_gradient.py.
+tests/test_steady_gradient.py (`--step-fraction` for another: a variable whose effect the seeds
+barely resolve is resolved by a wider step, the difference then a secant).
 
 Verdicts (`verdict`): "agrees" (significant, same sign, within 30 %), "consistent" (the
 difference not significant and the estimate within 3 SE of it), "not felt" (the runs of both
@@ -68,23 +69,33 @@ NEW_VARIABLES = (
 STEP_FRACTION = 0.15
 
 
-def steps(variables) -> dict:
-    """The difference step [SI] of each variable: `STEP_FRACTION` of its default box range."""
+def steps(variables, fraction: float = STEP_FRACTION) -> dict:
+    """The difference step [SI] of each variable: `fraction` of its default box range."""
     from optimise import ProfileBounds
 
     bounds = ProfileBounds()
     keys = [v.key for v in bounds.TABLE]
     width = bounds.upper - bounds.lower
-    return {k: STEP_FRACTION * float(width[keys.index(k)]) for k in variables}
+    return {k: fraction * float(width[keys.index(k)]) for k in variables}
 
 
 def check(
-    design_mm, *, variables=NEW_VARIABLES, slices=11, seeds=6, window_revs=2, workers=1, statistic="mean"
+    design_mm,
+    *,
+    variables=NEW_VARIABLES,
+    slices=11,
+    seeds=6,
+    window_revs=2,
+    workers=1,
+    statistic="mean",
+    step_fraction=STEP_FRACTION,
 ):
     """One design's rows: per variable the frozen-load estimate of d(mean PV)/dx with its
     standard error, the paired CRN central difference with its standard error and the verdict
     (module docstring). `design_mm`: the eight values in engineering units; `statistic`: the
-    settled statistic (`design.Statistic`: the mean PV by default, or e.g. "friction")."""
+    settled statistic (`design.Statistic`: the mean PV by default, or e.g. "friction");
+    `step_fraction`: the half-step as a fraction of each variable's box range (both steps must
+    stay inside the box, else a one-line error)."""
     import jaxbearing as jb
     from jaxbearing.design import (
         frozen_load_gradients,
@@ -100,6 +111,15 @@ def check(
     b = dataclasses.replace(jb.reference_bearing(), num_slices=slices)
     op = jb.reference_operating_point()
     design = ProfileVariables.from_array(x)
+    h = steps(variables, step_fraction)
+    bounds = ProfileBounds()
+    for k in variables:
+        i = keys.index(k)
+        if x[i] - h[k] < bounds.lower[i] - 1e-15 or x[i] + h[k] > bounds.upper[i] + 1e-15:
+            raise SystemExit(
+                f"step_fraction = {step_fraction}: {k} = {design_mm[i]} +- the step leaves the box "
+                f"[{bounds.lower[i]:g}, {bounds.upper[i]:g}] (SI); use a smaller fraction"
+            )
     base = steady_design_metrics(
         b,
         op,
@@ -111,7 +131,6 @@ def check(
         statistic=statistic,
     )
     (g,) = frozen_load_gradients([(b, op, design, base.sample_states)], workers=workers, statistic=statistic)
-    h = steps(variables)
     shifted = []
     for k in variables:
         for sign in (1.0, -1.0):
@@ -186,14 +205,21 @@ def main(argv=None) -> int:
         "--statistic", default="mean", help="the settled statistic differentiated (optimise run --statistic)"
     )
     p.add_argument("--workers", type=int, default=1)
+    p.add_argument(
+        "--step-fraction",
+        type=float,
+        default=STEP_FRACTION,
+        help=f"each half-step as a fraction of the variable's box range (default {STEP_FRACTION}); "
+        "larger resolves a variable of weak effect, as a secant",
+    )
     p.add_argument("--name", default="profile_gradient_check")
     args = p.parse_args(argv)
     variables = tuple(args.variables.split(","))
-    settings = {k: v for k, v in vars(args).items() if k not in ("name", "designs")}
+    settings = {k: v for k, v in vars(args).items() if k not in ("name", "designs", "step_fraction")}
     path = _common.RESULTS_DIR / f"{args.name}.json"
     out = json.loads(path.read_text()) if path.exists() else {}
-    if out.get("settings") != settings or out.get("step_fraction") != STEP_FRACTION:
-        out = {"settings": settings, "step_fraction": STEP_FRACTION, "designs": {}}
+    if out.get("settings") != settings or out.get("step_fraction") != args.step_fraction:
+        out = {"settings": settings, "step_fraction": args.step_fraction, "designs": {}}
     t0 = time.perf_counter()
     chosen = [list(DESIGNS)[int(i)] for i in args.designs.split(",")]
     for label, design in DESIGNS.items():
@@ -207,6 +233,7 @@ def main(argv=None) -> int:
             window_revs=args.window_revs,
             workers=args.workers,
             statistic=args.statistic,
+            step_fraction=args.step_fraction,
         )
         for r in out["designs"][label]["rows"]:
             _common.log(
