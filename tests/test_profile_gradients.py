@@ -6,8 +6,11 @@ In the default suite, the end offset e (the new variable the settled PV feels mo
 of the study's designs; the flange height's estimate there is exactly zero (the contact stays
 below the rib's top edge). Slow: all five new variables (e, R_cor, 1/R_rib, h_t, H_rf) at the
 three designs, each row "agrees" (|FD| > 3 SE, the same sign, within 30 %), "consistent" (the
-difference not significant, the estimate within 3 SE of it) or "not felt" (both exactly zero).
-The full study and its measured rows: benchmarks/results/profile_gradient_check.json.
+difference not significant, the estimate within 3 SE of it) or "not felt" (both exactly zero);
+and the rib's tangent height h_t, which three seeds resolve at one design only, with 8 seeds
+and steps of 40 % of the box at the second design, where it agrees.
+The full study and its measured rows: benchmarks/results/profile_gradient_check.json and
+profile_gradient_check_8seeds_wide.json.
 """
 
 from __future__ import annotations
@@ -62,3 +65,14 @@ def test_every_new_variable_at_three_designs(label):
     out = study.check(study.DESIGNS[label], slices=11, seeds=3)
     _show(label, out)
     assert all(r["verdict"] in ("agrees", "consistent", "not felt") for r in out["rows"])
+
+
+@pytest.mark.slow
+def test_tangent_height_agrees_with_a_wide_crn_difference():
+    label = list(study.DESIGNS)[1]
+    out = study.check(
+        study.DESIGNS[label], variables=("rib_tangent_height_mm",), slices=11, seeds=8, step_fraction=0.4
+    )
+    _show(label, out)
+    (row,) = out["rows"]
+    assert row["significant"] and row["verdict"] == "agrees"
