@@ -17,9 +17,10 @@ grows at unit rate along its own gradient. So each branch is
 
     delta = R + max over the centre circle of d(Q(phi)),    C = Q* + R n(Q*),
 
-a one-dimensional maximisation in the circle's angle phi: Newton's method on F'(phi) = 0 from
-`START_ANGLES` angles and again from the deepest of their ends (`NEWTON_STEPS` steps each,
-accuracy `NEWTON_ACCURACY`, derivatives by implicit differentiation, `jax.lax.custom_root`).
+a one-dimensional maximisation in the circle's angle phi: Newton's method on F'(phi) = 0,
+`SCOUT_STEPS` steps from each of `START_ANGLES` angles (enough to tell which maximum each start
+climbs), then `NEWTON_STEPS` from the deepest of their ends (accuracy `NEWTON_ACCURACY`,
+derivatives by implicit differentiation, `jax.lax.custom_root`).
 Angles are measured from the direction in which the circle's radius points along the normal at
 the circle's centre, so for the cone (d linear) the first start is the root. For e = 0 the arc's
 circle is a point (the sphere's centre) and the maximisation is trivial. The end body lies inside
@@ -63,15 +64,21 @@ from ._geometry import unit
 Scalar = Float[Array, ""]
 Vec3 = Float[Array, "3"]
 
-#: Newton steps of the one-dimensional maximisation over a centre circle, from each of
-#: `START_ANGLES` angles and again from the deepest end (`_circle_max`); convergence is quadratic.
-NEWTON_STEPS = 8
+#: Newton steps from each start angle (`_circle_max`): they only have to bring each start into
+#: the basin of the maximum it climbs, so the deepest end picks the global one.
+SCOUT_STEPS = 2
+
+#: Newton steps from the deepest start's end (`_circle_max`); convergence is quadratic. Two scout
+#: steps and five here give the contact of 16 starts with 8 + 8 steps to round-off over the
+#: sampled faces and poses below (benchmarks/studies/study_face_newton.py) at a third of the
+#: evaluations of 8 + 8.
+NEWTON_STEPS = 5
 
 #: Stated accuracy [m] of the ball centre on its circle after the Newton steps: the next step
 #: times the circle's radius, radius min(|F'/F''|, pi) (reported as `FaceContact.solve_error`). Met over
 #: e in [0, 0.9 R_ce], kappa_rib in [0, 0.95 kappa_end], h_t in [0, H_rf], tilt and skew up to
 #: 10 mrad, axial offsets of 20 um and all four flanges (tests/test_faces.py, hypothesis-sampled;
-#: 2e4 random samples gave at most 1.3e-17 m, and 1.1e-16 m at 20 mrad). The contact point is
+#: 3e4 random samples gave at most 2e-17 m). The contact point is
 #: then exact to round-off, the interference (stationary in the angle) by far more.
 NEWTON_ACCURACY = 1e-14
 
@@ -143,9 +150,11 @@ def _rib(frame: _Frame, faces: Faces, point: Vec3) -> tuple[Array, Vec3, Array, 
     return d, g_n * frame.n0 + g_t * frame.t0, k / s, g_n * frame.t0 - g_t * frame.n0
 
 
-def _newton(derivatives):
-    """Safeguarded Newton ascent on F, `derivatives`(phi) = (F', F''): steps F'/|F''| clipped to
-    0.5 rad (an ascent step on either side of a maximum)."""
+def _newton(derivatives, steps=None):
+    """Safeguarded Newton ascent on F, `derivatives`(phi) = (F', F''): `steps` (default
+    `NEWTON_STEPS`) steps F'/|F''| clipped to 0.5 rad (an ascent step on either side of a
+    maximum)."""
+    steps = NEWTON_STEPS if steps is None else steps
 
     def solve(_, phi0):
         def step(_, phi):
@@ -153,7 +162,7 @@ def _newton(derivatives):
             h = jnp.abs(g2)
             return phi + jnp.clip(g1 / jnp.where(h > 0, h, 1.0), -0.5, 0.5)
 
-        return jax.lax.fori_loop(0, NEWTON_STEPS, step, phi0)
+        return jax.lax.fori_loop(0, steps, step, phi0)
 
     return solve
 
@@ -168,9 +177,9 @@ def _circle_max(frame: _Frame, faces: Faces, centre: Vec3, radius, starts: int) 
     and radius min(|F'/F''|, pi) at it, how far one more Newton step would move it [m].
 
     F(phi) = d(Q(phi)), Q = centre + radius (cos(phi) r0 + sin(phi) s0); F' = grad d . Q',
-    F'' = (k/S) (m . Q')^2 - grad d . (Q - centre) (`_rib`). Newton's method runs from each
-    of `START_ANGLES` angles, and again (with implicit derivatives) from the deepest of their
-    ends, so the maximum found is the circle's global one even where the depth has two maxima
+    F'' = (k/S) (m . Q')^2 - grad d . (Q - centre) (`_rib`). Newton's method runs
+    `SCOUT_STEPS` steps from each of `starts` angles, and `NEWTON_STEPS` (with implicit
+    derivatives) from the deepest of their ends, so the maximum found is the circle's global one even where the depth has two maxima
     of nearly equal height (a two-point contact, of which the model keeps the deeper point)."""
     _, n_c, _, _ = _rib(frame, faces, centre)
     perp = n_c - jnp.dot(n_c, frame.x_end) * frame.x_end
@@ -187,7 +196,8 @@ def _circle_max(frame: _Frame, faces: Faces, centre: Vec3, radius, starts: int) 
 
     newton = _newton(derivatives)
     angles = 2 * np.pi * np.arange(starts) / starts
-    roots = jax.vmap(lambda t: newton(None, t))(jnp.asarray(angles))
+    scout = _newton(derivatives, SCOUT_STEPS)
+    roots = jax.vmap(lambda t: scout(None, t))(jnp.asarray(angles))
     depths = jax.vmap(lambda phi: _rib(frame, faces, point(phi))[0])(roots)
     start = jax.lax.stop_gradient(roots[jnp.argmax(depths)])
     phi = jax.lax.custom_root(lambda t: derivatives(t)[0], start, newton, _tangent_solve)
