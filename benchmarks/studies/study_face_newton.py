@@ -33,9 +33,9 @@ sys.path.insert(0, str(HERE.parents[1]))
 import _common  # noqa: E402
 
 #: (scout steps, refinement steps, starts); the first is the accuracy reference
-SCHEDULES = ((8, 8, 16), (8, 8, 4), (2, 5, 4), (2, 5, 16), (1, 5, 4), (2, 4, 4))
+SCHEDULES = ((8, 8, 16), (8, 8, 4), (3, 5, 4), (3, 5, 16), (2, 5, 4), (2, 5, 16), (3, 4, 4))
 #: the schedules timed in the vector field's flange contacts (before and after)
-TIMED = ((8, 8, 4), (2, 5, 4))
+TIMED = ((8, 8, 4), (3, 5, 4))
 
 
 def _samples(bearing, n, seed, tilt_max):

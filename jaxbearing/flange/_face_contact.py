@@ -66,12 +66,13 @@ Vec3 = Float[Array, "3"]
 
 #: Newton steps from each start angle (`_circle_max`): they only have to bring each start into
 #: the basin of the maximum it climbs, so the deepest end picks the global one.
-SCOUT_STEPS = 2
+SCOUT_STEPS = 3
 
-#: Newton steps from the deepest start's end (`_circle_max`); convergence is quadratic. Two scout
-#: steps and five here give the contact of 16 starts with 8 + 8 steps to round-off over the
-#: sampled faces and poses below (benchmarks/studies/study_face_newton.py) at a third of the
-#: evaluations of 8 + 8.
+#: Newton steps from the deepest start's end (`_circle_max`); convergence is quadratic. Three
+#: scout steps and five here give the contact of 16 starts with 8 + 8 steps to round-off over the
+#: sampled faces and poses below, with tilt and skew up to 40 mrad, from 4 starts as from 16
+#: (benchmarks/studies/study_face_newton.py; two scout steps pick the wrong maximum there), at
+#: 17 rib evaluations from 4 starts against 40 for 8 + 8.
 NEWTON_STEPS = 5
 
 #: Stated accuracy [m] of the ball centre on its circle after the Newton steps: the next step
