@@ -79,8 +79,8 @@ NEWTON_STEPS = 5
 #: times the circle's radius, radius min(|F'/F''|, pi) (reported as `FaceContact.solve_error`). Met over
 #: e in [0, 0.9 R_ce], kappa_rib in [0, 0.95 kappa_end], h_t in [0, H_rf], tilt and skew up to
 #: 10 mrad, axial offsets of 20 um and all four flanges (tests/test_faces.py, hypothesis-sampled;
-#: 3e4 random samples gave at most 2e-17 m). The contact point is
-#: then exact to round-off, the interference (stationary in the angle) by far more.
+#: 10,000 random samples gave at most 5.7e-17 m, benchmarks/studies/study_face_newton.py). The
+#: contact point is then exact to round-off, the interference (stationary in the angle) by far more.
 NEWTON_ACCURACY = 1e-14
 
 _X = np.array([1.0, 0.0, 0.0])
@@ -180,8 +180,9 @@ def _circle_max(frame: _Frame, faces: Faces, centre: Vec3, radius, starts: int) 
     F(phi) = d(Q(phi)), Q = centre + radius (cos(phi) r0 + sin(phi) s0); F' = grad d . Q',
     F'' = (k/S) (m . Q')^2 - grad d . (Q - centre) (`_rib`). Newton's method runs
     `SCOUT_STEPS` steps from each of `starts` angles, and `NEWTON_STEPS` (with implicit
-    derivatives) from the deepest of their ends, so the maximum found is the circle's global one even where the depth has two maxima
-    of nearly equal height (a two-point contact, of which the model keeps the deeper point)."""
+    derivatives) from the deepest of their ends, so the maximum found is the circle's global
+    one even where the depth has two maxima of nearly equal height (a two-point contact, of
+    which the model keeps the deeper point)."""
     _, n_c, _, _ = _rib(frame, faces, centre)
     perp = n_c - jnp.dot(n_c, frame.x_end) * frame.x_end
     r0 = jnp.where(safe_norm(perp) > 1e-12, unit(perp), frame.fallback)
