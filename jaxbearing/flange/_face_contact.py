@@ -71,16 +71,16 @@ SCOUT_STEPS = 3
 #: Newton steps from the deepest start's end (`_circle_max`); convergence is quadratic. Three
 #: scout steps and five here give the contact of 16 starts with 8 + 8 steps to round-off over the
 #: sampled faces and poses below, with tilt and skew up to 40 mrad, from 4 starts as from 16
-#: (benchmarks/studies/study_face_newton.py; two scout steps pick the wrong maximum there), at
-#: 17 rib evaluations from 4 starts against 40 for 8 + 8.
+#: (docs/model.md 5.4; two scout steps pick the wrong maximum there), at 17 rib evaluations
+#: from 4 starts against 40 for 8 + 8.
 NEWTON_STEPS = 5
 
 #: Stated accuracy [m] of the ball centre on its circle after the Newton steps: the next step
 #: times the circle's radius, radius min(|F'/F''|, pi) (reported as `FaceContact.solve_error`). Met over
 #: e in [0, 0.9 R_ce], kappa_rib in [0, 0.95 kappa_end], h_t in [0, H_rf], tilt and skew up to
 #: 10 mrad, axial offsets of 20 um and all four flanges (tests/test_faces.py, hypothesis-sampled;
-#: 10,000 random samples gave at most 5.7e-17 m, benchmarks/studies/study_face_newton.py). The
-#: contact point is then exact to round-off, the interference (stationary in the angle) by far more.
+#: 10,000 random samples gave at most 5.7e-17 m, docs/model.md 5.4). The contact point is then
+#: exact to round-off, the interference (stationary in the angle) by far more.
 NEWTON_ACCURACY = 1e-14
 
 _X = np.array([1.0, 0.0, 0.0])
