@@ -33,7 +33,7 @@ from ._search import SearchResult, grid_search, search, start_points
 from ._settings import Choice, CornerConstraint, Estimator, SteadySettings
 from ._steady import NearOptimal, SteadySearchResult, near_optimal_set, steady_search
 from ._toml import load_optimise_toml
-from ._verify import verification
+from ._verify import TailVerification, Verification, VerifiedPoint, verification
 
 __all__ = [
     "MARGIN_NAMES",
@@ -49,6 +49,9 @@ __all__ = [
     "SearchResult",
     "SteadySearchResult",
     "SteadySettings",
+    "TailVerification",
+    "Verification",
+    "VerifiedPoint",
     "any_feasible",
     "bounds_from_engineering",
     "feasibility_map",

@@ -66,7 +66,7 @@ def run_steady(args, problem, options, settings, out, meta=None) -> int:
         print(f"wrote {out / 'result.json'} and {plot_path}")
         return EXIT_INFEASIBLE
     _print_found(res, settings, plot_path)
-    if res.verification:
+    if res.verification is not None:
         _print_verification(problem, res.verification)
     print(f"  {res.num_evaluations} settled ensembles, {res.wall_time_s:.1f} s wall")
     print(f"wrote {out / 'result.json'} and {plot_path}")
@@ -103,31 +103,28 @@ def _print_found(res, settings, plot_path) -> None:
         )
 
 
-def _print_verification(problem, v: dict) -> None:
-    """Both designs at every operating point on the verification's seeds, the verdict on the
-    mean PV and on the tail."""
+def _print_verification(problem, v) -> None:
+    """Both designs at every operating point on the verification's seeds (`Verification`), the
+    verdict on the mean PV and on the tail."""
 
+    seeds = f"seeds {v.seeds[0]}-{v.seeds[-1]}"
     for k in range(problem.num_operating_points):
         where = f" at {problem.point_label(k)}" if problem.num_operating_points > 1 else ""
-        for name in ("reference", "optimum"):
-            row = v[name] if "mean_pv_GPa_m_s" in v[name] else v[name]["per_operating_point"][k]
+        for name, points in (("reference", v.reference), ("optimum", v.optimum)):
             label = name if where else f"{name:9s}"
-            seeds = f"seeds {v['seeds'][0]}-{v['seeds'][-1]}"
-            print(f"  verification {label}{where}: {_verified_text(row)} ({seeds})")
-    if "mean_pv_lower_disjoint" in v:
-        print(
-            "  verified lower mean PV with disjoint 95 % CIs"
-            f"{' at every operating point' if problem.num_operating_points > 1 else ''}: "
-            f"{v['mean_pv_lower_disjoint']}"
-        )
-    tail = v.get("tail")
-    if tail is not None:
-        print(f"  {tail_text(tail)}")
+            print(f"  verification {label}{where}: {_verified_text(points[k])} ({seeds})")
+    print(
+        "  verified lower mean PV with disjoint 95 % CIs"
+        f"{' at every operating point' if problem.num_operating_points > 1 else ''}: "
+        f"{v.mean_pv_lower_disjoint}"
+    )
+    print(f"  {tail_text(v.tail)}")
 
 
-def tail_text(tail: dict) -> str:
-    """The verification's statement on the found design's corner-contact risk, in one line."""
-    methods = sorted({m for m in tail["methods"] if m})
+def tail_text(tail) -> str:
+    """The verification's statement on the found design's corner-contact risk
+    (`TailVerification`), in one line."""
+    methods = sorted({m for m in tail.methods if m})
     model = {
         "normal": "a normal model of the per-revolution largest contact radius",
         "tail": "a generalised Pareto tail",
@@ -136,33 +133,32 @@ def tail_text(tail: dict) -> str:
     }
     how = " and ".join(model.get(m, m) for m in methods) or "no measured revolution"
     bound = (
-        f"corner-contact risk of the found design at most {tail['upper_per_revolution']:.2g} per cage "
+        f"corner-contact risk of the found design at most {tail.upper_per_revolution:.2g} per cage "
         f"revolution at every operating point (upper 95 % bound from {how}, "
-        f"{min(tail['revolutions_per_point'])} or more revolutions per point)"
+        f"{min(tail.revolutions_per_point)} or more revolutions per point)"
     )
-    if tail["verified"]:
-        return f"{bound}: verified in the tail at {tail['level_per_revolution']:.2g} per revolution"
+    if tail.verified:
+        return f"{bound}: verified in the tail at {tail.level_per_revolution:.2g} per revolution"
     return (
-        f"{bound}: NOT verified in the tail at {tail['level_per_revolution']:.2g} per revolution "
+        f"{bound}: NOT verified in the tail at {tail.level_per_revolution:.2g} per revolution "
         "(more revolutions per point narrow the bound: more --verify-seeds, or an accelerator; by counting "
-        f"alone it takes {tail['revolutions_needed']} revolutions per point without corner contact)"
+        f"alone it takes {tail.revolutions_needed} revolutions per point without corner contact)"
     )
 
 
-def _verified_text(row: dict) -> str:
-    """One design's verification at one operating point, in one line."""
-    e, c = row["mean_pv_GPa_m_s"], row["corner_contact_share"]
+def _verified_text(point) -> str:
+    """One design's verification at one operating point (`VerifiedPoint`), in one line."""
+    e, GPA = point.mean_pv, 1e9  # Pa m/s per GPa m/s
 
-    def interval(name: str, key: str) -> str:
-        v = row.get(key) or {}
-        if None in (v.get("value"), v.get("ci95_low"), v.get("ci95_high")):
+    def interval(name: str, est) -> str:
+        if not all(map(math.isfinite, (est.value, est.ci95_low, est.ci95_high))):
             return ""
-        return f", {name} {v['value']:.3f} [{v['ci95_low']:.3f}, {v['ci95_high']:.3f}]"
+        return f", {name} {est.value / GPA:.3f} [{est.ci95_low / GPA:.3f}, {est.ci95_high / GPA:.3f}]"
 
-    peak = interval("peak PV", "peak_pv_GPa_m_s") + interval("tail PV", "tail_pv_GPa_m_s")
+    peak = interval("peak PV", point.peak_pv) + interval("tail PV", point.tail_pv)
     return (
-        f"mean PV {e['value']:.4f} [{e['ci95_low']:.4f}, {e['ci95_high']:.4f}]{peak} GPa m/s, "
-        f"corner share {c['value']:.3f}"
+        f"mean PV {e.value / GPA:.4f} [{e.ci95_low / GPA:.4f}, {e.ci95_high / GPA:.4f}]{peak} GPa m/s, "
+        f"corner share {point.corner_contact_share.value:.3f}"
     )
 
 
@@ -187,7 +183,7 @@ def _steady_result_json(problem, options, settings, res) -> dict:
             "ci95_high": None if res.objective_ci is None else res.objective_ci[1],
         },
         "start_design": _engineering(res.start_design),
-        "verification": res.verification,
+        "verification": None if res.verification is None else res.verification.as_json(),
         "near_optimal": _near_optimal_json(res, settings.statistic.key),
         "axial_clearance_effect": _clearance_json(problem, settings, res),
         "near_optimal_rule": (

@@ -45,7 +45,7 @@ from ._problem import MARGIN_SCALE, DesignProblem, any_feasible
 from ._search import start_points
 from ._settings import Choice, SteadySettings
 from ._state import CHECKPOINT, History, SearchState, fingerprint, resumed_state, save_checkpoint
-from ._verify import verification
+from ._verify import Verification, verification
 
 #: names of the five constraints of the steady search (static zone margins, then dynamic)
 CONSTRAINT_NAMES = (*MARGIN_NAMES, "dynamic_corner")
@@ -115,7 +115,7 @@ class SteadySearchResult:
     resumed_from: int  # iteration the run resumed after (-1: fresh)
     best_start: int = -1
     best_iteration: int = -1
-    verification: dict | None = None
+    verification: Verification | None = None
 
 
 def check_profile_settings(problem: DesignProblem, settings: SteadySettings) -> None:

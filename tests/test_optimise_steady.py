@@ -24,7 +24,7 @@ import optimise._settings as search_settings
 import optimise._steady as steady
 import optimise._verify as verify
 from jaxbearing import UserInputError
-from jaxbearing.run import CornerCount, Estimate
+from jaxbearing.run import CornerCount, CornerRisk, Estimate
 from optimise._cli import main
 
 SMALL = "[bearing]\nnum_slices = 11\n"
@@ -349,28 +349,34 @@ def test_verification_uses_unseen_seeds(config, monkeypatch):
     )
     x = np.array([0.08, 1.6 * math.pi / 180, 0.15e-3])
     v = verify.verification(problem, settings, x, x)
-    assert v["seeds"] == [7, 8, 9]
+    assert v.seeds == [7, 8, 9]
     assert calls == [(0.08, 3, 7, 4), (0.08, 3, 7, 4), "call"]
+    for (point,) in (v.reference, v.optimum):
+        assert point.seeds == [7, 8, 9]
+        for est in (point.mean_pv, point.p95_pv, point.corner_contact_share):
+            assert est.ci95_low <= est.value <= est.ci95_high
+    # result.json's rows: the issue's keys in SI, the engineering-unit keys in GPa m/s, the same
+    # estimates
+    js = json.loads(json.dumps(v.as_json(), allow_nan=False))
+    assert js["seeds"] == [7, 8, 9]
     for name in ("reference", "optimum"):
-        row = v[name]
-        assert row["seeds"] == [7, 8, 9]
-        for key in ("mean_pv", "p95_pv", "corner_contact_share", "mean_pv_GPa_m_s", "p95_pv_GPa_m_s"):
-            est = row[key]
-            assert est["ci95_low"] <= est["value"] <= est["ci95_high"]
-        # the issue's keys in SI, the engineering-unit keys in GPa m/s: the same estimates
+        row = js[name]
         for key in ("mean_pv", "p95_pv"):
             assert row[key]["unit"] == "Pa m/s"
             for k in ("value", "ci95_low", "ci95_high"):
                 assert row[key][k] == pytest.approx(row[f"{key}_GPa_m_s"][k] * 1e9, rel=1e-12)
+        assert row["peak_pv_GPa_m_s"]["value"] is None  # nothing measured: None, not NaN
     # the same design and seeds: the same numbers, so the CIs overlap
-    assert v["mean_pv_lower_disjoint"] is False
-    assert v["optimum_corner_contacts"] is False
+    assert v.mean_pv_lower_disjoint is False and js["mean_pv_lower_disjoint"] is False
+    assert v.optimum_corner_contacts is False
     # a design 12.5 % lower, beyond the intervals, with corner contact
     v = verify.verification(problem, settings, np.array([0.07, *x[1:]]), x)
-    assert v["optimum"]["mean_pv_GPa_m_s"]["value"] == pytest.approx(0.875)
-    assert v["mean_pv_lower_disjoint"] is True and v["optimum_corner_contacts"] is True
-    assert v["reference_corner_contact_per_revolution_upper95"] == 0.17
-    assert v["optimum_corner_contact_per_revolution_upper95"] == 1.0
+    assert v.optimum[0].mean_pv.value == pytest.approx(0.875e9)
+    assert v.mean_pv_lower_disjoint is True and v.optimum_corner_contacts is True
+    js = v.as_json()
+    assert js["optimum"]["mean_pv_GPa_m_s"]["value"] == pytest.approx(0.875)
+    assert js["reference_corner_contact_per_revolution_upper95"] == 0.17
+    assert js["optimum_corner_contact_per_revolution_upper95"] == 1.0
 
 
 def test_grid_picks_the_best_point_inside_every_margin_and_resumes(tmp_path, config, monkeypatch):
@@ -768,11 +774,11 @@ def test_verification_reports_every_operating_point(monkeypatch, capsys):
     reference = np.array([0.08, 1.6 * math.pi / 180, 0.15e-3])
     found = np.array([0.07, 1.6 * math.pi / 180, 0.15e-3])
     v = verify.verification(problem, settings, found, reference)
-    assert len(v["optimum"]["per_operating_point"]) == 2
-    assert v["mean_pv_lower_disjoint_per_operating_point"] == [False, True]
-    assert v["objective_lower_disjoint_per_operating_point"] == [False, True]
-    assert v["mean_pv_lower_disjoint"] is False and v["objective_lower_disjoint"] is False
-    assert v["optimum_corner_contacts"] is True  # R_end 70 mm touches the corner in the stand-in
+    assert len(v.optimum) == 2 and len(v.as_json()["optimum"]["per_operating_point"]) == 2
+    assert v.mean_pv_lower_disjoint_per_point == [False, True]
+    assert v.as_json()["objective_lower_disjoint_per_operating_point"] == [False, True]
+    assert v.mean_pv_lower_disjoint is False and v.objective_lower_disjoint is False
+    assert v.optimum_corner_contacts is True  # R_end 70 mm touches the corner in the stand-in
 
 
 def test_initial_states_continue_a_start_s_first_evaluation(config, monkeypatch):
@@ -864,21 +870,22 @@ def test_tail_verification_needs_the_risk_bounded_at_every_operating_point(tmp_p
     unbounded; the revolutions needed are those of counting alone (2995 for 1e-3 at 95 %)."""
     from optimise._cli_steady import tail_text
 
-    risk = lambda upper, n: {"corner_risk": {"upper": upper, "method": "count", "revolutions": n}}  # noqa: E731
+    def risk(upper, n, method="count"):
+        return CornerRisk(upper / 2, 0.0, upper, 0.95, method, n, 4, 0, 3e-3, 2e-3, upper)
+
     ok = verify.tail_verification([risk(4e-4, 4000), risk(9e-4, 3200)], 1e-3)
-    assert ok["verified"] and ok["upper_per_revolution"] == 9e-4 and ok["revolutions_needed"] == 2995
+    assert ok.verified and ok.upper_per_revolution == 9e-4 and ok.revolutions_needed == 2995
     assert "verified in the tail at 0.001" in tail_text(ok) and "NOT" not in tail_text(ok)
     short = verify.tail_verification([risk(4e-4, 4000), risk(0.17, 16)], 1e-3)
-    assert not short["verified"] and short["upper_per_revolution"] == 0.17
+    assert not short.verified and short.upper_per_revolution == 0.17
     assert "NOT verified in the tail" in tail_text(short) and "2995 revolutions per point" in tail_text(short)
     assert "from counted corner contacts" in tail_text(short)
-    modelled = verify.tail_verification(
-        [{"corner_risk": {"upper": 2e-4, "method": "normal", "revolutions": 16}}], 1e-3
+    modelled = verify.tail_verification([risk(2e-4, 16, "normal")], 1e-3)
+    assert modelled.verified and "a normal model of the per-revolution largest contact radius" in tail_text(
+        modelled
     )
-    assert modelled[
-        "verified"
-    ] and "a normal model of the per-revolution largest contact radius" in tail_text(modelled)
-    assert not verify.tail_verification([{"corner_risk": None}], 1e-3)["verified"]
+    assert not verify.tail_verification([None], 1e-3).verified
+    assert verify.tail_verification([None], 1e-3).as_json()["upper_per_revolution"] == 1.0
     # the level is a setting of the search: out of (0, 1) it is one line before anything runs
     assert main(["run", "--out", str(tmp_path), "--corner-risk-level", "0"]) == 2
     assert capsys.readouterr().err.count("corner_risk_level = 0.0: must be in (0, 1) per revolution") == 1

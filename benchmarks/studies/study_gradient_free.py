@@ -146,7 +146,7 @@ def _verified(problem, settings, run) -> None:
 
     # the search's own reference: the bearing's design of the problem's kind (3 or 8 variables)
     reference = np.asarray(problem.bounds.from_scaled(start_points(problem, 1)[0]))
-    v = verification(problem, settings, np.asarray(run["design"]), reference)
+    v = verification(problem, settings, np.asarray(run["design"]), reference).as_json()
     rows = v["optimum"].get("per_operating_point", [v["optimum"]])
     run["verified"] = [r["objective_GPa_m_s"] for r in rows]
     run["verified_reference"] = [

@@ -112,7 +112,7 @@ def front(args) -> int:
         point = {"statistic": statistic, "max_friction_power_W": limit, "found": res.design is not None}
         point["wall_s"] = time.perf_counter() - t0
         if res.design is not None:
-            v = res.verification
+            v = res.verification.as_json()
             point["design"] = problem.bounds.engineering_values(res.design)
             for name in ("optimum", "reference"):
                 worst = _worst(v[name].get("per_operating_point", [v[name]]), "mean_pv_GPa_m_s")
