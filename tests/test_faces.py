@@ -30,6 +30,7 @@ from jaxbearing.flange import (
     flange_effective_modulus,
     flange_geometry,
     rib_distance,
+    roller_pose,
 )
 from jaxbearing.flange._face_contact import NEWTON_ACCURACY
 
@@ -53,16 +54,8 @@ def _f64(tree):
 
 
 def _pose(bearing, ring_sign, side, axial=0.0, tilt=0.0, skew=0.0, azimuth=0.3):
-    """(R_r, p, e): roller on the pitch circle at `azimuth`, offset `axial` along X, its axis
-    turned by `tilt` towards e_rad (in the meridian plane) and by `skew` towards e_tan."""
-    e_rad = np.array([0.0, math.sin(azimuth), math.cos(azimuth)])
-    e_tan = np.cross(X, e_rad)
-    p = float(bearing.pitch_diameter) / 2 * e_rad + axial * X
-    axis = (
-        X * math.cos(tilt) * math.cos(skew) + e_rad * math.sin(tilt) + e_tan * math.sin(skew) * math.cos(tilt)
-    )
-    radius = bearing.inner_raceway_radius if ring_sign > 0 else bearing.outer_raceway_radius
-    return float(radius), p, axis
+    """(R_r, p, e) of `flange.roller_pose` (the side is the contact's, not the pose's)."""
+    return roller_pose(bearing, ring_sign, axial, tilt, skew, azimuth)
 
 
 _face_contact = jax.jit(face_contact)

@@ -39,8 +39,9 @@ TIMED = ((8, 8, 4), (3, 5, 4))
 
 
 def _samples(bearing, n, seed, tilt_max):
+    from jaxbearing.flange import roller_pose
+
     rng = np.random.default_rng(seed)
-    x = np.array([1.0, 0.0, 0.0])
     r_ce = float(bearing.roller.diameter) / 2 - float(bearing.roller.corner_radius)
     k_end = 1 / float(bearing.roller.end_radius)
     rows = []
@@ -49,15 +50,7 @@ def _samples(bearing, n, seed, tilt_max):
         tilt, skew = rng.uniform(-tilt_max, tilt_max, 2)
         axial = rng.uniform(-20e-6, 20e-6)
         sign, side = rng.choice([1.0, -1.0]), rng.choice([1.0, -1.0])
-        e_rad = np.array([0.0, math.sin(0.3), math.cos(0.3)])
-        e_tan = np.cross(x, e_rad)
-        p = float(bearing.pitch_diameter) / 2 * e_rad + axial * x
-        axis = (
-            x * math.cos(tilt) * math.cos(skew)
-            + e_rad * math.sin(tilt)
-            + e_tan * math.sin(skew) * math.cos(tilt)
-        )
-        radius = float(bearing.inner_raceway_radius if sign > 0 else bearing.outer_raceway_radius)
+        radius, p, axis = roller_pose(bearing, sign, axial, tilt, skew)
         rows.append(
             (off * r_ce, conf * k_end, height * float(bearing.flange.height), radius, side, sign, p, axis)
         )
