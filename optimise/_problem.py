@@ -118,7 +118,8 @@ class DesignProblem(eqx.Module):
     """Minimise the (robust) smooth peak flange PV over the box `bounds` subject to the design
     zone. `operating` holds K stacked operating points; `weights` (K,) their weights.
 
-    `aggregate`: "max" (smooth worst case, log-sum-exp with `temperature` in GPa m/s) or
+    `aggregate`: "max" (smooth worst case, log-sum-exp with `temperature` in the objective's
+    unit: GPa m/s, or W for the steady search's friction statistic) or
     "mean" (weighted mean). `tighten`: constraint back-off in scaled units (x 0.1 mm)."""
 
     bearing: Bearing
@@ -154,7 +155,12 @@ class DesignProblem(eqx.Module):
         bearing and the operating points (`check_model_inputs`), and the search's own options."""
         if self.aggregate not in ("max", "mean"):
             raise UserInputError(f"aggregate = {self.aggregate!r}: must be 'max' or 'mean'")
-        require("temperature", self.temperature, lambda v: np.isfinite(v) & (v > 0), "> 0 GPa m/s and finite")
+        require(
+            "temperature",
+            self.temperature,
+            lambda v: np.isfinite(v) & (v > 0),
+            "> 0 and finite (the objective's unit)",
+        )
         check_solver_arguments(
             duration=self.duration, rtol=self.rtol, atol=self.atol, max_steps=self.max_steps
         )
