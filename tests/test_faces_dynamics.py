@@ -28,6 +28,7 @@ from jaxbearing.flange import (
     face_design_zone,
     faces_of,
     flange_geometry,
+    plain_faces,
     with_faces,
 )
 from jaxbearing.io import Config, loads_config
@@ -62,6 +63,33 @@ def test_todays_faces_carry_no_face_fields():
         zone.contact_height, face_design_zone(torus, faces_of(torus)).contact_height, rtol=0
     )
     assert zone.limited_circle_radius == pytest.approx(float(jb.geometry.limited_circle_radius(torus.roller)))
+
+
+def test_plain_faces_drops_todays_general_faces_only_where_concrete():
+    """`plain_faces`: a bearing given today's faces as general ones (e = 0, kappa_rib = 0, any
+    h_t: what a profile design at the reference applies) loses the three fields and so runs
+    today's contact code (the oracle below: the same numbers to round-off); every other field is
+    kept. A torus end, a curved rib, or traced values (a bearing differentiated in e) keep their
+    general faces."""
+    reference = jb.reference_bearing()
+    assert plain_faces(reference) is reference
+    general = ProfileVariables.of(reference).apply(reference)
+    general = with_faces(general, 0.0, 0.0, 1.2e-3)
+    assert general.has_general_faces
+    plain = plain_faces(general)
+    assert not plain.has_general_faces
+    for a, b in zip(jax.tree_util.tree_leaves(plain), jax.tree_util.tree_leaves(reference)):
+        np.testing.assert_array_equal(np.asarray(a), np.asarray(b))
+    for kept in (with_faces(reference, 1e-6, 0.0), with_faces(reference, 0.0, 0.5)):
+        assert plain_faces(kept) is kept
+    seen = []
+
+    def traced(e):
+        seen.append(plain_faces(with_faces(reference, e, 0.0)).has_general_faces)
+        return e
+
+    jax.jit(traced)(0.0)
+    assert seen == [True]
 
 
 def test_general_path_at_todays_faces_reproduces_a_short_run():

@@ -18,7 +18,7 @@
   `face_limited_circle`, `face_protrusion`, `rib_distance`; in the dynamics through
   `contact_geometry` (today's `flange_geometry` for a bearing without general faces,
   `face_flange_geometry` for one with them, `Bearing.has_general_faces`), set on a bearing with
-  `with_faces`; `roller_pose` (a concrete pose from azimuth, axial offset, tilt and skew);
+  `with_faces` (and dropped where they are today's, `plain_faces`); `roller_pose` (a concrete pose from azimuth, axial offset, tilt and skew);
 - the design variables R_end, theta_f, Delta_bf: `DesignVariables`, `with_design`, and the one
   range check every design entry point uses, `check_design`; the eight profile variables
   (R_end, e, R_cor, 1/R_rib, h_t, theta_f, H_rf, Delta_bf): `ProfileVariables`,
@@ -60,11 +60,19 @@ from ._lubrication import (
     flange_friction_coefficient,
 )
 from ._pose import roller_pose
-from ._profile import PROFILE_NAMES, ProfileVariables, check_profile, variables_from_array, with_faces
+from ._profile import (
+    PROFILE_NAMES,
+    ProfileVariables,
+    check_profile,
+    plain_faces,
+    variables_from_array,
+    with_faces,
+)
 from ._zone import MARGIN_NAMES, DesignZone, design_zone, design_zone_grid, zone_margins
 
 __all__ = [
     "roller_pose",
+    "plain_faces",
     "friction_power",
     "flash_temperature_factor",
     "flange_heat_source_speeds",

@@ -70,6 +70,27 @@ def with_faces(
     )
 
 
+def plain_faces(bearing: Bearing) -> Bearing:
+    """`bearing` without its general-face fields where they are concretely today's faces
+    (e = 0 and kappa_rib = 0 in every member; h_t then places nothing), else `bearing` itself.
+    Section 5's contact code then runs, with the same numbers to round-off as the general
+    contact at these values (docs/model.md 5.4) at about half its cost per step, as for a
+    configuration whose face keys are today's. Not for a bearing that is differentiated with
+    respect to e, kappa_rib or h_t: it has no such fields."""
+    r, f = bearing.roller, bearing.flange
+    if not bearing.has_general_faces or not is_concrete(r.end_offset, f.rib_curvature):
+        return bearing
+    flat = all(v is None or not np.any(np.asarray(v, dtype=float)) for v in (r.end_offset, f.rib_curvature))
+    if not flat:
+        return bearing
+    return eqx.tree_at(
+        lambda b: (b.roller.end_offset, b.flange.rib_curvature, b.flange.rib_tangent_height),
+        bearing,
+        (None, None, None),
+        is_leaf=lambda x: x is None,
+    )
+
+
 class ProfileVariables(eqx.Module):
     """The profile design (module docstring): eight scalars in SI units (curvature 1/m).
 
