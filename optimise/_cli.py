@@ -160,12 +160,14 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument(
         "--starts",
         type=int,
-        help=f"number of starts (default: {d['starts']['steady']} steady, {d['starts']['startup']} startup)",
+        help=f"number of starts (default: {d['starts']['steady']} steady, {d['starts']['profile']} with --profile, "
+        f"{d['starts']['startup']} startup)",
     )
     r.add_argument(
         "--iterations",
         type=int,
-        help=f"iterations (default: {d['iterations']['steady']} steady, {d['iterations']['startup']} startup)",
+        help=f"iterations (default: {d['iterations']['steady']} steady, {d['iterations']['profile']} with --profile, "
+        f"{d['iterations']['startup']} startup)",
     )
     r.add_argument(
         "--learning-rate",

@@ -39,10 +39,12 @@ PROFILE_OPTIONS = {
 #: defaults of the search settings that are not `SteadySettings` fields (per objective where
 #: they differ); the help strings below and `problem_from_settings` both read them
 SEARCH_DEFAULTS = {
-    "starts": {"steady": 2, "startup": 4},
+    # profile: the steady search over the eight profile variables, as examples/optimise_profile.toml
+    # (one start of three: docs/how-to/profile-design.md, "The default search at full size")
+    "starts": {"steady": 2, "startup": 4, "profile": 1},
     # steady: 4, as examples/optimise.toml; the best design of the runs with more came by the
     # third iteration (docs/how-to/design-search.md)
-    "iterations": {"steady": 4, "startup": 20},
+    "iterations": {"steady": 4, "startup": 20, "profile": 3},
     "learning_rate": 0.08,
     "rtol": 1e-3,
     "atol": 1e-6,
@@ -179,9 +181,10 @@ def problem_from_settings(bearing, op, s: dict, constant_corners=None):
         atol=_positive(s, "atol", SEARCH_DEFAULTS["atol"]),
     )
     objective = objective_of(s)
+    kind = "profile" if objective == "steady" and problem.num_variables != 3 else objective
     options = dict(
-        num_starts=int(_positive(s, "starts", SEARCH_DEFAULTS["starts"][objective], int)),
-        num_iterations=int(_positive(s, "iterations", SEARCH_DEFAULTS["iterations"][objective], int)),
+        num_starts=int(_positive(s, "starts", SEARCH_DEFAULTS["starts"][kind], int)),
+        num_iterations=int(_positive(s, "iterations", SEARCH_DEFAULTS["iterations"][kind], int)),
         learning_rate=_positive(s, "learning_rate", SEARCH_DEFAULTS["learning_rate"]),
     )
     return problem, options

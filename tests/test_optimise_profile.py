@@ -175,6 +175,25 @@ def test_cli_profile_options_reach_the_problem(tmp_path, capsys, monkeypatch):
     assert e["end_radius_mm"] == pytest.approx([60, 120])
 
 
+def test_profile_search_defaults_to_one_start_of_three_iterations(tmp_path, capsys, monkeypatch):
+    """Without `--starts` and `--iterations` the profile search runs one start of three
+    iterations, as examples/optimise_profile.toml; the three-variable steady search keeps two
+    starts of four (the search itself is not run)."""
+    import optimise._steady as steady
+
+    seen = []
+
+    def recording(problem, settings, **kw):
+        seen.append((problem.num_variables, kw["num_starts"], kw["num_iterations"]))
+        raise UserInputError("stop here")
+
+    monkeypatch.setattr(steady, "steady_search", recording)
+    for extra in (["--profile"], []):
+        assert cli.main(["run", *extra, "--out", str(tmp_path / f"run{len(extra)}")]) == 2
+    assert seen == [(8, 1, 3), (3, 2, 4)]
+    assert capsys.readouterr().err.count("stop here") == 2
+
+
 def test_toml_profile_switch_and_errors(tmp_path, capsys, monkeypatch):
     from optimise._cli_settings import bounds_of
     from optimise._toml import load_optimise_toml

@@ -289,6 +289,7 @@ def test_optimise_run_help_shows_the_actual_defaults_and_values():
     b, op = jb.reference_bearing(), jb.reference_operating_point()
     steady_problem, steady_opts = problem_from_settings(b, op, {})
     _, startup_opts = problem_from_settings(b, op, {"objective": "startup"})
+    _, profile_opts = problem_from_settings(b, op, {"profile": True})
     st = steady_settings_from({})
     assert st == SteadySettings()
     bounds = steady_problem.bounds.engineering()
@@ -297,9 +298,13 @@ def test_optimise_run_help_shows_the_actual_defaults_and_values():
         return float(shown[key].split(",")[0].split()[0])
 
     assert shown["--objective"] == "steady" == objective_of({})
-    assert shown["--starts"] == f"{steady_opts['num_starts']} steady, {startup_opts['num_starts']} startup"
+    assert shown["--starts"] == (
+        f"{steady_opts['num_starts']} steady, {profile_opts['num_starts']} with --profile, "
+        f"{startup_opts['num_starts']} startup"
+    )
     assert shown["--iterations"] == (
-        f"{steady_opts['num_iterations']} steady, {startup_opts['num_iterations']} startup"
+        f"{steady_opts['num_iterations']} steady, {profile_opts['num_iterations']} with --profile, "
+        f"{startup_opts['num_iterations']} startup"
     )
     assert num("--learning-rate") == steady_opts["learning_rate"]
     assert num("--seeds") == st.seeds and num("--window-revs") == st.window_revs
