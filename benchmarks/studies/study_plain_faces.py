@@ -6,8 +6,8 @@ contact code? (`jaxbearing.flange.plain_faces`, docs/model.md 5.4.)
 The reference bearing's own profile (e = 0, a cone rib: the start design and the verification's
 reference of every profile search) run from the skid start, settled for a fixed `--settle-ms`
 (so both paths simulate the same time) and measured over 2 revolutions, one seed at a time, on the
-general contact path (the profile applied with `with_faces`, as before `plain_faces`) and on
-today's code (what `steady_design_metrics_points` runs since), alternated `--rounds` times in
+general contact path (the profile applied with `with_faces` alone) and on today's code
+(`plain_faces`, what `steady_design_metrics_points` runs), alternated `--rounds` times in
 one process so both see the same load, seeds 0 .. rounds - 1 on each: settled wall time per
 member (the programs compiled in a first, untimed pass of each) and per simulated ms, mean
 flange PV with its 95 % interval over the seeds per path, and the largest contact radius.
