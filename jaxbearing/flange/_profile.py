@@ -50,6 +50,12 @@ def _f(x) -> Array:
     return jnp.asarray(x, dtype=jnp.float64)
 
 
+def _face_fields(bearing: Bearing) -> tuple:
+    """The bearing's three general-face fields (e, kappa_rib, h_t; None where not set): the
+    nodes `with_faces` sets and `plain_faces` drops."""
+    return (bearing.roller.end_offset, bearing.flange.rib_curvature, bearing.flange.rib_tangent_height)
+
+
 def with_faces(
     bearing: Bearing,
     end_offset: ArrayLike | None = None,
@@ -59,15 +65,10 @@ def with_faces(
     """`bearing` with the general-face parameters e [m], 1/R_rib [1/m] and h_t [m] set (None
     keeps the bearing's own; a bearing without them gets 0). The result has general faces
     (`Bearing.has_general_faces`): the general contact runs, even for e = 0, kappa_rib = 0."""
-    own = (bearing.roller.end_offset, bearing.flange.rib_curvature, bearing.flange.rib_tangent_height)
+    own = _face_fields(bearing)
     given = (end_offset, rib_curvature, rib_tangent_height)
     values = tuple(_f(g if g is not None else (o if o is not None else 0.0)) for g, o in zip(given, own))
-    return eqx.tree_at(
-        lambda b: (b.roller.end_offset, b.flange.rib_curvature, b.flange.rib_tangent_height),
-        bearing,
-        values,
-        is_leaf=lambda x: x is None,
-    )
+    return eqx.tree_at(_face_fields, bearing, values, is_leaf=lambda x: x is None)
 
 
 def plain_faces(bearing: Bearing) -> Bearing:
@@ -83,12 +84,7 @@ def plain_faces(bearing: Bearing) -> Bearing:
     flat = all(v is None or not np.any(np.asarray(v, dtype=float)) for v in (r.end_offset, f.rib_curvature))
     if not flat:
         return bearing
-    return eqx.tree_at(
-        lambda b: (b.roller.end_offset, b.flange.rib_curvature, b.flange.rib_tangent_height),
-        bearing,
-        (None, None, None),
-        is_leaf=lambda x: x is None,
-    )
+    return eqx.tree_at(_face_fields, bearing, (None, None, None), is_leaf=lambda x: x is None)
 
 
 class ProfileVariables(eqx.Module):
