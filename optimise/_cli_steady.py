@@ -148,7 +148,9 @@ def tail_text(tail) -> str:
 
 def _verified_text(point) -> str:
     """One design's verification at one operating point (`VerifiedPoint`), in one line."""
-    e, GPA = point.mean_pv, 1e9  # Pa m/s per GPa m/s
+    from ._problem import PV_SCALE as GPA  # Pa m/s per GPa m/s
+
+    e = point.mean_pv
 
     def interval(name: str, est) -> str:
         if not all(map(math.isfinite, (est.value, est.ci95_low, est.ci95_high))):
