@@ -19,7 +19,10 @@ search's clearance differences included). Every returned design is then verified
 Per run: the best-so-far objective (search seeds; the design the run would return had it stopped)
 against members, the returned design, its verified objective with its 95 % interval, and the
 members at which the run's best-so-far first reached the median of CMA-ES's final objectives
-(`members_to_cmaes_final`). Writes results/NAME.json (every finished run kept: a rerun with the
+(`members_to_cmaes_final`). With `--profile`, the three-variable optimum
+(`THREE_VARIABLE_OPTIMUM`, the bearing's own R_cor, flat rib and spherical end) is verified the
+same way once (`three_variable_optimum`), so the figure shows where the profile designs stand
+against it. Writes results/NAME.json (every finished run kept: a rerun with the
 same options continues, also with another `--repeats`) and, with `--plot PATH`, the curves with the verified objectives as
 bars at the members spent.
 """
@@ -41,6 +44,10 @@ sys.path.insert(0, str(HERE.parents[1]))
 import _common  # noqa: E402
 
 ROOT = HERE.parents[2]
+
+#: the three-variable search's optimum (R_end [mm], theta_f [deg], Delta_bf [mm]): docs/how-to
+#: "Design the roller end and rib profiles", the design a profile has to beat
+THREE_VARIABLE_OPTIMUM = (101.6, 1.527, 0.140)
 
 
 def _problem(args):
@@ -154,6 +161,29 @@ def _verified(problem, settings, run) -> None:
     ]
 
 
+def _three_variable_optimum(problem) -> np.ndarray:
+    """`THREE_VARIABLE_OPTIMUM` as the eight profile variables [SI]: the bearing's own profile
+    (sphere, cone, its corner radius and flange height) with R_end, theta_f and Delta_bf set."""
+    from optimise import ProfileBounds, start_points
+
+    x = np.array(problem.bounds.from_scaled(start_points(problem, 1)[0]), dtype=float)
+    keys = [v.key for v in ProfileBounds.TABLE]
+    r_end, theta, delta = THREE_VARIABLE_OPTIMUM
+    x[keys.index("end_radius_mm")] = r_end * 1e-3
+    x[keys.index("layback_angle_deg")] = np.deg2rad(theta)
+    x[keys.index("axial_clearance_mm")] = delta * 1e-3
+    return x
+
+
+def _verified_optimum(problem, settings, out) -> None:
+    """Verify the three-variable optimum once, as every run's design (`_verified`)."""
+    if "three_variable_optimum" in out:
+        return
+    run = {"design": _three_variable_optimum(problem).tolist()}
+    _verified(problem, settings, run)
+    out["three_variable_optimum"] = {"design_mm_deg_mm": list(THREE_VARIABLE_OPTIMUM), **run}
+
+
 def _reach(run, target) -> int | None:
     for m, v in zip(run["members_curve"], run["best_curve"]):
         if v is not None and v <= target:
@@ -167,7 +197,7 @@ def _plot(out, path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(6.4, 4.0))
+    fig, ax = plt.subplots(figsize=(8.6, 4.0))
     colours = {"gradient": "C0", "random": "C1", "cmaes": "C2"}
     for run in out["runs"]:
         c = colours[run["method"]]
@@ -193,10 +223,14 @@ def _plot(out, path) -> None:
     ref = next((r["verified_reference"][0] for r in out["runs"] if r.get("verified_reference")), None)
     if ref is not None:
         ax.axhline(ref["value"], color="0.5", linestyle="--", label="start design, verified")
+    opt = out.get("three_variable_optimum", {}).get("verified")
+    if opt:
+        ax.axhline(opt[0]["value"], color="k", linestyle=":", label="three-variable optimum, verified")
+        ax.axhspan(opt[0]["ci95_low"], opt[0]["ci95_high"], color="k", alpha=0.08)
     ax.set_xlabel("settled members simulated")
     ax.set_ylabel("objective [GPa m/s]")
     ax.set_title("lines: best so far on the search's seeds; dots: verified on unseen seeds", fontsize=9)
-    ax.legend()
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     fig.tight_layout()
     fig.savefig(path, dpi=120)
 
@@ -259,6 +293,9 @@ def main(argv=None) -> int:
         _verified(problem, settings, run)
         out["runs"].append(run)
         _common.log(f"{method} {repeat}: objective {run['objective']}, {run['members']} members")
+        _common.write_json(args.name, out)
+    if args.profile:
+        _verified_optimum(problem, settings, out)
         _common.write_json(args.name, out)
     finals = [r["objective"] for r in out["runs"] if r["method"] == "cmaes" and r["objective"] is not None]
     target = float(np.median(finals)) if finals else None
