@@ -323,6 +323,35 @@ def test_frozen_load_derivative_matches_central_differences(settled, frozen_wind
     np.testing.assert_allclose(value, direct, rtol=1e-9)
 
 
+def test_held_load_objective_is_the_frozen_functional_with_the_contact_kept(settled, frozen_window):
+    """`held_readouts` (the held-load objective, docs/model.md 17) at the frozen-load window's
+    saved states: at the design that ran it is the frozen functional's mean PV (the PV of the
+    contacts at the loads the dynamics gave, over their weights) to round-off; at a nearby end
+    radius (every contact still overlapping) it equals the frozen ratio form; and where the
+    ratio form loses a contact it keeps it: 20 um more axial clearance moves no contact point on
+    a cone rib (the end's extreme point along the rib normal does not depend on where the rib
+    is), so the held mean PV is unchanged while the frozen form's contacts open."""
+    from jaxbearing.design import held_contacts, held_readouts
+
+    b, op, x, _ = settled
+    saved, q0, ratio = frozen_window
+    contacts = held_contacts(b, op, DesignVariables.from_array(x), saved, min_weight=0.0)
+    held = eqx.filter_jit(held_readouts)
+    ref = STEADY_FUNCTIONALS.pv_reference
+    w = q0 / (q0 + STEADY_FUNCTIONALS.contact_load)
+    at_x = held(b, jnp.asarray(x), contacts)
+    assert float(at_x.mean_pv) == pytest.approx(float(jnp.sum(w * ratio) / jnp.sum(w) * ref), rel=1e-10)
+
+    near = jnp.asarray(x) * jnp.array([1.0 + 1e-5, 1.0, 1.0])
+    a, c = _frozen_sums(b, op, saved, q0, 1.0, near)
+    assert float(held(b, near, contacts).mean_pv) == pytest.approx(float(a / c * ref), rel=1e-9)
+
+    wider = jnp.asarray(x) + jnp.array([0.0, 0.0, 20e-6])
+    assert float(held(b, wider, contacts).mean_pv) == pytest.approx(float(at_x.mean_pv), rel=1e-12)
+    a_wide, _ = _frozen_sums(b, op, saved, q0, 1.0, wider)
+    assert float(a_wide) < 0.5 * float(jnp.sum(w * ratio))
+
+
 def test_frozen_friction_derivative_matches_central_differences(settled, frozen_window):
     """The friction statistic's frozen integrand (`frozen_friction_integrands`: sum_c mu_c(x)
     Q0_c |u_c(x)| per saved state, a plain time average) differentiated by jax.jacfwd against

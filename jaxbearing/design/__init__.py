@@ -17,6 +17,10 @@
   accumulators they differentiate, `STEADY_FUNCTIONALS` (`STATISTICS`, by `Statistic`: the mean, the
   peak statistic's p-mean with p = `PEAK_EXPONENT`, the tail mean, and the time-mean flange
   friction power, `FRICTION_REFERENCE`).
+- the held-load objective (docs/model.md 17): `held_readouts` (mean and peak PV and the corner
+  distance of any design at the poses and loads of one design's settled running, `HeldReadouts`:
+  deterministic, differentiable, without dynamics), `held_contacts` (those contacts,
+  `HeldContacts`, from saved states of `trajectory_states`).
 
 - which uncertain inputs matter (docs/model.md 18): `sensitivity` (the effect, derivative x
   stated uncertainty, of every `[uncertainty]` key and `MODEL_CONSTANTS` entry on settled
@@ -46,7 +50,13 @@ from ._design import (
     forward_jacobian,
     seated_perturbation,
 )
-from ._frozen_load import frozen_load_gradient, frozen_load_gradients, frozen_load_statistics
+from ._frozen_load import (
+    frozen_load_gradient,
+    frozen_load_gradients,
+    frozen_load_statistics,
+    trajectory_states,
+)
+from ._held_load import HeldContacts, HeldReadouts, held_contacts, held_readouts
 from ._robustness import (
     ROBUSTNESS_CONSTANTS,
     Robustness,
@@ -116,6 +126,11 @@ __all__ = [
     "design_metrics",
     "forward_jacobian",
     "frozen_load_gradient",
+    "HeldContacts",
+    "HeldReadouts",
+    "held_contacts",
+    "held_readouts",
+    "trajectory_states",
     "frozen_load_gradients",
     "frozen_load_statistics",
     "paired_central_difference",

@@ -35,6 +35,7 @@ from ._contact import (
     FLANGE_ORDER,
     FlangeContact,
     all_flange_contacts,
+    flange_pv_at_load,
     roller_flange_contact,
     without_absent_flanges,
 )
@@ -71,6 +72,7 @@ from ._profile import (
 from ._zone import MARGIN_NAMES, DesignZone, design_zone, design_zone_grid, zone_margins
 
 __all__ = [
+    "flange_pv_at_load",
     "roller_pose",
     "plain_faces",
     "friction_power",

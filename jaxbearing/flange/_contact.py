@@ -260,6 +260,49 @@ def roller_flange_contact(
 FLANGE_ORDER = ((1.0, -1.0), (1.0, 1.0), (-1.0, -1.0), (-1.0, 1.0))
 
 
+def flange_pv_at_load(
+    bearing: Bearing,
+    raceway_radius: ArrayLike,
+    side: ArrayLike,
+    ring_sign: ArrayLike,
+    roller_centre: Vec3,
+    roller_axis: Vec3,
+    roller_velocity: Vec3,
+    roller_angular_velocity: Vec3,
+    ring_centre: Vec3,
+    ring_velocity: Vec3,
+    ring_angular_velocity: Vec3,
+    load: ArrayLike,
+    *,
+    ring_axis: Vec3 | None = None,
+) -> tuple[Scalar, Scalar]:
+    """(PV [Pa m/s], contact radius rho_c [m]) of one roller end against one flange at the pose
+    and velocities given (the arguments of `roller_flange_contact`), with the normal load Q held
+    at `load` instead of the one the interference gives: p_max(Q) |u|, the contact point, the
+    curvature sums and the material sliding speed |u| those of `bearing`'s faces at this pose
+    (docs/model.md 17, the held-load objective). On a cone rib the contact point and the
+    curvatures do not depend on how far the end is pressed into the rib, so this is the PV the
+    roller would have pressed against these faces with load Q, whether or not they overlap at
+    this pose; on a concave rib the same to the order of the interference."""
+    g = contact_geometry(
+        bearing, raceway_radius, side, ring_sign, roller_centre, roller_axis, ring_centre, ring_axis
+    )
+    speed = _flange_sliding(
+        g.normal,
+        g.contact_point,
+        jnp.asarray(roller_centre),
+        jnp.asarray(ring_centre),
+        roller_velocity,
+        roller_angular_velocity,
+        ring_velocity,
+        ring_angular_velocity,
+    )[4]
+    p_max = point_contact_peak_pressure(
+        load, g.radius_meridian, g.radius_parallel, flange_effective_modulus(bearing)
+    )
+    return p_max * speed, g.contact_radius
+
+
 def all_flange_contacts(
     bearing: Bearing,
     roller_centre: Float[Array, "Z 3"],
