@@ -55,6 +55,20 @@ def _row(m) -> dict:
         "friction_power_W": None if st is None else st.flange_friction_power_W.total.as_dict(),
         "flash_temperature_K": None if st is None else st.flange_flash_temperature_K.max.as_dict(),
         "film_parameter_p05": None if st is None else st.film_parameter.p05.as_dict(),
+        # what the mean PV is made of: per contact event (the mean per revolution of the events'
+        # largest values) the normal load, the peak pressure and the sliding speed, the events per
+        # revolution and the mean contact height
+        "event_load_N": None if st is None else st.flange_force_N.mean.as_dict(),
+        "event_pressure_GPa": None if st is None else _gpa(st.flange_pressure_Pa.mean),
+        "event_sliding_speed_m_s": None if st is None else st.flange_sliding_velocity_m_s.mean.as_dict(),
+        "events_per_revolution": None if st is None else st.flange_contact_events_per_rev.as_dict(),
+        "contact_height_mm": None
+        if st is None
+        else {
+            k: (None if v is None else v * 1e3)
+            for k, v in st.contact_height_m.mean.as_dict().items()
+            if k != "n"
+        },
         "settled": m.settled,
         "seeds": m.seeds,
     }
