@@ -11,7 +11,9 @@ of examples/optimise.toml (`--profile`: the eight variables of examples/optimise
 `--starts` x `--iterations`) runs once; random search and CMA-ES
 (`optimise.gradient_free_search`, a generation of `--population` designs per engine call) run
 `--repeats` times each (seeds 0, 1, ...) with the settled members the gradient search spent as
-their budget (`--budget-members` to set it). Members are counted where every search simulates:
+their budget (`--budget-members` to set it). `--methods held` adds the held-load search once
+(`_held_run`: settle, hold the contacts, SLSQP on the held-load objective, settle again,
+`--held-rounds` holds; deterministic given the seeds). Members are counted where every search simulates:
 each call of `optimise._evaluate.settled_metrics` adds its designs x seeds (the gradient
 search's clearance differences included). Every returned design is then verified on seeds 1000..
 (`optimise.verification`, `--verify-seeds`, 4-revolution windows).
@@ -124,6 +126,93 @@ def _gradient_run(problem, settings, args) -> dict:
     )
 
 
+def _held_run(problem, settings, args) -> dict:
+    """The held-load search (`--methods held`): settle the start design (the bearing's own) on
+    the search's seeds, hold the flange contacts of a window of `--held-window-ms` from each
+    seed's settled state (`design.held_contacts`), minimise the held mean PV at every
+    operating point inside the static zone with the held corner distance at least the search's
+    corner margin (`study_profile_bound.held_minimum`, SLSQP, `--held-maxiter` iterations),
+    settle that design, and repeat from it `--held-rounds` times. Each settled design counts
+    its members as every search's do; the returned design is the feasible one of the lowest
+    upper 95 % bound, as the gradient-free searches choose."""
+    import importlib.util
+
+    import jax
+    import jax.numpy as jnp
+
+    from jaxbearing.design import held_contacts, trajectory_states
+    from optimise import start_points
+    from optimise._evaluate import evaluate, operating_points
+    from optimise._problem import MARGIN_SCALE
+    from optimise._steady import constraints, interval_bounds, scaled_limits
+
+    spec = importlib.util.spec_from_file_location(
+        "study_profile_bound", HERE.parent / "study_profile_bound.py"
+    )
+    bound = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bound)
+    ops = operating_points(problem)
+    lower, upper = np.asarray(problem.bounds.lower, float), np.asarray(problem.bounds.upper, float)
+    n = max(1, int(round(args.held_window_ms * 100)))
+    u = np.asarray(start_points(problem, 1)[0], float)
+    designs, objectives, highs, marks, curve = [], [], [], [], []
+    with _Counter() as count:
+        for k in range(args.held_rounds + 1):
+            ev = evaluate(problem, settings, u, gradient=False)
+            c, _ = constraints(problem, u, ev.dynamic_margin, u, scaled_limits(settings, ev.limit_margins)[0])
+            feasible = bool(np.all(c > 0) and np.isfinite(ev.objective))
+            designs.append(np.asarray(problem.bounds.from_scaled(u), float))
+            objectives.append(float(ev.objective))
+            highs.append(
+                float(interval_bounds(np.asarray([ev.objective_ci]), np.asarray([ev.objective]))[0, 1])
+                if feasible
+                else np.inf
+            )
+            best = int(np.argmin(highs)) if np.isfinite(min(highs)) else None
+            marks.append(count.members)
+            curve.append(None if best is None else objectives[best])
+            _common.log(
+                f"held round {k}: objective {ev.objective:.3f}, feasible {feasible}, {count.members} members, "
+                f"zone margins {np.round(np.asarray(ev.static_margins) * 1e6, 1)} um, "
+                f"dynamic corner margin {ev.dynamic_margin * 1e6:.1f} um"
+            )
+            if k == args.held_rounds:
+                break
+            design = problem.bounds.variables(jnp.asarray(designs[-1]))
+            held = []
+            for i, op in enumerate(ops):
+                b = problem.bearing_at(i)
+                windows = [
+                    trajectory_states(design.apply(b), op, s, args.held_window_ms * 1e-3, n)[0]
+                    for s in ev.states[i]
+                ]
+                states = jax.tree_util.tree_map(lambda *a: np.concatenate(a), *windows)
+                held.append(held_contacts(b, op, design, states))
+            at = bound.held_evaluator(problem.bearing, held, lower, upper, margins=problem.margins)
+            readouts = at(u)[0]
+            reference = readouts[0 : 3 * len(ops) : 3]
+            # the search's constraints (margins / 0.1 mm - tighten > 0) with 2 um to spare; the
+            # dynamic corner margin through the held corner distance, offset by what separates the
+            # two at this design (the tolerance bound of the maxima against the held maximum)
+            spare = problem.tighten * MARGIN_SCALE + 2e-6
+            dynamic = ev.dynamic_margin if np.isfinite(ev.dynamic_margin) else settings.corner_margin
+            floor = readouts[2 : 3 * len(ops) : 3] - dynamic + spare
+            u, _ = bound.held_minimum(
+                at, reference, u, list(range(len(ops))), floor, args.held_maxiter, zone_floor=spare
+            )
+    best = int(np.argmin(highs)) if np.isfinite(min(highs)) else None
+    return dict(
+        method="held",
+        repeat=0,
+        members_curve=marks,
+        best_curve=curve,
+        design=None if best is None else designs[best].tolist(),
+        objective=None if best is None else objectives[best],
+        members=count.members,
+        rounds=[dict(design=d.tolist(), objective=o) for d, o in zip(designs, objectives)],
+    )
+
+
 def _free_run(problem, settings, method, repeat, budget, args) -> dict:
     from optimise import gradient_free_search
 
@@ -191,6 +280,10 @@ def _reach(run, target) -> int | None:
     return None
 
 
+#: the methods' names in the figure's legend
+_LABELS = {"held": "held-load search"}
+
+
 def _plot(out, path) -> None:
     import matplotlib
 
@@ -198,7 +291,7 @@ def _plot(out, path) -> None:
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(8.6, 4.0))
-    colours = {"gradient": "C0", "random": "C1", "cmaes": "C2"}
+    colours = {"gradient": "C0", "random": "C1", "cmaes": "C2", "held": "C3"}
     for run in out["runs"]:
         c = colours[run["method"]]
         y = [np.nan if v is None else v for v in run["best_curve"]]
@@ -208,7 +301,8 @@ def _plot(out, path) -> None:
             where="post",
             color=c,
             alpha=0.8,
-            label=run["method"] if run["repeat"] == 0 else None,
+            label=_LABELS.get(run["method"], run["method"]) if run["repeat"] == 0 else None,
+            marker="s" if run["method"] == "held" else None,
         )
         if run.get("verified"):
             e = run["verified"][0]
@@ -236,9 +330,9 @@ def _plot(out, path) -> None:
 
 
 #: options a rerun may change and still continue the file's runs: the repeats (fewer: the
-#: later repeats' runs move to `runs_left_out`; more: they run), the gradient-free methods run
-#: and where the figure goes
-_ANY = ("repeats", "plot", "methods")
+#: later repeats' runs move to `runs_left_out`; more: they run), the gradient-free methods run,
+#: where the figure goes and the held-load search's settings
+_ANY = ("repeats", "plot", "methods", "held_rounds", "held_window_ms", "held_maxiter")
 
 
 def main(argv=None) -> int:
@@ -253,6 +347,9 @@ def main(argv=None) -> int:
     p.add_argument("--population", type=int, default=6)
     p.add_argument("--methods", default="cmaes,random", help="the gradient-free methods run, in order")
     p.add_argument("--budget-members", type=int, default=0, help="0: what the gradient search spent")
+    p.add_argument("--held-rounds", type=int, default=2, help="held-load search: re-holds after the first")
+    p.add_argument("--held-window-ms", type=float, default=1.0, help="held-load search: window per seed")
+    p.add_argument("--held-maxiter", type=int, default=40, help="held-load search: SLSQP iterations")
     p.add_argument("--name", default="study_gradient_free")
     p.add_argument("--plot", default="", help="where to draw the figure (PNG); none by default")
     p.add_argument("--quick", action="store_true")
@@ -279,12 +376,16 @@ def main(argv=None) -> int:
     out["runs"] = kept
     done = {(r["method"], r["repeat"]) for r in out["runs"]}
     methods = args.methods.split(",")
-    jobs = [("gradient", 0)] + [(m, k) for m in methods for k in range(args.repeats)]
+    # the held-load search is deterministic given its seeds: one run, as the gradient search
+    jobs = [("gradient", 0)] + [(m, 0 if m == "held" else k) for m in methods for k in range(args.repeats)]
+    jobs = list(dict.fromkeys(jobs))
     for method, repeat in jobs:
         if (method, repeat) in done:
             continue
         if method == "gradient":
             run = _gradient_run(problem, settings, args)
+        elif method == "held":
+            run = _held_run(problem, settings, args)
         else:
             budget = args.budget_members or next(
                 r["members"] for r in out["runs"] if r["method"] == "gradient"
