@@ -9,6 +9,8 @@ objective's gradients come from forward-mode differentiation through the diffrax
 `SteadySettings`; its choices are typed: `Statistic` (the PV statistic minimised), `Estimator`
 (the gradient estimate), `CornerConstraint` (the dynamic corner constraint) and `Choice` (which
 of the tied designs is returned); the command line and the TOML files name them by their values.
+`held_load_search` minimises the held-load objective of settled contacts by SLSQP, settles the
+result and repeats (`HeldLoadResult`).
 Command line: `optimise run --help`.
 """
 
@@ -18,6 +20,7 @@ from jaxbearing.flange import MARGIN_NAMES
 
 from ._gradient_free import GradientFreeResult, gradient_free_search
 from ._grid import steady_grid
+from ._held_load import HeldLoadResult, held_load_search
 from ._plot import plot_search
 from ._problem import (
     Bounds,
@@ -37,6 +40,8 @@ from ._verify import TailVerification, Verification, VerifiedPoint, verification
 
 __all__ = [
     "MARGIN_NAMES",
+    "HeldLoadResult",
+    "held_load_search",
     "Bounds",
     "ProfileBounds",
     "Choice",

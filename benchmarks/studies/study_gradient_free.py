@@ -127,90 +127,48 @@ def _gradient_run(problem, settings, args) -> dict:
 
 
 def _held_run(problem, settings, args) -> dict:
-    """The held-load search (`--methods held`): settle the start design (the bearing's own) on
-    the search's seeds, hold the flange contacts of a window of `--held-window-ms` from each
-    seed's settled state (`design.held_contacts`), minimise the held mean PV at every
-    operating point inside the static zone with the held corner distance at least the search's
-    corner margin (`study_profile_bound.held_minimum`, SLSQP, `--held-maxiter` iterations),
-    settle that design, and repeat from it `--held-rounds` times. Each settled design counts
-    its members as every search's do; the returned design is the feasible one of the lowest
-    upper 95 % bound, as the gradient-free searches choose."""
-    import importlib.util
+    """The held-load search (`optimise.held_load_search`, `--held-rounds` holds of
+    `--held-window-ms` windows, `--held-maxiter` SLSQP iterations) from the bearing's own
+    design; its settled members counted as every search's."""
+    from optimise import held_load_search
 
-    import jax
-    import jax.numpy as jnp
+    marks = []
 
-    from jaxbearing.design import held_contacts, trajectory_states
-    from optimise import start_points
-    from optimise._evaluate import evaluate, operating_points
-    from optimise._problem import MARGIN_SCALE
-    from optimise._steady import constraints, interval_bounds, scaled_limits
+    def log(line):
+        marks.append(count.members)
+        _common.log(line)
 
-    spec = importlib.util.spec_from_file_location(
-        "study_profile_bound", HERE.parent / "study_profile_bound.py"
-    )
-    bound = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(bound)
-    ops = operating_points(problem)
-    lower, upper = np.asarray(problem.bounds.lower, float), np.asarray(problem.bounds.upper, float)
-    n = max(1, int(round(args.held_window_ms * 100)))
-    u = np.asarray(start_points(problem, 1)[0], float)
-    designs, objectives, highs, marks, curve = [], [], [], [], []
     with _Counter() as count:
-        for k in range(args.held_rounds + 1):
-            ev = evaluate(problem, settings, u, gradient=False)
-            c, _ = constraints(problem, u, ev.dynamic_margin, u, scaled_limits(settings, ev.limit_margins)[0])
-            feasible = bool(np.all(c > 0) and np.isfinite(ev.objective))
-            designs.append(np.asarray(problem.bounds.from_scaled(u), float))
-            objectives.append(float(ev.objective))
-            highs.append(
-                float(interval_bounds(np.asarray([ev.objective_ci]), np.asarray([ev.objective]))[0, 1])
-                if feasible
-                else np.inf
-            )
-            best = int(np.argmin(highs)) if np.isfinite(min(highs)) else None
-            marks.append(count.members)
-            curve.append(None if best is None else objectives[best])
-            _common.log(
-                f"held round {k}: objective {ev.objective:.3f}, feasible {feasible}, {count.members} members, "
-                f"zone margins {np.round(np.asarray(ev.static_margins) * 1e6, 1)} um, "
-                f"dynamic corner margin {ev.dynamic_margin * 1e6:.1f} um"
-            )
-            if k == args.held_rounds:
-                break
-            design = problem.bounds.variables(jnp.asarray(designs[-1]))
-            held = []
-            for i, op in enumerate(ops):
-                b = problem.bearing_at(i)
-                windows = [
-                    trajectory_states(design.apply(b), op, s, args.held_window_ms * 1e-3, n)[0]
-                    for s in ev.states[i]
-                ]
-                states = jax.tree_util.tree_map(lambda *a: np.concatenate(a), *windows)
-                held.append(held_contacts(b, op, design, states))
-            at = bound.held_evaluator(problem.bearing, held, lower, upper, margins=problem.margins)
-            readouts = at(u)[0]
-            reference = readouts[0 : 3 * len(ops) : 3]
-            # the search's constraints (margins / 0.1 mm - tighten > 0) with 2 um to spare; the
-            # dynamic corner margin through the held corner distance, offset by what separates the
-            # two at this design (the tolerance bound of the maxima against the held maximum)
-            spare = problem.tighten * MARGIN_SCALE + 2e-6
-            dynamic = ev.dynamic_margin if np.isfinite(ev.dynamic_margin) else settings.corner_margin
-            floor = readouts[2 : 3 * len(ops) : 3] - dynamic + spare
-            u, _ = bound.held_minimum(
-                at, reference, u, list(range(len(ops))), floor, args.held_maxiter, zone_floor=spare
-            )
-    best = int(np.argmin(highs)) if np.isfinite(min(highs)) else None
+        res = held_load_search(
+            problem,
+            settings,
+            rounds=args.held_rounds,
+            window_ms=args.held_window_ms,
+            maxiter=args.held_maxiter,
+            log=log,
+        )
+    curve = []
+    for k in range(len(res.objective)):
+        upto = _first_rounds(res, k + 1).best
+        curve.append(None if upto < 0 else float(res.objective[upto]))
+    b = res.best
     return dict(
         method="held",
         repeat=0,
         members_curve=marks,
         best_curve=curve,
-        design=None if best is None else designs[best].tolist(),
-        objective=None if best is None else objectives[best],
+        design=None if b < 0 else res.designs[b].tolist(),
+        objective=None if b < 0 else float(res.objective[b]),
         members=count.members,
-        rounds=[dict(design=d.tolist(), objective=o) for d, o in zip(designs, objectives)],
+        rounds=[dict(design=d.tolist(), objective=float(o)) for d, o in zip(res.designs, res.objective)],
     )
+
+
+def _first_rounds(res, n: int):
+    """The first `n` rounds of a `HeldLoadResult` (its best-so-far after round n - 1)."""
+    from optimise import HeldLoadResult
+
+    return HeldLoadResult(res.designs[:n], res.objective[:n], res.ci[:n], res.feasible[:n])
 
 
 def _free_run(problem, settings, method, repeat, budget, args) -> dict:

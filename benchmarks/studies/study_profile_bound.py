@@ -25,8 +25,8 @@ ratios (every speed at once: what acceptance demands). A ratio near 1 under "as 
 finding "no profile does better at these loads"; the same ratio under "none" says how much the
 corner costs. What the held loads leave out: how a design changes the loads and the poses (the
 dynamics); a design the held minimum calls better is a candidate for settled running on unseen
-seeds (`study_unseen_seeds.py`), not a result. `held_evaluator` and `held_minimum` also serve
-the held-load search of `study_gradient_free.py`.
+seeds (`study_unseen_seeds.py`), not a result. The evaluator and the SLSQP step are
+`optimise.held_load_search`'s (`optimise/_held_load.py`).
 
 Writes results/NAME.json: the settings, per speed the optimum's settled mean PV, its held mean
 PV and the frozen-load estimate, the held ratios of the starts, and per rule and objective the
@@ -107,89 +107,6 @@ def _settle(bearing, ops, x0, args):
     return metrics, held, [g.value / 1e9 for g in estimates]
 
 
-def held_evaluator(bearing, held, lower, upper, margins=None):
-    """at(u) -> (readouts, their Jacobian in u), cached: for every set of held contacts of
-    `held` (one per operating point) the held mean PV [GPa m/s], peak PV [GPa m/s] and corner
-    distance [m] (`design.held_readouts`), then the four static zone margins [m]
-    (`margins(u)`, by default `flange.zone_margins` at 100 N), of the profile design
-    lower + u (upper - lower)."""
-    import jax
-    import jax.numpy as jnp
-
-    from jaxbearing.design import held_readouts
-    from jaxbearing.flange import ProfileVariables, zone_margins
-
-    def readouts(u):
-        x = jnp.asarray(lower) + u * jnp.asarray(upper - lower)
-        per = []
-        for c in held:
-            r = held_readouts(bearing, x, c)
-            per += [r.mean_pv / 1e9, r.peak_pv / 1e9, r.corner_distance]
-        if margins is None:
-            zone = zone_margins(bearing, ProfileVariables.from_array(x), flange_load=100.0)
-        else:
-            zone = margins(u)
-        return jnp.concatenate([jnp.stack(per), zone])
-
-    value, jacobian = jax.jit(readouts), jax.jit(jax.jacfwd(readouts))
-    cache = {}
-
-    def at(u):
-        key = tuple(np.round(np.asarray(u, float), 14))
-        if key not in cache:
-            v = jnp.asarray(np.asarray(u, float))
-            cache[key] = (np.asarray(value(v)), np.asarray(jacobian(v)))
-        return cache[key]
-
-    return at
-
-
-def held_minimum(at, reference, u_start, points, floor, maxiter, zone_floor=0.0):
-    """SLSQP from `u_start` in the unit box: the design u (and scipy's result) that minimises
-    the largest held mean PV over the operating points `points` (indices), each against its
-    `reference` value, with the static zone margins >= `zone_floor` [m] and, unless `floor` is
-    None, every point's held corner distance >= floor[point] [m] (`held_evaluator`'s `at`)."""
-    from scipy.optimize import minimize
-
-    n = len(u_start)
-    k = (len(at(u_start)[0]) - 4) // 3  # operating points
-    cons = [
-        {
-            "type": "ineq",
-            "fun": lambda v, i=i: v[-1] - at(v[:n])[0][3 * i] / reference[i],
-            "jac": lambda v, i=i: np.r_[-at(v[:n])[1][3 * i] / reference[i], 1.0],
-        }
-        for i in points
-    ]
-    cons.append(
-        {
-            "type": "ineq",
-            "fun": lambda v: (at(v[:n])[0][3 * k :] - zone_floor) * 1e3,
-            "jac": lambda v: np.c_[at(v[:n])[1][3 * k :] * 1e3, np.zeros(4)],
-        }
-    )
-    if floor is not None:
-        cons.append(
-            {
-                "type": "ineq",
-                "fun": lambda v: (at(v[:n])[0][2 : 3 * k : 3] - floor) * 1e3,
-                "jac": lambda v: np.c_[at(v[:n])[1][2 : 3 * k : 3] * 1e3, np.zeros(k)],
-            }
-        )
-    r_start, _ = at(u_start)
-    t_start = max(r_start[3 * i] / reference[i] for i in points)
-    res = minimize(
-        lambda v: (v[-1], np.r_[np.zeros(n), 1.0]),
-        np.r_[u_start, t_start],
-        jac=True,
-        method="SLSQP",
-        bounds=[(0.0, 1.0)] * n + [(0.0, None)],
-        constraints=cons,
-        options={"maxiter": maxiter, "ftol": 1e-6},
-    )
-    return np.clip(res.x[:n], 0.0, 1.0), res
-
-
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--slices", type=int, default=11)
@@ -208,8 +125,10 @@ def main(argv=None) -> int:
     args = p.parse_args(argv)
 
     import jaxbearing as jb
+    from jaxbearing.flange import ProfileVariables, zone_margins
     from jaxbearing.geometry import rpm_to_rad_s
     from optimise import ProfileBounds
+    from optimise._held_load import held_evaluator, held_minimum
     from optimise._problem import halton_points
 
     t0 = time.perf_counter()
@@ -226,7 +145,15 @@ def main(argv=None) -> int:
         f"settled in {time.perf_counter() - t0:.0f} s; held contacts {[h.load.shape[0] for h in held]}"
     )
 
-    at = held_evaluator(bearing, held, lower, upper)
+    at = held_evaluator(
+        bearing,
+        held,
+        lower,
+        upper,
+        lambda u: zone_margins(
+            bearing, ProfileVariables.from_array(lower + u * (upper - lower)), flange_load=100.0
+        ),
+    )
     r0, _ = at(u0)
     ref = r0[:9].reshape(3, 3)
     _common.log(f"optimum held: mean {ref[:, 0]}, peak {ref[:, 1]}, corner distance {ref[:, 2]} m")
