@@ -3,7 +3,7 @@
     python benchmarks/studies/study_profile_gradients.py --slices 11 --seeds 6 \
         --name profile_gradient_check
 
-At each of three profile designs (`DESIGNS`, inside the box of examples/optimise_profile.toml,
+At each of four profile designs (`DESIGNS`, inside the box of examples/optimise_profile.toml,
 the faces general: a torus end, a concave rib; `--designs` picks some by position) the reference bearing at `--slices` slices and
 its operating point (20,000 rpm, 1000 N) settles `--seeds` seeds from the skid start (`design.steady_design_metrics`, a
 `--window-revs` window); the frozen-load estimator (`design.frozen_load_gradients`) gives the
@@ -26,7 +26,7 @@ below the rib's top edge, as the design zone demands), "disagrees" or "inconsist
 Writes results/NAME.json after every design (a rerun with the same options continues; a design
 of the file no longer in `DESIGNS` is kept): per design and variable the estimate, its standard error, the paired
 difference, its standard error and the verdict. tests/test_profile_gradients.py runs `check`
-at reduced size: the end offset at one design in `make test`, every variable at the three
+at reduced size: the end offset at one design in `make test`, every variable at the four
 designs with `make test-slow`.
 """
 
@@ -46,7 +46,7 @@ sys.path.insert(0, str(HERE.parents[1]))
 
 import _common  # noqa: E402
 
-#: three designs [engineering units, PROFILE_TABLE order: R_end mm, e mm, R_cor mm, 1/R_rib
+#: four designs [engineering units, PROFILE_TABLE order: R_end mm, e mm, R_cor mm, 1/R_rib
 #: 1/m, h_t mm, theta_f deg, H_rf mm, Delta_bf mm], inside examples/optimise_profile.toml's box
 #: with every variable at least one step from its bounds
 #: and inside the static design zone (`flange.zone_margins` all positive)
@@ -54,6 +54,9 @@ DESIGNS = {
     "torus end, concave rib": (80.0, 0.3, 0.4, 1.0, 0.5, 1.6, 2.0, 0.15),
     "larger end radius, half-curved rib": (90.0, 0.2, 0.45, 2.5, 0.8, 1.5, 2.1, 0.15),
     "small end radius, more curved rib": (70.0, 0.7, 0.5, 3.5, 1.0, 1.3, 2.2, 0.2),
+    # towards the held-load design (docs/how-to/profile-design.md, "Below the three-variable
+    # optimum"): a large torus end conforming with a concave rib, where the rib curvature acts
+    "conforming torus end on a concave rib": (110.0, 0.6, 0.35, 3.5, 0.3, 1.25, 2.1, 0.15),
 }
 
 #: the variables the three-variable search does not have
@@ -200,7 +203,7 @@ def main(argv=None) -> int:
     p.add_argument("--seeds", type=int, default=6)
     p.add_argument("--window-revs", type=int, default=2)
     p.add_argument("--variables", default=",".join(NEW_VARIABLES))
-    p.add_argument("--designs", default="0,1,2", help="which of DESIGNS, by position (0, 1, 2)")
+    p.add_argument("--designs", default="0,1,2", help="which of DESIGNS, by position (0-3)")
     p.add_argument(
         "--statistic", default="mean", help="the settled statistic differentiated (optimise run --statistic)"
     )
