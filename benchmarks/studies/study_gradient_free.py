@@ -210,16 +210,13 @@ def _verified(problem, settings, run) -> None:
 
 def _three_variable_optimum(problem) -> np.ndarray:
     """`THREE_VARIABLE_OPTIMUM` as the eight profile variables [SI]: the bearing's own profile
-    (sphere, cone, its corner radius and flange height) with R_end, theta_f and Delta_bf set."""
-    from optimise import ProfileBounds, start_points
+    (sphere, cone, its corner radius and flange height) with R_end, theta_f and Delta_bf set
+    (`flange.ProfileVariables.from_design`)."""
+    from jaxbearing.flange import DesignVariables, ProfileVariables
 
-    x = np.array(problem.bounds.from_scaled(start_points(problem, 1)[0]), dtype=float)
-    keys = [v.key for v in ProfileBounds.TABLE]
     r_end, theta, delta = THREE_VARIABLE_OPTIMUM
-    x[keys.index("end_radius_mm")] = r_end * 1e-3
-    x[keys.index("layback_angle_deg")] = np.deg2rad(theta)
-    x[keys.index("axial_clearance_mm")] = delta * 1e-3
-    return x
+    design = DesignVariables(r_end * 1e-3, np.deg2rad(theta), delta * 1e-3)
+    return np.array(ProfileVariables.from_design(design, problem.bearing).as_array(), dtype=float)
 
 
 def _verified_optimum(problem, settings, out) -> None:

@@ -57,17 +57,13 @@ RULES = ("as safe", "margin", "none")
 
 
 def _optimum_si(bearing) -> np.ndarray:
-    """The three-variable optimum as the eight profile variables [SI]."""
-    from jaxbearing.flange import ProfileVariables
-    from optimise import ProfileBounds
+    """The three-variable optimum as the eight profile variables [SI]
+    (`flange.ProfileVariables.from_design`: the bearing's other faces)."""
+    from jaxbearing.flange import DesignVariables, ProfileVariables
 
-    x = np.array(ProfileVariables.of(bearing).as_array(), dtype=float)
-    keys = [v.key for v in ProfileBounds.TABLE]
     r_end, theta, delta = THREE_VARIABLE_OPTIMUM
-    x[keys.index("end_radius_mm")] = r_end * 1e-3
-    x[keys.index("layback_angle_deg")] = np.deg2rad(theta)
-    x[keys.index("axial_clearance_mm")] = delta * 1e-3
-    return x
+    design = DesignVariables(r_end * 1e-3, np.deg2rad(theta), delta * 1e-3)
+    return np.array(ProfileVariables.from_design(design, bearing).as_array(), dtype=float)
 
 
 def _settle(bearing, ops, x0, args):
