@@ -160,8 +160,9 @@ def held_load_search(
     log=None,
 ) -> HeldLoadResult:
     """The held-load search (module docstring) from `start` (scaled; default the bearing's own
-    design, `start_points`): `rounds` holds, `rounds + 1` settled evaluations. `log`: called
-    with one line per settled round."""
+    design, `start_points`): `rounds` holds, `rounds + 1` settled evaluations (fewer where a
+    settled design has no flange contact to hold at some operating point). `log`: called with
+    one line per settled round."""
     from ._search import start_points
 
     require("rounds", rounds, lambda v: (v >= 0) & (v == np.round(v)), "an integer >= 0")
@@ -188,9 +189,12 @@ def held_load_search(
         if k == rounds:
             break
         design = problem.bounds.variables(jnp.asarray(designs[-1]))
-        at = held_evaluator(
-            problem.bearing, _held(problem, ev, design, window_ms), lower, upper, problem.margins
-        )
+        held = _held(problem, ev, design, window_ms)
+        if any(c.load.shape[0] == 0 for c in held):  # no flange contact to hold at some point
+            if log is not None:
+                log(f"held-load round {k}: an operating point has no flange contact to hold; stopped")
+            break
+        at = held_evaluator(problem.bearing, held, lower, upper, problem.margins)
         readouts = at(u)[0]
         dynamic = ev.dynamic_margin if np.isfinite(ev.dynamic_margin) else settings.corner_margin
         floor = readouts[2 : 3 * len(points) : 3] - dynamic + spare
