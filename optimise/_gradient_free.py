@@ -39,7 +39,7 @@ from ._evaluate import evaluate_starts, in_shared_pool
 from ._problem import DesignProblem, margins_batch
 from ._settings import SteadySettings
 from ._state import load_checkpoint, save_checkpoint
-from ._steady import constraints, interval_bounds, scaled_limits
+from ._steady import constraints, measured_constraints, returned_so_far
 
 #: the fitness offset of an infeasible design [GPa m/s]: far above every objective
 INFEASIBLE = 1e3
@@ -67,19 +67,14 @@ class GradientFreeResult:
     def best(self) -> int:
         """Index of the returned design: the feasible one of the lowest upper bound (-1: none; one
         without an interval counts with its point estimate, as in `steady_search`)."""
-        high = np.where(self.feasible, interval_bounds(self.ci, self.objective)[:, 1], np.inf)
-        return int(np.argmin(high)) if self.feasible.any() else -1
+        chosen = returned_so_far(self.feasible, self.ci, self.objective)
+        return int(chosen[-1]) if len(chosen) else -1
 
     def best_so_far(self) -> tuple[np.ndarray, np.ndarray]:
         """(members, objective of the design returned had the search stopped there) after each
         simulated design; NaN before the first feasible one."""
-        high = np.where(self.feasible, interval_bounds(self.ci, self.objective)[:, 1], np.inf)
-        out = np.full(len(high), np.nan)
-        best = -1
-        for i in range(len(high)):
-            if np.isfinite(high[i]) and (best < 0 or high[i] < high[best]):
-                best = i
-            out[i] = self.objective[best] if best >= 0 else np.nan
+        chosen = returned_so_far(self.feasible, self.ci, self.objective)
+        out = np.where(chosen >= 0, self.objective[np.maximum(chosen, 0)], np.nan)
         keep = self.simulated
         return self.members[keep], out[keep]
 
@@ -106,12 +101,9 @@ def _generation(problem: DesignProblem, settings: SteadySettings, us: np.ndarray
     evs = evaluate_starts(problem, settings, list(us[inside]), None, gradient=False) if inside.any() else []
     np.random.set_state(state)
     for i, ev in zip(np.flatnonzero(inside), evs):
-        c, _ = constraints(
-            problem, us[i], ev.dynamic_margin, us[i], scaled_limits(settings, ev.limit_margins)[0]
-        )
+        c, row["feasible"][i] = measured_constraints(problem, settings, us[i], ev)
         row["objective"][i], row["ci"][i] = ev.objective, ev.objective_ci
         row["violation"][i] = float(np.sum(np.minimum(c, 0.0) ** 2) ** 0.5)
-        row["feasible"][i] = bool(np.all(c > 0) and np.isfinite(ev.objective))
         row["corner_risk"][i], row["simulated_ms"][i] = ev.corner_risk, ev.simulated_ms
     for i in np.flatnonzero(~inside):  # the static constraints alone (the dynamic one far off)
         c, _ = constraints(problem, us[i], 1.0, us[i])

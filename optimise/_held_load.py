@@ -30,7 +30,7 @@ from jaxbearing.io import require
 from ._evaluate import evaluate, operating_points
 from ._problem import MARGIN_SCALE, DesignProblem
 from ._settings import SteadySettings
-from ._steady import constraints, interval_bounds, scaled_limits
+from ._steady import measured_constraints, returned_so_far
 
 #: the margin [m] the held minimum keeps beyond the problem's tightened constraints
 SPARE = 2e-6
@@ -127,8 +127,14 @@ class HeldLoadResult:
 
     @property
     def best(self) -> int:
-        high = np.where(self.feasible, interval_bounds(self.ci, self.objective)[:, 1], np.inf)
-        return int(np.argmin(high)) if np.isfinite(high).any() else -1
+        chosen = returned_so_far(self.feasible, self.ci, self.objective)
+        return int(chosen[-1]) if len(chosen) else -1
+
+    def best_so_far(self) -> np.ndarray:
+        """After each round, the objective of the design returned had the search stopped there
+        (NaN before the first feasible round)."""
+        chosen = returned_so_far(self.feasible, self.ci, self.objective)
+        return np.where(chosen >= 0, self.objective[np.maximum(chosen, 0)], np.nan)
 
     @property
     def design(self) -> np.ndarray | None:
@@ -175,11 +181,10 @@ def held_load_search(
     designs, objective, ci, feasible = [], [], [], []
     for k in range(int(rounds) + 1):
         ev = evaluate(problem, settings, u, gradient=False)
-        c, _ = constraints(problem, u, ev.dynamic_margin, u, scaled_limits(settings, ev.limit_margins)[0])
         designs.append(np.asarray(problem.bounds.from_scaled(u), float))
         objective.append(float(ev.objective))
         ci.append(tuple(ev.objective_ci))
-        feasible.append(bool(np.all(c > 0) and np.isfinite(ev.objective)))
+        feasible.append(measured_constraints(problem, settings, u, ev)[1])
         if log is not None:
             log(
                 f"held-load round {k}: objective {ev.objective:.3f}, feasible {feasible[-1]}, "

@@ -299,6 +299,29 @@ def interval_bounds(ci, objective) -> np.ndarray:
     return np.where(np.isfinite(ci), ci, np.asarray(objective, float)[..., None])
 
 
+def returned_so_far(feasible, ci, objective) -> np.ndarray:
+    """After each of a search's settled evaluations, in order, the index of the one it returns
+    had it stopped there: the feasible evaluation of the lowest upper 95 % bound (the first of
+    ties; one without an interval counts with its point estimate, `interval_bounds`), -1 before
+    the first feasible one."""
+    high = np.where(feasible, interval_bounds(ci, objective)[:, 1], np.inf)
+    out = np.full(len(high), -1)
+    best = -1
+    for i in range(len(high)):
+        if np.isfinite(high[i]) and (best < 0 or high[i] < high[best]):
+            best = i
+        out[i] = best
+    return out
+
+
+def measured_constraints(problem: DesignProblem, settings: SteadySettings, u, ev) -> tuple[np.ndarray, bool]:
+    """The scaled constraints of the settled evaluation `ev` of the scaled design u at its own
+    measurements (`constraints`, the limits at their measured values, `scaled_limits`) and
+    whether it is feasible: every one positive and its objective finite."""
+    c, _ = constraints(problem, u, ev.dynamic_margin, u, scaled_limits(settings, ev.limit_margins)[0])
+    return c, bool(np.all(c > 0) and np.isfinite(ev.objective))
+
+
 def tied_with_best(h: History) -> tuple[np.ndarray, tuple | None]:
     """The feasible evaluations statistically tied with the best (iteration, start mask), and
     the best's index: the best is the feasible evaluation of the lowest upper 95 % bound of the

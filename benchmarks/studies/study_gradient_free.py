@@ -147,10 +147,7 @@ def _held_run(problem, settings, args) -> dict:
             maxiter=args.held_maxiter,
             log=log,
         )
-    curve = []
-    for k in range(len(res.objective)):
-        upto = _first_rounds(res, k + 1).best
-        curve.append(None if upto < 0 else float(res.objective[upto]))
+    curve = [None if not np.isfinite(v) else float(v) for v in res.best_so_far()]
     b = res.best
     return dict(
         method="held",
@@ -162,13 +159,6 @@ def _held_run(problem, settings, args) -> dict:
         members=count.members,
         rounds=[dict(design=d.tolist(), objective=float(o)) for d, o in zip(res.designs, res.objective)],
     )
-
-
-def _first_rounds(res, n: int):
-    """The first `n` rounds of a `HeldLoadResult` (its best-so-far after round n - 1)."""
-    from optimise import HeldLoadResult
-
-    return HeldLoadResult(res.designs[:n], res.objective[:n], res.ci[:n], res.feasible[:n])
 
 
 def _free_run(problem, settings, method, repeat, budget, args) -> dict:

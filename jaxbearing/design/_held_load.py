@@ -27,10 +27,11 @@ import jax.numpy as jnp
 import numpy as np
 from jaxtyping import Array, Float
 
-from ..dynamics import contact_loads, inner_ring_pose
+from ..dynamics import inner_ring_pose
 from ..flange import FLANGE_ORDER, flange_pv_at_load, variables_from_array
 from ..geometry import limited_circle_radius
-from ._steady_objective import STEADY_FUNCTIONALS, _design_params, _functionals
+from ._frozen_load import _exponent, _reference_loads
+from ._steady_objective import STEADY_FUNCTIONALS
 
 #: held contacts whose weight w(Q0) is below this are left out (`HeldContacts.weight_share`)
 MIN_WEIGHT = 1e-4
@@ -73,9 +74,7 @@ def held_contacts(bearing, op, design, states, *, min_weight: float = MIN_WEIGHT
     """The touching contacts of the saved `states` (a leading time axis, e.g. from
     `trajectory_states`) of `design` (a `DesignVariables` or `ProfileVariables`) applied to
     `bearing`: those whose weight w(Q0) exceeds `min_weight`."""
-    params = _design_params(bearing, op, jnp.asarray(design.as_array()))
-    b = params.bearing
-    q0 = np.asarray(jax.vmap(lambda s: contact_loads(s, params).flange.normal_force)(states))  # (T, Z, 4)
+    q0 = np.asarray(_reference_loads(bearing, op, jnp.asarray(design.as_array()), states))  # (T, Z, 4)
     w = q0 / (q0 + STEADY_FUNCTIONALS.contact_load)
     t, z, f = np.nonzero(w > min_weight)
     r = states.rollers
@@ -84,7 +83,7 @@ def held_contacts(bearing, op, design, states, *, min_weight: float = MIN_WEIGHT
     inner = (f < 2)[:, None]
     zero = np.zeros((len(t), 3))
     flange = np.asarray(FLANGE_ORDER, dtype=float)[f]  # (ring sign, side)
-    radii = np.array([float(b.inner_raceway_radius)] * 2 + [float(b.outer_raceway_radius)] * 2)
+    radii = np.array([float(bearing.inner_raceway_radius)] * 2 + [float(bearing.outer_raceway_radius)] * 2)
     return HeldContacts(
         raceway_radius=jnp.asarray(radii[f]),
         side=jnp.asarray(flange[:, 1]),
@@ -119,7 +118,7 @@ def held_readouts(
         c.load, c.ring_axis,
     )  # fmt: skip
     total = jnp.sum(c.weight)
-    p = float(_functionals("peak").pv_exponent)
+    p = float(_exponent("peak"))
     ref = STEADY_FUNCTIONALS.pv_reference
     top = smooth_max_width * jax.scipy.special.logsumexp(rho / smooth_max_width)
     return HeldReadouts(
