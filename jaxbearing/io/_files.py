@@ -178,11 +178,19 @@ def check_output_dir(path: str | os.PathLike, option: str = "--out") -> None:
     if anc.exists() and not anc.is_dir():
         raise UserInputError(f"{shown}: cannot create the directory: {anc} is not a directory")
     try:
-        p.mkdir(parents=True, exist_ok=True)
-        probe = p / f".jaxbearing-write-test.{_host()}.{os.getpid()}"
-        with open(probe, "wb") as f:
-            f.write(b"ok")
-        probe.unlink()
+        # processes of one distributed run check the same new directory at once; one may remove
+        # the directory it created for its check while another probes it: create and probe again
+        for attempt in range(3):
+            try:
+                p.mkdir(parents=True, exist_ok=True)
+                probe = p / f".jaxbearing-write-test.{_host()}.{os.getpid()}"
+                with open(probe, "wb") as f:
+                    f.write(b"ok")
+                probe.unlink()
+                break
+            except FileNotFoundError:
+                if attempt == 2:
+                    raise
     except OSError as exc:
         raise UserInputError(
             f"{shown}: cannot write there: {exc.strerror or exc}; choose a writable directory"
